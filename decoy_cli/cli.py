@@ -1,0 +1,58 @@
+"""The `decoy` command-line application: registers the subcommands, nothing else."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+import typer
+from typer.core import TyperGroup
+
+from decoy_cli import __version__
+from decoy_cli.commands import build_waypoints
+from decoy_cli.errors import DecoyError
+
+_debug = False
+
+
+class _Group(TyperGroup):
+    """Turns a `DecoyError` into one line on stderr and exit code 1 (a traceback with --debug)."""
+
+    def invoke(self, ctx: click.Context):  # type: ignore[override]
+        try:
+            return super().invoke(ctx)
+        except DecoyError as error:
+            if _debug:
+                raise
+            click.echo(f"error: {error}", err=True)
+            sys.exit(1)
+
+
+app = typer.Typer(
+    cls=_Group,
+    help="Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        typer.echo(f"decoy {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: bool = typer.Option(
+        False, "--version", callback=_show_version, is_eager=True, help="Print the version."
+    ),
+    debug: bool = typer.Option(False, "--debug", help="Show a traceback for errors."),
+) -> None:
+    """Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity."""
+    global _debug
+    _debug = debug
+
+
+app.command("build-waypoints")(build_waypoints.build_waypoints)

@@ -1,0 +1,24 @@
+"""The project's typed errors: every bad input ends as one of these, with a one-line message.
+
+Library code raises them; the CLI turns them into one clear line on stderr and a non-zero exit.
+"""
+
+
+class DecoyError(Exception):
+    """Base of every error a user can cause by giving bad input."""
+
+
+class WorldError(DecoyError):
+    """A mesh or map that cannot be read or used (missing, corrupt, wrong scale or axis)."""
+
+
+class GraphError(DecoyError):
+    """A waypoint graph file that is missing, corrupt, of another version, or a bad query."""
+
+
+class EstaError(DecoyError):
+    """An ESTA match file that cannot be read: corrupt, truncated, wrong schema, missing round."""
+
+
+class OutputError(DecoyError):
+    """An output path that cannot be written."""

@@ -1,0 +1,1 @@
+"""The waypoint graph: its type and file format, the lattice builder, nearest lookup and paths."""

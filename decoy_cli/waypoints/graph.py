@@ -1,0 +1,295 @@
+"""The waypoint graph: nodes on walkable floors, directed edges along the 8 compass directions.
+
+A `WaypointGraph` is plain arrays (positions in metres, edges as source/target/kind/direction),
+so it saves to one versioned `.npz` file, loads in milliseconds, and feeds numpy, scipy and the
+simulator directly. Queries:
+
+* `nearest(points)`: floor-aware nearest waypoint, vectorised. The search runs in a space whose
+  z axis is stretched, and a candidate must lie within a vertical band around the query, so a
+  player on the upper floor of a two-floor spot never snaps to the floor below (or above).
+* `shortest_path(a, b)` / `path_lengths(a, b)`: Dijkstra on edge lengths over the directed graph.
+
+Compass directions are numbered clockwise from north (N = +y, E = +x): 0 N, 1 NE, 2 E, 3 SE,
+4 S, 5 SW, 6 W, 7 NW. These are also the paper's 8 move actions; action 8 is STOP.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import tempfile
+import zipfile
+from dataclasses import dataclass, field
+from enum import IntEnum
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+from scipy.spatial import cKDTree
+
+from decoy_cli.errors import GraphError, OutputError
+
+FORMAT_VERSION = 1
+"""Version of the graph file; bump when the arrays or their meaning change."""
+
+DIRECTION_NAMES = ("N", "NE", "E", "SE", "S", "SW", "W", "NW")
+DIRECTION_VECTORS = np.array(
+    [(0, 1), (1, 1), (1, 0), (1, -1), (0, -1), (-1, -1), (-1, 0), (-1, 1)], dtype=np.int64
+)
+"""Lattice offsets (di, dj) of each compass direction, index = direction number."""
+STOP_ACTION = 8
+
+
+class EdgeKind(IntEnum):
+    """How an agent crosses an edge."""
+
+    WALK = 0  # level or gently sloped floor
+    STEP = 1  # a ledge up to the step height, walked without jumping
+    JUMP = 2  # a ledge above the step height, reached with a (crouch-)jump
+    DROP = 3  # a one-way drop to a lower floor
+
+
+# Vertical band for the floor-aware lookup: how far a waypoint may lie above or below the query.
+# Feet sit on the floor, so the band is tight above (ramps between lattice points) and looser
+# below (a jumping or falling player is above its floor). Floors of a two-floor spot are at least
+# a player height (1.37 m) apart.
+SNAP_MAX_ABOVE_M = 0.75
+SNAP_MAX_BELOW_M = 1.25
+_Z_STRETCH = 4.0
+_CANDIDATES = 12
+
+
+@dataclass
+class WaypointGraph:
+    """Waypoints and directed edges, in metres; see the module docstring."""
+
+    positions: np.ndarray  # (N, 3) float64
+    edge_source: np.ndarray  # (E,) int32
+    edge_target: np.ndarray  # (E,) int32
+    edge_kind: np.ndarray  # (E,) uint8, EdgeKind
+    edge_direction: np.ndarray  # (E,) uint8, compass direction 0..7
+    node_place: np.ndarray  # (N,) int16 index into place_names, -1 = none
+    place_names: list[str]
+    regions: dict[str, np.ndarray]  # region name -> sorted node indices
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    # ---- basic properties -------------------------------------------------------------------
+
+    @property
+    def num_nodes(self) -> int:
+        return int(len(self.positions))
+
+    @property
+    def num_edges(self) -> int:
+        return int(len(self.edge_source))
+
+    @cached_property
+    def edge_length(self) -> np.ndarray:
+        """3-D length of every edge in metres."""
+        delta = self.positions[self.edge_target] - self.positions[self.edge_source]
+        return np.linalg.norm(delta, axis=1)
+
+    @cached_property
+    def adjacency(self) -> csr_matrix:
+        """Sparse (N, N) matrix of edge lengths, for scipy's graph routines."""
+        return csr_matrix(
+            (self.edge_length, (self.edge_source, self.edge_target)),
+            shape=(self.num_nodes, self.num_nodes),
+        )
+
+    @cached_property
+    def out_edges(self) -> np.ndarray:
+        """(N, 8) edge index leaving each node in each compass direction, -1 where none."""
+        table = np.full((self.num_nodes, 8), -1, dtype=np.int64)
+        table[self.edge_source, self.edge_direction] = np.arange(self.num_edges)
+        return table
+
+    def action_mask(self, node: int) -> np.ndarray:
+        """Which of the 9 actions (8 moves, STOP) are possible at a node."""
+        mask = np.ones(9, dtype=np.int8)
+        mask[:8] = self.out_edges[node] >= 0
+        return mask
+
+    def region_of(self, name: str) -> np.ndarray:
+        """Node indices of a region (for example 'bombsite_a'); a GraphError if unknown."""
+        if name not in self.regions:
+            raise GraphError(f"unknown region {name!r}; known: {', '.join(sorted(self.regions))}")
+        return self.regions[name]
+
+    # ---- nearest waypoint -------------------------------------------------------------------
+
+    @cached_property
+    def _tree(self) -> cKDTree:
+        return cKDTree(self.positions * np.array([1.0, 1.0, _Z_STRETCH]))
+
+    def nearest(
+        self, points: np.ndarray, max_distance: float = np.inf
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Floor-aware nearest waypoint of each point (metres, shape (M, 3) or (3,)).
+
+        Returns (index, distance): the waypoint index (-1 where no waypoint on the query's floor
+        lies within `max_distance` and the vertical band) and the true 3-D distance (inf there).
+        """
+        pts = np.asarray(points, dtype=np.float64)
+        single = pts.ndim == 1
+        pts = np.atleast_2d(pts)
+        if pts.shape[1] != 3:
+            raise GraphError(f"nearest() wants points of shape (M, 3), got {pts.shape}")
+        if not np.all(np.isfinite(pts)):
+            raise GraphError("nearest() got a NaN or infinite position")
+        k = min(_CANDIDATES, self.num_nodes)
+        _, cand = self._tree.query(pts * np.array([1.0, 1.0, _Z_STRETCH]), k=k)
+        cand = cand.reshape(len(pts), k)
+        cand_pos = self.positions[np.minimum(cand, self.num_nodes - 1)]
+        dz = cand_pos[..., 2] - pts[:, None, 2]
+        dist = np.linalg.norm(cand_pos - pts[:, None, :], axis=2)
+        ok = (cand < self.num_nodes) & (dz <= SNAP_MAX_ABOVE_M) & (dz >= -SNAP_MAX_BELOW_M)
+        ok &= dist <= max_distance
+        dist = np.where(ok, dist, np.inf)
+        best = np.argmin(dist, axis=1)
+        rows = np.arange(len(pts))
+        index = np.where(ok[rows, best], cand[rows, best], -1)
+        distance = dist[rows, best]
+        if single:
+            return index[:1], distance[:1]
+        return index, distance
+
+    # ---- shortest paths ---------------------------------------------------------------------
+
+    def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
+        """Dijkstra from one node: (distance to every node, predecessor of every node)."""
+        dist, pred = dijkstra(self.adjacency, directed=True, indices=source, return_predecessors=True)
+        return dist, pred
+
+    def shortest_path(self, source: int, target: int) -> list[int]:
+        """Node sequence of the shortest path from `source` to `target` (both included).
+
+        Raises GraphError when `target` cannot be reached from `source`.
+        """
+        if source == target:
+            return [int(source)]
+        straight = float(np.linalg.norm(self.positions[target] - self.positions[source]))
+        # A bounded search first (most calls join nearby waypoints), then an unbounded one.
+        for limit in (4.0 * straight + 5.0, np.inf):
+            dist, pred = dijkstra(
+                self.adjacency, directed=True, indices=source, return_predecessors=True,
+                limit=limit,
+            )
+            if np.isfinite(dist[target]):
+                path = [int(target)]
+                while path[-1] != source:
+                    path.append(int(pred[path[-1]]))
+                return path[::-1]
+        raise GraphError(f"waypoint {target} cannot be reached from waypoint {source}")
+
+    # ---- file format ------------------------------------------------------------------------
+
+    def save(self, path: str | Path) -> None:
+        """Write the graph as a versioned `.npz`, byte-identical for identical graphs.
+
+        Written to a temporary file beside the target, then renamed: never half-written.
+        """
+        arrays = {
+            "format_version": np.array(FORMAT_VERSION, dtype=np.int32),
+            "positions": np.asarray(self.positions, dtype=np.float64),
+            "edge_source": np.asarray(self.edge_source, dtype=np.int32),
+            "edge_target": np.asarray(self.edge_target, dtype=np.int32),
+            "edge_kind": np.asarray(self.edge_kind, dtype=np.uint8),
+            "edge_direction": np.asarray(self.edge_direction, dtype=np.uint8),
+            "node_place": np.asarray(self.node_place, dtype=np.int16),
+            "place_names": np.array(json.dumps(self.place_names)),
+            "regions": np.array(
+                json.dumps({k: [int(i) for i in v] for k, v in sorted(self.regions.items())})
+            ),
+            "meta": np.array(json.dumps(self.meta, sort_keys=True)),
+        }
+        write_npz_atomic(Path(path), arrays)
+
+    @classmethod
+    def load(cls, path: str | Path) -> WaypointGraph:
+        """Read a graph file written by `save`; a GraphError for anything else."""
+        path = Path(path)
+        if not path.is_file():
+            raise GraphError(f"waypoint graph not found: {path}")
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                version = int(data["format_version"])
+                if version != FORMAT_VERSION:
+                    raise GraphError(
+                        f"{path}: graph format version {version}, this decoy reads "
+                        f"{FORMAT_VERSION}; rebuild it with `decoy build-waypoints`"
+                    )
+                graph = cls(
+                    positions=data["positions"].astype(np.float64),
+                    edge_source=data["edge_source"].astype(np.int32),
+                    edge_target=data["edge_target"].astype(np.int32),
+                    edge_kind=data["edge_kind"].astype(np.uint8),
+                    edge_direction=data["edge_direction"].astype(np.uint8),
+                    node_place=data["node_place"].astype(np.int16),
+                    place_names=list(json.loads(str(data["place_names"]))),
+                    regions={
+                        k: np.asarray(v, dtype=np.int64)
+                        for k, v in json.loads(str(data["regions"])).items()
+                    },
+                    meta=json.loads(str(data["meta"])),
+                )
+        except GraphError:
+            raise
+        except (OSError, KeyError, ValueError, zipfile.BadZipFile, json.JSONDecodeError) as error:
+            raise GraphError(f"{path}: not a readable waypoint graph ({error})") from None
+        graph.validate(path)
+        return graph
+
+    def validate(self, origin: str | Path = "graph") -> None:
+        """Check array shapes and index ranges; a GraphError names the first problem."""
+        n = len(self.positions)
+        problems = []
+        if self.positions.ndim != 2 or self.positions.shape[1] != 3:
+            problems.append("positions are not (N, 3)")
+        if not np.all(np.isfinite(self.positions)):
+            problems.append("positions hold NaN")
+        e = len(self.edge_source)
+        if not all(len(a) == e for a in (self.edge_target, self.edge_kind, self.edge_direction)):
+            problems.append("edge arrays differ in length")
+        elif e and (
+            min(self.edge_source.min(), self.edge_target.min()) < 0
+            or max(self.edge_source.max(), self.edge_target.max()) >= n
+        ):
+            problems.append("an edge points outside the node list")
+        if len(self.node_place) != n:
+            problems.append("node_place length differs from the node count")
+        if problems:
+            raise GraphError(f"{origin}: corrupt waypoint graph ({problems[0]})")
+
+
+def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write arrays as an uncompressed-deterministic `.npz` (fixed timestamps), atomically."""
+    path = Path(path)
+    if path.exists() and path.is_dir():
+        raise OutputError(f"cannot write {path}: it is a directory")
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=parent)
+    except OSError as error:
+        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
+    try:
+        with os.fdopen(fd, "wb") as raw, zipfile.ZipFile(raw, "w", zipfile.ZIP_DEFLATED) as zf:
+            for name, array in arrays.items():
+                buffer = io.BytesIO()
+                np.lib.format.write_array(buffer, np.asarray(array), allow_pickle=False)
+                info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = 0o644 << 16
+                zf.writestr(info, buffer.getvalue())
+        os.replace(tmp, path)
+    except OSError as error:
+        Path(tmp).unlink(missing_ok=True)
+        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
