@@ -9,7 +9,6 @@ import typer
 from typer.core import TyperGroup
 
 from decoy_cli import __version__
-from decoy_cli.commands import build_waypoints
 from decoy_cli.errors import DecoyError
 
 _debug = False
@@ -54,5 +53,3 @@ def main(
     global _debug
     _debug = debug
 
-
-app.command("build-waypoints")(build_waypoints.build_waypoints)

@@ -1,0 +1,1 @@
+"""One thin module per subcommand: options, progress bars and printing; no computation."""
