@@ -52,4 +52,3 @@ def main(
     """Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity."""
     global _debug
     _debug = debug
-

@@ -54,8 +54,16 @@ def main(sdist: Path) -> None:
         w.writerow(["area_id", "place", "x_min", "y_min", "z_at_min", "x_max", "y_max", "z_at_max"])
         for r in rows:
             w.writerow(
-                [int(r["areaId"]), r["areaName"], r["northWestX"], r["northWestY"],
-                 r["northWestZ"], r["southEastX"], r["southEastY"], r["southEastZ"]]
+                [
+                    int(r["areaId"]),
+                    r["areaName"],
+                    r["northWestX"],
+                    r["northWestY"],
+                    r["northWestZ"],
+                    r["southEastX"],
+                    r["southEastY"],
+                    r["southEastZ"],
+                ]
             )
     pairs = sorted({tuple(int(v) for v in line.split(",")) for line in connections.split()})
     with open(OUT / "nav_connections.csv", "w", newline="") as f:
@@ -67,7 +75,11 @@ def main(sdist: Path) -> None:
         "source": f"awpy=={AWPY_VERSION} (PyPI sdist), awpy/data/nav and awpy/data/map",
         "license": "MIT, Copyright (c) 2020-2023 Peter Xenopoulos",
         "units": "Hammer units (1 u = 0.01905 m), x east, y north, z up",
-        "radar": {"pos_x": map_data["pos_x"], "pos_y": map_data["pos_y"], "scale": map_data["scale"]},
+        "radar": {
+            "pos_x": map_data["pos_x"],
+            "pos_y": map_data["pos_y"],
+            "scale": map_data["scale"],
+        },
         "areas": len(rows),
         "connections": len(pairs),
     }

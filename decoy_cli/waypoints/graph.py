@@ -81,11 +81,11 @@ class WaypointGraph:
 
     @property
     def num_nodes(self) -> int:
-        return int(len(self.positions))
+        return len(self.positions)
 
     @property
     def num_edges(self) -> int:
-        return int(len(self.edge_source))
+        return len(self.edge_source)
 
     @cached_property
     def edge_length(self) -> np.ndarray:
@@ -162,7 +162,9 @@ class WaypointGraph:
 
     def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
         """Dijkstra from one node: (distance to every node, predecessor of every node)."""
-        dist, pred = dijkstra(self.adjacency, directed=True, indices=source, return_predecessors=True)
+        dist, pred = dijkstra(
+            self.adjacency, directed=True, indices=source, return_predecessors=True
+        )
         return dist, pred
 
     def shortest_path(self, source: int, target: int) -> list[int]:
@@ -176,7 +178,10 @@ class WaypointGraph:
         # A bounded search first (most calls join nearby waypoints), then an unbounded one.
         for limit in (4.0 * straight + 5.0, np.inf):
             dist, pred = dijkstra(
-                self.adjacency, directed=True, indices=source, return_predecessors=True,
+                self.adjacency,
+                directed=True,
+                indices=source,
+                return_predecessors=True,
                 limit=limit,
             )
             if np.isfinite(dist[target]):

@@ -36,7 +36,7 @@ class World:
 
     @property
     def num_triangles(self) -> int:
-        return int(len(self.triangles))
+        return len(self.triangles)
 
     @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
