@@ -1,0 +1,345 @@
+"""Timed waypoint plans: one player's snapped waypoints joined by shortest paths, with deadlines.
+
+A plan says which waypoint the agent must reach by each data-frame time (a *target*), the full
+node path between targets (weighted shortest paths on the directed graph), the same path as the
+paper's action space (8 compass moves, one per edge, and STOP for waiting), and for every interval
+between two targets how fast the player would have to run and whether that is possible with the
+weapon in hand. Nothing is collapsed: standing still for 10 s is 10 s of STOP.
+
+How a simulator executes a plan (the contract this module promises):
+
+* Spawn the agent at `target_node[0]` at `target_seconds[0]`.
+* Take the actions in order. A move crosses the edge `action_edge` to `action_node`; over one
+  interval the agent runs at the interval's required speed, capped by `interval_max_speed_m_s`,
+  so it reaches the target by its deadline unless the interval is `infeasible`. A STOP holds the
+  agent at `action_node` until `action_deadline_s` (its planned length is `action_duration_s`; an
+  agent that arrives late after an infeasible interval waits less, so it catches up with the
+  clock instead of drifting).
+* A RELOCATE marks an `unreachable` interval (the target cannot be reached from the previous
+  waypoint on the directed graph: a gap in the graph). The agent holds its waypoint until the
+  deadline, then is placed at `action_node`; the simulator counts it as a recovery, like a
+  teleport out of a stuck position.
+* After the last target the agent holds its waypoint. A plan never kills its agent: a player
+  alive at the end of the data survives (`death_frame == -1`). A player who died in the data has
+  `death_frame >= 0`, the first frame where the data shows it dead; a movement-only replay removes
+  the agent at `death_seconds`, a replay with combat lets combat decide.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.errors import EstaError, GraphError
+from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
+from decoy_cli.weapons import max_speed_m_s
+
+RELOCATE_ACTION = 9
+"""Plan-only action (not one of the paper's 9): jump to a waypoint across a gap in the graph."""
+
+ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
+"""Display name of every plan action code: 0..7 compass moves, 8 STOP, 9 RELOCATE."""
+
+RATIO_TOLERANCE = 1e-9
+"""An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
+
+
+class PathCache:
+    """Shortest paths between waypoint pairs on one graph, each pair computed once.
+
+    Share one cache between the players of a round (or many rounds): players crossing the same
+    spots ask for the same pairs.
+    """
+
+    def __init__(self, graph: WaypointGraph) -> None:
+        self.graph = graph
+        # Edge lookup by (source, target): keys sorted, the shortest edge first among duplicates.
+        keys = graph.edge_source.astype(np.int64) * graph.num_nodes + graph.edge_target
+        order = np.lexsort((graph.edge_length, keys))
+        self._keys = keys[order]
+        self._edge_ids = order
+        self._paths: dict[tuple[int, int], np.ndarray | None] = {}
+
+    def __len__(self) -> int:
+        """Number of (source, target) pairs computed so far."""
+        return len(self._paths)
+
+    def edges(self, source: int, target: int) -> np.ndarray | None:
+        """Edge indices of the shortest path from `source` to `target`, None if unreachable.
+
+        Empty for `source == target`.
+        """
+        key = (source, target)
+        if key not in self._paths:
+            self._paths[key] = self._compute(source, target)
+        return self._paths[key]
+
+    def _compute(self, source: int, target: int) -> np.ndarray | None:
+        try:
+            nodes = np.asarray(self.graph.shortest_path(source, target), dtype=np.int64)
+        except GraphError:
+            return None
+        keys = nodes[:-1] * self.graph.num_nodes + nodes[1:]
+        return self._edge_ids[np.searchsorted(self._keys, keys)]
+
+
+@dataclass(frozen=True)
+class PlayerPlan:
+    """Timed plan of one player in one round; see the module docstring for how to execute it.
+
+    Arrays come in four groups: targets (T,), intervals between consecutive targets (T-1,), the
+    node path (K,) and the actions (A,). Times are seconds since freeze-time end, lengths metres.
+    """
+
+    target_frame: np.ndarray
+    """(T,) int64 data frame of each target: alive and snapped frames, in order."""
+    target_node: np.ndarray
+    """(T,) int64 waypoint to be at by the target's deadline."""
+    target_seconds: np.ndarray
+    """(T,) float64 deadline of each target: its frame time."""
+    target_path_index: np.ndarray
+    """(T,) int64 position of each target in `path_node`."""
+
+    interval_seconds: np.ndarray
+    """(T-1,) float64 time from target k to target k+1."""
+    interval_skipped_frames: np.ndarray
+    """(T-1,) int64 frames between the two targets without a target (absent, unsnappable)."""
+    interval_length_m: np.ndarray
+    """(T-1,) float64 shortest-path length, 0 when standing still, NaN when unreachable."""
+    interval_required_speed_m_s: np.ndarray
+    """(T-1,) float64 length / time: the speed needed to arrive on time (inf for 0 s moves)."""
+    interval_max_speed_m_s: np.ndarray
+    """(T-1,) float64 CS:GO maximum speed with the weapon held at the interval's start."""
+    interval_speed_ratio: np.ndarray
+    """(T-1,) float64 required / maximum speed (NaN when unreachable)."""
+    interval_infeasible: np.ndarray
+    """(T-1,) bool the ratio exceeds 1: the plan asks for more than the player can run."""
+    interval_unreachable: np.ndarray
+    """(T-1,) bool the target is not reachable from the previous one: the plan relocates."""
+
+    path_node: np.ndarray
+    """(K,) int64 every waypoint in order; a repeated node is a wait or a relocation target."""
+    path_interval: np.ndarray
+    """(K,) int64 interval each entry ends, -1 for the start node."""
+    path_deadline_s: np.ndarray
+    """(K,) float64 deadline of the target whose interval holds the entry."""
+
+    action: np.ndarray
+    """(A,) int8 0..7 compass move (the edge's direction), 8 STOP, 9 RELOCATE."""
+    action_edge: np.ndarray
+    """(A,) int64 edge crossed by a move, -1 for STOP and RELOCATE."""
+    action_node: np.ndarray
+    """(A,) int64 waypoint the agent is at after the action."""
+    action_interval: np.ndarray
+    """(A,) int64 interval the action belongs to."""
+    action_duration_s: np.ndarray
+    """(A,) float64 planned duration: a move's share of its interval, a STOP's whole interval."""
+    action_deadline_s: np.ndarray
+    """(A,) float64 deadline of the action's interval."""
+
+    last_alive_frame: int
+    """Last frame the player is alive in the data, -1 if never."""
+    death_frame: int
+    """First frame after `last_alive_frame` that shows the player dead; -1 if it survives."""
+    death_seconds: float
+    """Frame time of `death_frame`, NaN if the player survives."""
+
+    @property
+    def is_empty(self) -> bool:
+        """No target at all: the player is never alive on the graph."""
+        return len(self.target_frame) == 0
+
+    @property
+    def died(self) -> bool:
+        """The data shows the player dead after its last alive frame."""
+        return self.death_frame >= 0
+
+    @property
+    def num_intervals(self) -> int:
+        return len(self.interval_seconds)
+
+    @property
+    def num_infeasible(self) -> int:
+        return int(np.count_nonzero(self.interval_infeasible))
+
+    @property
+    def num_unreachable(self) -> int:
+        return int(np.count_nonzero(self.interval_unreachable))
+
+    @property
+    def worst_ratio(self) -> float:
+        """Largest required / maximum speed ratio over reachable intervals, NaN if none."""
+        ratios = self.interval_speed_ratio[~self.interval_unreachable]
+        return float(ratios.max()) if len(ratios) else float("nan")
+
+    @property
+    def total_length_m(self) -> float:
+        """Path length over all reachable intervals."""
+        return float(np.nansum(self.interval_length_m))
+
+    @property
+    def stop_seconds(self) -> float:
+        """Planned time spent in STOP actions."""
+        return float(self.action_duration_s[self.action == STOP_ACTION].sum())
+
+    def interval_table(self) -> pd.DataFrame:
+        """One row per interval, for reports: frames, times, nodes, length, speeds and flags."""
+        return pd.DataFrame(
+            {
+                "start_frame": self.target_frame[:-1],
+                "end_frame": self.target_frame[1:],
+                "start_s": self.target_seconds[:-1],
+                "end_s": self.target_seconds[1:],
+                "seconds": self.interval_seconds,
+                "skipped_frames": self.interval_skipped_frames,
+                "from_node": self.target_node[:-1],
+                "to_node": self.target_node[1:],
+                "length_m": self.interval_length_m,
+                "required_m_s": self.interval_required_speed_m_s,
+                "max_m_s": self.interval_max_speed_m_s,
+                "ratio": self.interval_speed_ratio,
+                "infeasible": self.interval_infeasible,
+                "unreachable": self.interval_unreachable,
+            }
+        )
+
+
+def build_plan(
+    graph: WaypointGraph,
+    snapped_nodes: np.ndarray,
+    frame_seconds: np.ndarray,
+    alive: np.ndarray,
+    weapons: np.ndarray,
+    *,
+    present: np.ndarray | None = None,
+    paths: PathCache | None = None,
+) -> PlayerPlan:
+    """Build the timed plan of one player from its snapped waypoints (all arrays (F,)).
+
+    `snapped_nodes` holds -1 for frames without a waypoint; `weapons` the weapon name in hand per
+    frame ("" = none, runs at knife speed; an unknown name raises EstaError). `present` marks the
+    frames where the player is recorded at all (default: every frame); after the last alive frame
+    only a present, not-alive frame counts as a death, so a player who merely vanishes from the
+    data is not killed. Frames without a target in the middle are joined over, with the deadline
+    at the next target. `paths` shares a path cache between calls.
+    """
+    nodes = np.asarray(snapped_nodes, dtype=np.int64)
+    seconds = np.asarray(frame_seconds, dtype=np.float64)
+    alive = np.asarray(alive, dtype=bool)
+    weapons = np.asarray(weapons)
+    present = np.ones(len(seconds), dtype=bool) if present is None else np.asarray(present, bool)
+    frames = len(seconds)
+    for name, array in (
+        ("snapped nodes", nodes),
+        ("alive flags", alive),
+        ("weapons", weapons),
+        ("present flags", present),
+    ):
+        if array.shape != (frames,):
+            raise EstaError(f"{name} have shape {array.shape}, expected ({frames},)")
+    if frames and (nodes.min() < -1 or nodes.max() >= graph.num_nodes):
+        raise GraphError(f"snapped waypoints outside the graph's {graph.num_nodes} waypoints")
+    if not np.all(np.isfinite(seconds)) or np.any(np.diff(seconds) < 0):
+        raise EstaError("frame times must be finite and non-decreasing")
+    if paths is None:
+        paths = PathCache(graph)
+    elif paths.graph is not graph:
+        raise GraphError("the path cache belongs to another waypoint graph")
+
+    target_frame = np.flatnonzero((nodes >= 0) & alive)
+    target_node = nodes[target_frame]
+    target_seconds = seconds[target_frame]
+    interval_seconds = np.diff(target_seconds)
+    count = len(interval_seconds)
+    max_speed = _max_speeds(weapons[target_frame[:-1]])
+
+    length = np.zeros(count)
+    unreachable = np.zeros(count, dtype=bool)
+    path_parts = [target_node[:1]]
+    path_interval_parts = [np.full(len(target_node[:1]), -1, dtype=np.int64)]
+    act_parts: list[np.ndarray] = []
+    edge_parts: list[np.ndarray] = []
+    act_node_parts: list[np.ndarray] = []
+    act_interval_parts: list[np.ndarray] = []
+    duration_parts: list[np.ndarray] = []
+    for k in range(count):
+        a, b = int(target_node[k]), int(target_node[k + 1])
+        dt = float(interval_seconds[k])
+        edges = paths.edges(a, b) if a != b else None
+        if edges is None:  # stand still (a == b) or cross a gap (unreachable)
+            unreachable[k] = a != b
+            length[k] = np.nan if a != b else 0.0
+            step_nodes = np.array([b], dtype=np.int64)
+            act_parts.append(np.array([RELOCATE_ACTION if a != b else STOP_ACTION], np.int8))
+            edge_parts.append(np.array([-1], dtype=np.int64))
+            duration_parts.append(np.array([dt]))
+        else:
+            edge_length = graph.edge_length[edges]
+            length[k] = edge_length.sum()
+            step_nodes = graph.edge_target[edges].astype(np.int64)
+            act_parts.append(graph.edge_direction[edges].astype(np.int8))
+            edge_parts.append(edges.astype(np.int64))
+            duration_parts.append(dt * edge_length / length[k])
+        path_parts.append(step_nodes)
+        path_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
+        act_node_parts.append(step_nodes)
+        act_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        required = np.where(length == 0, 0.0, length / interval_seconds)
+    ratio = required / max_speed
+    path_interval = np.concatenate(path_interval_parts)
+    action_interval = _concat(act_interval_parts, np.int64)
+    entries_per_interval = np.array([len(p) for p in path_parts[1:]], dtype=np.int64)
+    target_path_index = np.concatenate([[0], np.cumsum(entries_per_interval)])[: len(target_node)]
+    last_alive_frame, death_frame = _fate(alive, present)
+    return PlayerPlan(
+        target_frame=target_frame.astype(np.int64),
+        target_node=target_node,
+        target_seconds=target_seconds,
+        target_path_index=target_path_index,
+        interval_seconds=interval_seconds,
+        interval_skipped_frames=np.diff(target_frame).astype(np.int64) - 1,
+        interval_length_m=length,
+        interval_required_speed_m_s=required,
+        interval_max_speed_m_s=max_speed,
+        interval_speed_ratio=ratio,
+        interval_infeasible=ratio > 1.0 + RATIO_TOLERANCE,
+        interval_unreachable=unreachable,
+        path_node=np.concatenate(path_parts).astype(np.int64),
+        path_interval=path_interval,
+        path_deadline_s=target_seconds[path_interval + 1],
+        action=_concat(act_parts, np.int8),
+        action_edge=_concat(edge_parts, np.int64),
+        action_node=_concat(act_node_parts, np.int64),
+        action_interval=action_interval,
+        action_duration_s=_concat(duration_parts, np.float64),
+        action_deadline_s=target_seconds[action_interval + 1],
+        last_alive_frame=last_alive_frame,
+        death_frame=death_frame,
+        death_seconds=float(seconds[death_frame]) if death_frame >= 0 else float("nan"),
+    )
+
+
+def _max_speeds(names: np.ndarray) -> np.ndarray:
+    """Maximum speed (m/s) for each weapon name, each distinct name looked up once."""
+    unique, inverse = np.unique(names.astype(str), return_inverse=True)
+    speeds = np.array([max_speed_m_s(str(name)) for name in unique], dtype=np.float64)
+    return speeds[inverse]
+
+
+def _fate(alive: np.ndarray, present: np.ndarray) -> tuple[int, int]:
+    """(last alive frame, first later frame recorded dead), -1 where there is none."""
+    alive_frames = np.flatnonzero(alive)
+    if not len(alive_frames):
+        return -1, -1
+    last = int(alive_frames[-1])
+    dead_after = np.flatnonzero(present[last + 1 :])
+    return last, (last + 1 + int(dead_after[0])) if len(dead_after) else -1
+
+
+def _concat(parts: list[np.ndarray], dtype: type) -> np.ndarray:
+    """Concatenate per-interval arrays (none for a plan without intervals)."""
+    return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
