@@ -1,0 +1,86 @@
+"""Top-down picture of a waypoint graph over the walkable map.
+
+Walk and step edges are coloured by height; jump edges and drop edges have their own colours so
+they stand out; optionally, edges removed by verification and nodes removed by pruning are drawn
+too, for looking at what the builder threw away.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.errors import OutputError
+from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
+from decoy_cli.world.navmesh import NavMesh
+
+
+def plot_graph(
+    graph: WaypointGraph,
+    path: str | Path,
+    nav: NavMesh | None = None,
+    floor_triangles: np.ndarray | None = None,
+    removed_segments: np.ndarray | None = None,
+    pruned_positions: np.ndarray | None = None,
+    title: str = "",
+    dpi: int = 150,
+) -> None:
+    """Write a PNG of the graph. The walkable map is the nav areas or the given floor triangles."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    fig, ax = plt.subplots(figsize=(12, 12))
+    if nav is not None:
+        boxes = [
+            [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+            for x0, y0, x1, y1 in zip(nav.x_min, nav.y_min, nav.x_max, nav.y_max, strict=True)
+        ]
+        polys = np.asarray(boxes) * HAMMER_TO_M
+        ax.add_collection(PolyCollection(polys, facecolor="#e6e6e6", edgecolor="#c8c8c8", lw=0.3))
+    if floor_triangles is not None and len(floor_triangles):
+        ax.add_collection(
+            PolyCollection(floor_triangles[:, :, :2], facecolor="#e6e6e6", edgecolor="none")
+        )
+    pos = graph.positions
+    segments = np.stack([pos[graph.edge_source, :2], pos[graph.edge_target, :2]], axis=1)
+    kind = graph.edge_kind
+    flat = (kind == EdgeKind.WALK) | (kind == EdgeKind.STEP)
+    height = (pos[graph.edge_source, 2] + pos[graph.edge_target, 2]) / 2
+    lines = LineCollection(segments[flat], array=height[flat], cmap="viridis", lw=0.4)
+    ax.add_collection(lines)
+    fig.colorbar(lines, ax=ax, shrink=0.6, label="height (m)")
+    ax.add_collection(
+        LineCollection(segments[kind == EdgeKind.JUMP], colors="#ff7f0e", lw=1.4, label="jump")
+    )
+    ax.add_collection(
+        LineCollection(segments[kind == EdgeKind.DROP], colors="#d62728", lw=1.4, label="drop")
+    )
+    if removed_segments is not None and len(removed_segments):
+        ax.add_collection(
+            LineCollection(
+                removed_segments[:, :, :2], colors="#e377c2", lw=0.8, label="removed by verification"
+            )
+        )
+    if pruned_positions is not None and len(pruned_positions):
+        ax.scatter(*pruned_positions[:, :2].T, s=2, c="#7f7f7f", label="pruned nodes")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.set_xlabel("x (m, east)")
+    ax.set_ylabel("y (m, north)")
+    ax.legend(loc="lower right")
+    ax.set_title(title or f"{graph.num_nodes} waypoints, {graph.num_edges} edges")
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.tmp.png")
+        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+        tmp.replace(path)
+    except OSError as error:
+        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
+    finally:
+        plt.close(fig)

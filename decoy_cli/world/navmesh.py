@@ -1,0 +1,457 @@
+"""The built-in de_dust2 world, made from the real CS:GO navigation mesh (awpy 1.3.1 slice).
+
+The nav mesh is 1,118 axis-aligned rectangles ("areas") with a place name and the heights of two
+opposite corners, plus the list of connected area pairs. `nav_world()` turns it into a triangle
+world that a physics engine can use:
+
+* **Floors.** Each area is a bilinear quad. awpy 1.x dropped two corner heights of each area;
+  they are fitted by least squares so that touching areas meet along their shared edges (without
+  that fit, seams show steps of about 12 u at the 90th percentile).
+* **Step faces.** Vertical faces between touching areas at different heights, so a ledge is a
+  ledge and not a gap.
+* **Bridges.** Connected areas separated by a small gap (up to 32 u, typically a jump onto a box)
+  get a floor across the gap (each half at its own side's height, with a step face between).
+* **Walls.** Area edges that border no other area become vertical walls. Nav areas stop about
+  16 u (half a player hull) short of the real walls, so walls are pushed out by up to 16 u, capped
+  at half the gap to the next area, and the floor is extended under the push.
+
+Everything is computed in Hammer units and returned in metres. Line of sight in this world is
+approximate: holes in the nav mesh become walls, and windows, low cover and door gaps vanish.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.linalg import lsqr
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.errors import WorldError
+from decoy_cli.world.world import World
+
+BUILTIN_MAP = "de_dust2"
+
+WALL_PUSH_U = 16.0
+"""How far walls stand beyond the nav edge (half a player hull)."""
+BRIDGE_MAX_GAP_U = 32.0
+"""Connected areas whose facing edges are at most this far apart get a bridging floor."""
+TOUCH_TOL_U = 1.0
+"""Edges closer than this count as touching."""
+MAX_SHARED_STEP_U = 320.0
+"""Touching areas further apart in height than this are not neighbours: the edge gets a wall."""
+WALL_HEIGHT_U = 184.0
+"""Wall height above its floor (3.5 m), capped below any floor overhead."""
+SEAM_MATCH_U = 24.0
+"""Touching edges whose heights differ by less than this are fitted to meet (else a ledge)."""
+
+REGION_PLACES = {
+    "t_spawn": "TSpawn",
+    "ct_spawn": "CTSpawn",
+    "bombsite_a": "BombsiteA",
+    "bombsite_b": "BombsiteB",
+}
+"""Regions the simulator and the replay use, and the nav place that defines each."""
+
+
+@dataclass(frozen=True)
+class NavMesh:
+    """Nav areas as arrays (Hammer units): rectangle bounds, corner heights, places, links."""
+
+    area_id: np.ndarray  # (A,) int64
+    place: np.ndarray  # (A,) str
+    x_min: np.ndarray
+    y_min: np.ndarray
+    x_max: np.ndarray
+    y_max: np.ndarray
+    z_at_min: np.ndarray  # height at (x_min, y_min)
+    z_at_max: np.ndarray  # height at (x_max, y_max)
+    connections: np.ndarray  # (C, 2) area indices (not ids), directed
+    radar: dict[str, float]
+
+    @property
+    def num_areas(self) -> int:
+        return len(self.area_id)
+
+    @property
+    def places(self) -> list[str]:
+        """Sorted distinct place names (the empty name excluded)."""
+        return sorted({p for p in self.place.tolist() if p})
+
+    def contains(self, points_u: np.ndarray, z_tolerance_u: float, margin_u: float = 0.0):
+        """(M, A) mask of points inside each area's rectangle (grown by margin) near its height."""
+        x, y, z = points_u[:, 0:1], points_u[:, 1:2], points_u[:, 2:3]
+        inside = (
+            (x >= self.x_min - margin_u)
+            & (x <= self.x_max + margin_u)
+            & (y >= self.y_min - margin_u)
+            & (y <= self.y_max + margin_u)
+        )
+        low = np.minimum(self.z_at_min, self.z_at_max)
+        high = np.maximum(self.z_at_min, self.z_at_max)
+        return inside & (z >= low - z_tolerance_u) & (z <= high + z_tolerance_u)
+
+    def area_of(self, points_m: np.ndarray, max_distance_m: float = 1.0) -> np.ndarray:
+        """Index of the nav area under each point (metres), -1 where none is near.
+
+        A point inside several rectangles (two floors) takes the one closest in height; a point
+        just outside every rectangle (near a wall) takes the nearest rectangle on its floor.
+        """
+        pts = np.asarray(points_m, dtype=np.float64).reshape(-1, 3) / HAMMER_TO_M
+        out = np.full(len(pts), -1, dtype=np.int64)
+        centre_z = (self.z_at_min + self.z_at_max) / 2
+        for start in range(0, len(pts), 2048):
+            chunk = pts[start : start + 2048]
+            dx = np.maximum(0, np.maximum(self.x_min - chunk[:, :1], chunk[:, :1] - self.x_max))
+            dy = np.maximum(0, np.maximum(self.y_min - chunk[:, 1:2], chunk[:, 1:2] - self.y_max))
+            dz = np.abs(chunk[:, 2:3] - centre_z)
+            cost = np.hypot(dx, dy) + 0.25 * dz
+            best = np.argmin(cost, axis=1)
+            ok = cost[np.arange(len(chunk)), best] <= max_distance_m / HAMMER_TO_M
+            out[start : start + len(chunk)] = np.where(ok, best, -1)
+        return out
+
+
+def asset_dir(map_name: str = BUILTIN_MAP) -> Path:
+    """Folder of a built-in map's assets inside the installed package."""
+    return Path(str(resources.files("decoy_cli") / "assets" / map_name))
+
+
+@cache
+def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
+    """Read the nav areas, connections and radar transform shipped for a built-in map."""
+    folder = asset_dir(map_name)
+    if not (folder / "nav_areas.csv").is_file():
+        raise WorldError(f"no built-in map {map_name!r} (looked in {folder})")
+    with open(folder / "nav_areas.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    area_id = np.array([int(r["area_id"]) for r in rows], dtype=np.int64)
+    col = {k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k not in ("area_id", "place")}
+    index = {int(a): i for i, a in enumerate(area_id)}
+    with open(folder / "nav_connections.csv", newline="") as f:
+        pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in csv.DictReader(f)]
+    meta = json.loads((folder / "map.json").read_text())
+    return NavMesh(
+        area_id=area_id,
+        place=np.array([r["place"] for r in rows]),
+        x_min=col["x_min"],
+        y_min=col["y_min"],
+        x_max=col["x_max"],
+        y_max=col["y_max"],
+        z_at_min=col["z_at_min"],
+        z_at_max=col["z_at_max"],
+        connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
+        radar=meta["radar"],
+    )
+
+
+# ---- corner heights ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Contact:
+    """Two areas touching along an axis-aligned segment (Hammer units)."""
+
+    a: int
+    b: int
+    axis: int  # 0: the shared edge is vertical (x = const), 1: horizontal (y = const)
+    coord: float  # the constant coordinate of the shared edge
+    lo: float  # extent of the overlap along the edge
+    hi: float
+
+
+def _corner_heights(nav: NavMesh, zx: np.ndarray, zy: np.ndarray):
+    """The four corner heights: (x_min,y_min), (x_max,y_min), (x_min,y_max), (x_max,y_max)."""
+    return nav.z_at_min, zx, zy, nav.z_at_max
+
+
+def _height(nav: NavMesh, zx, zy, area: int, x: float, y: float) -> float:
+    """Bilinear floor height of an area at a point of its rectangle (clamped)."""
+    u = np.clip((x - nav.x_min[area]) / (nav.x_max[area] - nav.x_min[area]), 0, 1)
+    v = np.clip((y - nav.y_min[area]) / (nav.y_max[area] - nav.y_min[area]), 0, 1)
+    z00, z10, z01, z11 = (c[area] for c in _corner_heights(nav, zx, zy))
+    return float(z00 * (1 - u) * (1 - v) + z10 * u * (1 - v) + z01 * (1 - u) * v + z11 * u * v)
+
+
+def _find_contacts(nav: NavMesh) -> list[_Contact]:
+    """Every pair of areas whose rectangles touch along a segment of positive length."""
+    contacts = []
+    for axis, (lo_a, hi_a, lo_t, hi_t) in enumerate(
+        ((nav.x_min, nav.x_max, nav.y_min, nav.y_max), (nav.y_min, nav.y_max, nav.x_min, nav.x_max))
+    ):
+        # a's high side touches b's low side
+        touch = np.abs(hi_a[:, None] - lo_a[None, :]) <= TOUCH_TOL_U
+        lo = np.maximum(lo_t[:, None], lo_t[None, :])
+        hi = np.minimum(hi_t[:, None], hi_t[None, :])
+        touch &= hi - lo > TOUCH_TOL_U
+        for a, b in zip(*np.nonzero(touch), strict=True):
+            contacts.append(_Contact(int(a), int(b), axis, float(hi_a[a]), lo[a, b], hi[a, b]))
+    return contacts
+
+
+def _edge_point(c: _Contact, t: float) -> tuple[float, float]:
+    along = c.lo + t * (c.hi - c.lo)
+    return (c.coord, along) if c.axis == 0 else (along, c.coord)
+
+
+def fit_corner_heights(nav: NavMesh, contacts: list[_Contact]) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares heights of the two corners awpy dropped, so touching floors meet.
+
+    Unknowns: per area the height at (x_max, y_min) and at (x_min, y_max). Equations: along every
+    shared edge whose two sides are roughly level (a seam, not a ledge), both bilinear floors give
+    the same height at the overlap's ends; per area, a weak pull toward a plane through the two
+    known corners keeps isolated areas sensible.
+    """
+    n = nav.num_areas
+    guess = (nav.z_at_min + nav.z_at_max) / 2
+    rows, cols, vals, rhs = [], [], [], []
+
+    def coefficients(area: int, x: float, y: float):
+        u = np.clip((x - nav.x_min[area]) / (nav.x_max[area] - nav.x_min[area]), 0, 1)
+        v = np.clip((y - nav.y_min[area]) / (nav.y_max[area] - nav.y_min[area]), 0, 1)
+        known = nav.z_at_min[area] * (1 - u) * (1 - v) + nav.z_at_max[area] * u * v
+        return u * (1 - v), (1 - u) * v, known  # weights of zx, zy, and the known part
+
+    eq = 0
+    for c in contacts:
+        for t in (0.0, 1.0):
+            x, y = _edge_point(c, t)
+            wa_x, wa_y, ka = coefficients(c.a, x, y)
+            wb_x, wb_y, kb = coefficients(c.b, x, y)
+            if abs((ka + (wa_x + wa_y) * guess[c.a]) - (kb + (wb_x + wb_y) * guess[c.b])) > (
+                SEAM_MATCH_U
+            ):
+                continue
+            rows += [eq] * 4
+            cols += [c.a, n + c.a, c.b, n + c.b]
+            vals += [wa_x, wa_y, -wb_x, -wb_y]
+            rhs.append(kb - ka)
+            eq += 1
+    weak = 0.05
+    for a in range(n):
+        rows += [eq, eq, eq + 1, eq + 1]
+        cols += [a, n + a, a, n + a]
+        vals += [weak, weak, weak, -weak]
+        rhs += [weak * 2 * guess[a], 0.0]
+        eq += 2
+    matrix = coo_matrix((vals, (rows, cols)), shape=(eq, 2 * n)).tocsr()
+    solution = lsqr(matrix, np.asarray(rhs), atol=1e-10, btol=1e-10, iter_lim=20000)[0]
+    return solution[:n], solution[n:]
+
+
+# ---- triangles --------------------------------------------------------------------------------
+
+
+def _quad(p0, p1, p2, p3) -> list[list[tuple[float, float, float]]]:
+    """Two triangles of the quad p0-p1-p2-p3 (in order around its boundary)."""
+    return [[p0, p1, p2], [p0, p2, p3]]
+
+
+def _subtract(interval: tuple[float, float], covers: list[tuple[float, float]]):
+    """Parts of a 1-D interval not covered by any of `covers`."""
+    pieces = [interval]
+    for lo, hi in covers:
+        nxt = []
+        for a, b in pieces:
+            if hi <= a or lo >= b:
+                nxt.append((a, b))
+                continue
+            if lo > a:
+                nxt.append((a, lo))
+            if hi < b:
+                nxt.append((hi, b))
+        pieces = nxt
+    return [(a, b) for a, b in pieces if b - a > TOUCH_TOL_U]
+
+
+def build_nav_triangles(nav: NavMesh) -> np.ndarray:
+    """Floors, step faces, bridges and walls of the nav world, (T, 3, 3) in Hammer units."""
+    contacts = _find_contacts(nav)
+    zx, zy = fit_corner_heights(nav, contacts)
+    height = lambda area, x, y: _height(nav, zx, zy, area, x, y)  # noqa: E731
+    tris: list = []
+
+    # floors
+    for a in range(nav.num_areas):
+        x0, x1, y0, y1 = nav.x_min[a], nav.x_max[a], nav.y_min[a], nav.y_max[a]
+        tris += _quad(
+            (x0, y0, height(a, x0, y0)),
+            (x1, y0, height(a, x1, y0)),
+            (x1, y1, height(a, x1, y1)),
+            (x0, y1, height(a, x0, y1)),
+        )
+
+    # each area side: the outward normal, its constant coordinate and its extent
+    covered: dict[tuple[int, int], list[tuple[float, float]]] = {}
+
+    def side_key(area: int, axis: int, high: bool) -> tuple[int, int]:
+        return area, axis * 2 + int(high)
+
+    def point_on(c: _Contact, along: float) -> tuple[float, float]:
+        return (c.coord, along) if c.axis == 0 else (along, c.coord)
+
+    def step_face(c: _Contact, lo: float, hi: float) -> None:
+        p0, p1 = point_on(c, lo), point_on(c, hi)
+        za0, za1 = height(c.a, *p0), height(c.a, *p1)
+        zb0, zb1 = height(c.b, *p0), height(c.b, *p1)
+        if max(abs(za0 - zb0), abs(za1 - zb1)) > 1.0:
+            tris.extend(_quad((*p0, za0), (*p1, za1), (*p1, zb1), (*p0, zb0)))
+
+    rise = {}
+    level: dict[tuple[int, int], list[tuple[float, float]]] = {}
+    for c in contacts:
+        rise[c] = height(c.b, *_edge_point(c, 0.5)) - height(c.a, *_edge_point(c, 0.5))
+        if abs(rise[c]) <= SEAM_MATCH_U:
+            level.setdefault(side_key(c.a, c.axis, True), []).append((c.lo, c.hi))
+            level.setdefault(side_key(c.b, c.axis, False), []).append((c.lo, c.hi))
+    for c in contacts:
+        if abs(rise[c]) > MAX_SHARED_STEP_U:
+            continue
+        covered.setdefault(side_key(c.a, c.axis, True), []).append((c.lo, c.hi))
+        covered.setdefault(side_key(c.b, c.axis, False), []).append((c.lo, c.hi))
+        if abs(rise[c]) <= 72:
+            step_face(c, c.lo, c.hi)
+            continue
+        # A high ledge: where the lower floor goes on under the upper one, there is no face.
+        lower_side = side_key(c.a, c.axis, True) if rise[c] > 0 else side_key(c.b, c.axis, False)
+        for lo, hi in _subtract((c.lo, c.hi), level.get(lower_side, [])):
+            step_face(c, lo, hi)
+
+    # bridges across small gaps between connected areas
+    linked = {(int(a), int(b)) for a, b in nav.connections}
+    linked |= {(b, a) for a, b in linked}
+    for a, b in sorted(linked):
+        if a > b:
+            continue
+        for axis in (0, 1):
+            lo_a, hi_a = (nav.x_min, nav.x_max) if axis == 0 else (nav.y_min, nav.y_max)
+            lo_t, hi_t = (nav.y_min, nav.y_max) if axis == 0 else (nav.x_min, nav.x_max)
+            for first, second in ((a, b), (b, a)):
+                gap = lo_a[second] - hi_a[first]
+                lo, hi = max(lo_t[first], lo_t[second]), min(hi_t[first], hi_t[second])
+                if not (TOUCH_TOL_U < gap <= BRIDGE_MAX_GAP_U and hi - lo > TOUCH_TOL_U):
+                    continue
+                c0, mid, c1 = hi_a[first], hi_a[first] + gap / 2, lo_a[second]
+
+                def point(along: float, across: float) -> tuple[float, float]:
+                    return (across, along) if axis == 0 else (along, across)  # noqa: B023
+
+                for area, near, far in ((first, c0, mid), (second, c1, mid)):
+                    z_lo = height(area, *point(lo, near))
+                    z_hi = height(area, *point(hi, near))
+                    tris += _quad(
+                        (*point(lo, near), z_lo),
+                        (*point(hi, near), z_hi),
+                        (*point(hi, far), z_hi),
+                        (*point(lo, far), z_lo),
+                    )
+                z_first = [height(first, *point(s, c0)) for s in (lo, hi)]
+                z_second = [height(second, *point(s, c1)) for s in (lo, hi)]
+                tris += _quad(
+                    (*point(lo, mid), z_first[0]),
+                    (*point(hi, mid), z_first[1]),
+                    (*point(hi, mid), z_second[1]),
+                    (*point(lo, mid), z_second[0]),
+                )
+                covered.setdefault(side_key(first, axis, True), []).append((lo, hi))
+                covered.setdefault(side_key(second, axis, False), []).append((lo, hi))
+
+    # walls along uncovered sides, pushed out
+    tris += _walls(nav, covered, height)
+    return np.asarray(tris, dtype=np.float64)
+
+
+def _walls(nav: NavMesh, covered, height) -> list:
+    """Walls (and the floor strip under the push) along every side that borders no area."""
+    tris: list = []
+    z_low = np.minimum(nav.z_at_min, nav.z_at_max)
+    for a in range(nav.num_areas):
+        for axis in (0, 1):
+            for high in (False, True):
+                lo_t, hi_t = (
+                    (nav.y_min[a], nav.y_max[a]) if axis == 0 else (nav.x_min[a], nav.x_max[a])
+                )
+                coord = (nav.x_max[a] if high else nav.x_min[a]) if axis == 0 else (
+                    nav.y_max[a] if high else nav.y_min[a]
+                )
+                sign = 1.0 if high else -1.0
+                for lo, hi in _subtract((lo_t, hi_t), covered.get((a, axis * 2 + int(high)), [])):
+                    push = _push_distance(nav, a, axis, coord, sign, lo, hi)
+                    tris += _wall_piece(nav, a, axis, coord, sign, lo, hi, push, height, z_low)
+    return tris
+
+
+def _push_distance(nav: NavMesh, a, axis, coord, sign, lo, hi) -> float:
+    """How far out a wall may go: 16 u, or half the gap to the nearest area facing it."""
+    if axis == 0:
+        near_lo, near_hi, t_lo, t_hi = nav.x_min, nav.x_max, nav.y_min, nav.y_max
+    else:
+        near_lo, near_hi, t_lo, t_hi = nav.y_min, nav.y_max, nav.x_min, nav.x_max
+    gap = (near_lo - coord) if sign > 0 else (coord - near_hi)
+    overlap = (np.minimum(t_hi, hi) - np.maximum(t_lo, lo)) > 0
+    dz = np.abs((nav.z_at_min + nav.z_at_max) / 2 - (nav.z_at_min[a] + nav.z_at_max[a]) / 2)
+    facing = overlap & (gap >= -TOUCH_TOL_U) & (gap < 2 * WALL_PUSH_U) & (dz < 128)
+    facing[a] = False
+    if not facing.any():
+        return WALL_PUSH_U
+    return float(max(0.0, min(WALL_PUSH_U, gap[facing].min() / 2)))
+
+
+def _wall_piece(nav: NavMesh, a, axis, coord, sign, lo, hi, push, height, z_low) -> list:
+    """One wall segment with its floor strip; the ends grow by the push at convex corners."""
+    tris: list = []
+
+    def point(along: float, across: float) -> tuple[float, float]:
+        return (across, along) if axis == 0 else (along, across)
+
+    out = coord + sign * push
+    lo_t, hi_t = (nav.y_min[a], nav.y_max[a]) if axis == 0 else (nav.x_min[a], nav.x_max[a])
+    # grow an end only at a corner of the area, where the perpendicular side is also open
+    grow_lo = push if abs(lo - lo_t) <= TOUCH_TOL_U else 0.0
+    grow_hi = push if abs(hi - hi_t) <= TOUCH_TOL_U else 0.0
+    z0 = height(a, *point(lo, coord))
+    z1 = height(a, *point(hi, coord))
+    if push > 0.5:
+        tris += _quad(
+            (*point(lo, coord), z0),
+            (*point(hi, coord), z1),
+            (*point(hi, out), z1),
+            (*point(lo, out), z0),
+        )
+    top = WALL_HEIGHT_U
+    # cap below a floor overhead: an area above this wall's footprint
+    if axis == 0:
+        over = (nav.x_min <= out) & (nav.x_max >= out) & (nav.y_max > lo) & (nav.y_min < hi)
+    else:
+        over = (nav.y_min <= out) & (nav.y_max >= out) & (nav.x_max > lo) & (nav.x_min < hi)
+    clearance = z_low - max(z0, z1)
+    above = over & (clearance > 72)
+    if above.any():
+        top = min(top, float(clearance[above].min()) - 8)
+    a0, a1 = lo - grow_lo, hi + grow_hi
+    tris += _quad(
+        (*point(a0, out), z0),
+        (*point(a1, out), z1),
+        (*point(a1, out), z1 + top),
+        (*point(a0, out), z0 + top),
+    )
+    return tris
+
+
+@cache
+def nav_world(map_name: str = BUILTIN_MAP) -> World:
+    """The built-in triangle world of a map, in metres (cached per process)."""
+    nav = load_navmesh(map_name)
+    tris = build_nav_triangles(nav) * HAMMER_TO_M
+    return World(
+        triangles=tris,
+        name=map_name,
+        source=f"built-in {map_name} nav mesh (awpy 1.3.1)",
+        meta={"kind": "navmesh", "areas": nav.num_areas},
+    )

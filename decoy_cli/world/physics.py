@@ -1,0 +1,186 @@
+"""A `World` loaded headless into pybullet: batched ray tests and capsule overlap tests.
+
+pybullet is the physics engine of the whole project; this module owns the pitfalls met with it:
+
+* The world body's collision group and mask are set explicitly (its default group is not 1, and
+  agents fall through); rays have group 1, so the world's mask includes bit 1, or every ray
+  silently misses and everything looks visible.
+* `rayTestBatch` takes at most 16,384 rays per call: larger batches are split here.
+* The vertex-array mesh API fails somewhere between 159k and 635k triangles; larger worlds are
+  written to a temporary OBJ and loaded by file name.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from typing import Self
+
+import numpy as np
+
+from decoy_cli.world.world import World
+
+WORLD_GROUP = 1
+AGENT_GROUP = 2
+_RAY_BATCH = 16384
+_MAX_VERTEX_ARRAY_TRIANGLES = 150_000
+
+
+class PhysicsWorld:
+    """A pybullet DIRECT client holding one static world mesh; use as a context manager."""
+
+    def __init__(self, world: World) -> None:
+        import pybullet
+
+        self.world = world
+        self._p = pybullet
+        self.client = pybullet.connect(pybullet.DIRECT)
+        self.body = self._load(world)
+        pybullet.setCollisionFilterGroupMask(
+            self.body, -1, WORLD_GROUP, WORLD_GROUP | AGENT_GROUP, physicsClientId=self.client
+        )
+        self._capsules: list[int] = []
+        self._capsule_shape: tuple[float, float] | None = None
+
+    def _load(self, world: World) -> int:
+        p = self._p
+        if world.num_triangles <= _MAX_VERTEX_ARRAY_TRIANGLES:
+            vertices, indices = world.vertices_and_indices()
+            shape = p.createCollisionShape(
+                p.GEOM_MESH,
+                vertices=vertices.tolist(),
+                indices=indices.ravel().tolist(),
+                flags=p.GEOM_FORCE_CONCAVE_TRIMESH,
+                physicsClientId=self.client,
+            )
+        else:
+            with tempfile.TemporaryDirectory() as folder:
+                path = os.path.join(folder, "world.obj")
+                _write_plain_obj(world, path)
+                shape = p.createCollisionShape(
+                    p.GEOM_MESH,
+                    fileName=path,
+                    flags=p.GEOM_FORCE_CONCAVE_TRIMESH,
+                    physicsClientId=self.client,
+                )
+        return p.createMultiBody(
+            baseMass=0, baseCollisionShapeIndex=shape, physicsClientId=self.client
+        )
+
+    def close(self) -> None:
+        if self.client is not None and self._p.isConnected(self.client):
+            self._p.disconnect(self.client)
+        self.client = None  # type: ignore[assignment]
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ---- rays -------------------------------------------------------------------------------
+
+    def ray_test(self, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cast rays against the world: (hit fraction in [0, 1], inf for a miss; hit normal z).
+
+        Only the world mesh is hit (agents are in another collision group).
+        """
+        starts = np.asarray(starts, dtype=np.float64).reshape(-1, 3)
+        ends = np.asarray(ends, dtype=np.float64).reshape(-1, 3)
+        fraction = np.full(len(starts), np.inf)
+        normal_z = np.zeros(len(starts))
+        for lo in range(0, len(starts), _RAY_BATCH):
+            hits = self._p.rayTestBatch(
+                starts[lo : lo + _RAY_BATCH].tolist(),
+                ends[lo : lo + _RAY_BATCH].tolist(),
+                collisionFilterMask=WORLD_GROUP,
+                physicsClientId=self.client,
+            )
+            for k, hit in enumerate(hits):
+                if hit[0] == self.body:
+                    fraction[lo + k] = hit[2]
+                    normal_z[lo + k] = hit[4][2]
+        return fraction, normal_z
+
+    def first_floor_below(
+        self, points: np.ndarray, depth: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Height of the first surface straight below each point within `depth` (NaN if none).
+
+        Returns (floor z, surface normal z).
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        ends = points.copy()
+        ends[:, 2] -= depth
+        fraction, normal_z = self.ray_test(points, ends)
+        z = np.where(np.isfinite(fraction), points[:, 2] - fraction * depth, np.nan)
+        return z, normal_z
+
+    def line_of_sight(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """True where nothing of the world lies between the two points."""
+        fraction, _ = self.ray_test(starts, ends)
+        return ~np.isfinite(fraction)
+
+    # ---- capsule overlap --------------------------------------------------------------------
+
+    def capsules_blocked(
+        self, centres: np.ndarray, radius: float, height: float, tolerance: float = 0.01
+    ) -> np.ndarray:
+        """True where an upright capsule at the centre would penetrate the world.
+
+        `height` is the full height of the capsule including both caps. Many capsules are placed
+        at once and checked in one collision pass; they never collide with each other.
+        """
+        p = self._p
+        centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+        self._ensure_capsules(radius, height)
+        blocked = np.zeros(len(centres), dtype=bool)
+        pool = len(self._capsules)
+        index = {body: k for k, body in enumerate(self._capsules)}
+        for lo in range(0, len(centres), pool):
+            chunk = centres[lo : lo + pool]
+            for k, body in enumerate(self._capsules):
+                where = chunk[k].tolist() if k < len(chunk) else [0.0, 0.0, 1e6 + 10 * k]
+                p.resetBasePositionAndOrientation(
+                    body, where, [0, 0, 0, 1], physicsClientId=self.client
+                )
+            p.performCollisionDetection(physicsClientId=self.client)
+            for contact in p.getContactPoints(bodyA=self.body, physicsClientId=self.client):
+                if contact[8] < -tolerance:
+                    k = index.get(contact[2])
+                    if k is not None and k < len(chunk):
+                        blocked[lo + k] = True
+        return blocked
+
+    def _ensure_capsules(self, radius: float, height: float, pool: int = 1024) -> None:
+        p = self._p
+        if self._capsule_shape == (radius, height):
+            return
+        for body in self._capsules:
+            p.removeBody(body, physicsClientId=self.client)
+        shape = p.createCollisionShape(
+            p.GEOM_CAPSULE,
+            radius=radius,
+            height=max(height - 2 * radius, 1e-3),
+            physicsClientId=self.client,
+        )
+        self._capsules = []
+        for k in range(pool):
+            body = p.createMultiBody(
+                baseMass=0,
+                baseCollisionShapeIndex=shape,
+                basePosition=[0.0, 0.0, 1e6 + 10 * k],
+                physicsClientId=self.client,
+            )
+            p.setCollisionFilterGroupMask(
+                body, -1, AGENT_GROUP, WORLD_GROUP, physicsClientId=self.client
+            )
+            self._capsules.append(body)
+        self._capsule_shape = (radius, height)
+
+
+def _write_plain_obj(world: World, path: str) -> None:
+    vertices, indices = world.vertices_and_indices()
+    with open(path, "w") as f:
+        f.writelines(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in vertices)
+        f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in indices)
