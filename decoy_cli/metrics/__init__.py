@@ -1,0 +1,67 @@
+"""Replay fidelity metrics, exactly as defined in docs/metrics.md.
+
+* `distances`: exact DTW (with the warping-path length) and discrete Fréchet kernels.
+* `trajectory`: the ten trajectory metrics of a player-round, protocols "clock" and "paper".
+* `combat`: HP, death-time and round-outcome metrics of full rounds.
+* `aggregate`: mean, std, median and p90 by side and overall, with unevaluated rows accounted for.
+"""
+
+from decoy_cli.metrics.aggregate import GROUPS, SIDES, MetricSummary, summarize
+from decoy_cli.metrics.combat import (
+    DEATH_COUNT_NAMES,
+    DEATH_TIME_METRIC_NAMES,
+    HP_METRIC_NAMES,
+    OUTCOME_METRIC_NAMES,
+    DeathTimeMetrics,
+    HpMetrics,
+    OutcomeMetrics,
+    confusion_matrix,
+    death_time_metrics,
+    hp_metrics,
+    outcome_metrics,
+    pearson,
+)
+from decoy_cli.metrics.distances import TIE_RTOL, dtw, dtw_mean, frechet
+from decoy_cli.metrics.trajectory import (
+    METRIC_NAMES,
+    METRIC_NAMES_CLOCK,
+    METRIC_NAMES_PAPER,
+    PAPER_LENGTH,
+    PlayerRound,
+    TrajectoryMetrics,
+    resample,
+    trajectory_metrics,
+    trajectory_metrics_frame,
+)
+
+__all__ = [
+    "DEATH_COUNT_NAMES",
+    "DEATH_TIME_METRIC_NAMES",
+    "GROUPS",
+    "HP_METRIC_NAMES",
+    "METRIC_NAMES",
+    "METRIC_NAMES_CLOCK",
+    "METRIC_NAMES_PAPER",
+    "OUTCOME_METRIC_NAMES",
+    "PAPER_LENGTH",
+    "SIDES",
+    "TIE_RTOL",
+    "DeathTimeMetrics",
+    "HpMetrics",
+    "MetricSummary",
+    "OutcomeMetrics",
+    "PlayerRound",
+    "TrajectoryMetrics",
+    "confusion_matrix",
+    "death_time_metrics",
+    "dtw",
+    "dtw_mean",
+    "frechet",
+    "hp_metrics",
+    "outcome_metrics",
+    "pearson",
+    "resample",
+    "summarize",
+    "trajectory_metrics",
+    "trajectory_metrics_frame",
+]
