@@ -9,6 +9,7 @@ import typer
 from typer.core import TyperGroup
 
 from decoy_cli import __version__
+from decoy_cli.commands import build_waypoints
 from decoy_cli.errors import DecoyError
 
 _debug = False
@@ -52,3 +53,6 @@ def main(
     """Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity."""
     global _debug
     _debug = debug
+
+
+app.command("build-waypoints")(build_waypoints.build_waypoints)

@@ -291,6 +291,7 @@ def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
                 info.compress_type = zipfile.ZIP_DEFLATED
                 info.external_attr = 0o644 << 16
                 zf.writestr(info, buffer.getvalue())
+        os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except OSError as error:
         Path(tmp).unlink(missing_ok=True)

@@ -9,9 +9,15 @@
    crouch-jump) edges, in both directions where both pass.
 2. **Drop pass.** Moves whose profile falls by more than the step height (down to the safe-fall
    depth) become one-way drop edges; lower floors first found this way are flooded too.
-3. **Verification.** A capsule of the player's size is moved along every edge in pybullet, in
-   steps of at most 0.1 m, floating the step height above the floor (as the simulator moves
-   agents); an edge along which it would penetrate the world is removed.
+3. **Verification.** A capsule is moved along every edge in pybullet, in steps of at most
+   0.1 m, floating the step height above the floor (as the simulator moves agents); an edge
+   along which it would penetrate the world is removed. First, a node where the capsule does not
+   fit (a lattice point that happens to lie too close to a wall) is moved up to 0.3 m to where it
+   fits, instead of being lost: without that, a quarter of the lattice's edges near walls die.
+   The capsule is 20% thinner than the CS:GO hull (radius 12.8 u, not 16 u): the nav world's
+   walls stand up to 16 u beyond the nav edge, often less where areas face each other across
+   narrow gaps, and the thinner capsule tolerates that approximation (measured: with the full
+   radius 96.4% of the nodes are in the largest strongly connected component, with 12.8 u 98.6%).
 
 Then the graph is pruned to its largest strongly connected component (so an agent can always get
 back), manual waypoints are merged in, each node gets its nav place, and nodes are numbered in a
@@ -52,7 +58,7 @@ class LatticeParams:
     step_height: float = STEP_HEIGHT_M
     jump_height: float = JUMP_HEIGHT_M
     max_drop: float = MAX_DROP_M
-    agent_radius: float = PLAYER_RADIUS_M
+    agent_radius: float = 0.8 * PLAYER_RADIUS_M  # see the module docstring
     agent_height: float = PLAYER_HEIGHT_M
     min_floor_normal_z: float = 0.7  # CS:GO: surfaces steeper than ~45 degrees are not floors
     profile_samples: int = 8
@@ -60,6 +66,7 @@ class LatticeParams:
     same_floor_dz: float = 0.6  # two lattice hits closer than this in height are one node
     verify_step: float = 0.1
     verify_clearance: float = 0.03  # capsule floats this much above the step height
+    max_nudge: float = 0.3  # a node the capsule does not fit at moves up to this far to fit
 
 
 @dataclass
@@ -71,6 +78,7 @@ class BuildStats:
     lattice_edges: dict[str, int] = field(default_factory=dict)
     drop_edges: int = 0
     drop_new_nodes: int = 0
+    nudged_nodes: int = 0
     verified_removed: dict[str, int] = field(default_factory=dict)
     components_before: int = 0
     largest_component_share: float = 0.0
@@ -149,11 +157,11 @@ def _evaluate_moves(
     t = np.arange(1, s + 1) / (s + 1)
     high = np.fmax(sources[:, 2], np.where(ok, target_z, sources[:, 2]))
     prof_xy = sources[:, None, :2] + t[None, :, None] * step[:, None, :]
-    prof_start = np.concatenate([prof_xy, np.broadcast_to((high + top)[:, None, None], (k, s, 1))], 2)
-    depth = top + params.max_drop + np.abs(high - sources[:, 2])
-    prof_z, prof_nz = physics.first_floor_below(
-        prof_start.reshape(-1, 3), float(np.max(depth))
+    prof_start = np.concatenate(
+        [prof_xy, np.broadcast_to((high + top)[:, None, None], (k, s, 1))], 2
     )
+    depth = top + params.max_drop + np.abs(high - sources[:, 2])
+    prof_z, _ = physics.first_floor_below(prof_start.reshape(-1, 3), float(np.max(depth)))
     prof_z = prof_z.reshape(k, s)
     ok &= np.all(np.isfinite(prof_z), axis=1)
     profile = np.column_stack([sources[:, 2], prof_z, np.where(ok, target_z, sources[:, 2])])
@@ -229,6 +237,43 @@ def _flood(
         progress(stage, len(lattice.positions), 0)
 
 
+def _capsule_dims(params: LatticeParams) -> tuple[float, float]:
+    """(height above the floor of the capsule's bottom, capsule height)."""
+    float_h = params.step_height + params.verify_clearance
+    return float_h, params.agent_height - float_h
+
+
+def _nudge_nodes(
+    physics: PhysicsWorld, positions: np.ndarray, params: LatticeParams
+) -> tuple[np.ndarray, int]:
+    """Move nodes where the capsule does not fit (too close to a wall or ledge face) to the
+    nearest spot within `max_nudge` where it does, on the same floor; returns the new positions
+    and how many moved. Nodes with no such spot stay, and verification removes their edges."""
+    float_h, cap_h = _capsule_dims(params)
+    lift = np.array([0.0, 0.0, float_h + cap_h / 2])
+    blocked = np.nonzero(physics.capsules_blocked(positions + lift, params.agent_radius, cap_h))[0]
+    if len(blocked) == 0:
+        return positions, 0
+    angles = np.arange(16) * (np.pi / 8)
+    rings = np.arange(1, int(np.ceil(params.max_nudge / 0.05)) + 1) * 0.05
+    offsets = np.array([(r * np.cos(a), r * np.sin(a)) for r in rings for a in angles])
+    moved = positions.copy()
+    count = 0
+    for node in blocked:
+        xy = positions[node, :2] + offsets
+        top = np.column_stack([xy, np.full(len(xy), positions[node, 2] + params.step_height)])
+        z, nz = physics.first_floor_below(top, 2 * params.step_height)
+        ok = np.isfinite(z) & (nz >= params.min_floor_normal_z)
+        if not ok.any():
+            continue
+        cand = np.column_stack([xy[ok], z[ok]])
+        free = ~physics.capsules_blocked(cand + lift, params.agent_radius, cap_h)
+        if free.any():
+            moved[node] = cand[np.argmax(free)]  # offsets are ordered nearest first
+            count += 1
+    return moved, count
+
+
 def _verify(
     physics: PhysicsWorld,
     positions: np.ndarray,
@@ -240,8 +285,7 @@ def _verify(
     src, dst, kind = positions[edges[:, 0]], positions[edges[:, 1]], edges[:, 2]
     length = np.linalg.norm(dst[:, :2] - src[:, :2], axis=1)
     n_steps = np.maximum(1, np.ceil(length / params.verify_step)).astype(np.int64)
-    float_h = params.step_height + params.verify_clearance
-    cap_height = params.agent_height - float_h
+    float_h, cap_height = _capsule_dims(params)
     centres, owner = [], []
     for e in range(len(edges)):
         t = np.linspace(0.0, 1.0, n_steps[e] + 1)
@@ -329,10 +373,11 @@ def build_lattice(
 
     # stage 3: verification with a moving capsule
     clock = time.perf_counter()
-    positions = np.asarray(lattice.positions)
+    positions, stats.nudged_nodes = _nudge_nodes(physics, np.asarray(lattice.positions), params)
     edge_arr = np.asarray(edges, dtype=np.int64).reshape(-1, 4)
     keep = _verify(physics, positions, edge_arr, params, progress)
     removed = edge_arr[~keep]
+    removed_segments = np.stack([positions[removed[:, 0]], positions[removed[:, 1]]], axis=1)
     stats.verified_removed = _kind_counts(removed[:, 2])
     edge_arr = edge_arr[keep]
     stats.seconds["verification"] = time.perf_counter() - clock
@@ -346,16 +391,13 @@ def build_lattice(
     stats.seconds["pruning"] = time.perf_counter() - clock
     stats.nodes = len(positions)
     stats.edges = _kind_counts(edge_arr[:, 2])
-    full = np.asarray(lattice.positions)
     return LatticeResult(
         positions=positions,
         edge_source=edge_arr[:, 0].astype(np.int32),
         edge_target=edge_arr[:, 1].astype(np.int32),
         edge_kind=edge_arr[:, 2].astype(np.uint8),
         edge_direction=edge_arr[:, 3].astype(np.uint8),
-        removed_segments=np.stack([full[removed[:, 0]], full[removed[:, 1]]], axis=1)
-        if len(removed)
-        else np.zeros((0, 2, 3)),
+        removed_segments=removed_segments,
         removed_kinds=removed[:, 2].astype(np.uint8),
         pruned_positions=pruned,
         stats=stats,

@@ -63,7 +63,10 @@ def plot_graph(
     if removed_segments is not None and len(removed_segments):
         ax.add_collection(
             LineCollection(
-                removed_segments[:, :, :2], colors="#e377c2", lw=0.8, label="removed by verification"
+                removed_segments[:, :, :2],
+                colors="#e377c2",
+                lw=0.8,
+                label="removed by verification",
             )
         )
     if pruned_positions is not None and len(pruned_positions):

@@ -50,6 +50,11 @@ WALL_HEIGHT_U = 184.0
 """Wall height above its floor (3.5 m), capped below any floor overhead."""
 SEAM_MATCH_U = 24.0
 """Touching edges whose heights differ by less than this are fitted to meet (else a ledge)."""
+STEP_U = 18.0
+"""The CS:GO step height."""
+JUMP_U = 64.0
+"""Areas closer in height than a crouch-jump count as the same floor for gaps and walls."""
+
 
 REGION_PLACES = {
     "t_spawn": "TSpawn",
@@ -132,7 +137,9 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
     with open(folder / "nav_areas.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     area_id = np.array([int(r["area_id"]) for r in rows], dtype=np.int64)
-    col = {k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k not in ("area_id", "place")}
+    col = {
+        k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k not in ("area_id", "place")
+    }
     index = {int(a): i for i, a in enumerate(area_id)}
     with open(folder / "nav_connections.csv", newline="") as f:
         pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in csv.DictReader(f)]
@@ -368,80 +375,146 @@ def build_nav_triangles(nav: NavMesh) -> np.ndarray:
 
 
 def _walls(nav: NavMesh, covered, height) -> list:
-    """Walls (and the floor strip under the push) along every side that borders no area."""
+    """Faces along the open parts of every area side (parts that touch no area), by what lies
+    beyond them (see `_Side.open_parts`)."""
     tris: list = []
-    z_low = np.minimum(nav.z_at_min, nav.z_at_max)
     for a in range(nav.num_areas):
         for axis in (0, 1):
             for high in (False, True):
-                lo_t, hi_t = (
-                    (nav.y_min[a], nav.y_max[a]) if axis == 0 else (nav.x_min[a], nav.x_max[a])
-                )
-                coord = (nav.x_max[a] if high else nav.x_min[a]) if axis == 0 else (
-                    nav.y_max[a] if high else nav.y_min[a]
-                )
-                sign = 1.0 if high else -1.0
-                for lo, hi in _subtract((lo_t, hi_t), covered.get((a, axis * 2 + int(high)), [])):
-                    push = _push_distance(nav, a, axis, coord, sign, lo, hi)
-                    tris += _wall_piece(nav, a, axis, coord, sign, lo, hi, push, height, z_low)
+                side = _Side(nav, a, axis, high)
+                for lo, hi in _subtract((side.lo, side.hi), covered.get((a, axis * 2 + high), [])):
+                    for part in side.open_parts(lo, hi):
+                        tris += side.faces(part, height)
     return tris
 
 
-def _push_distance(nav: NavMesh, a, axis, coord, sign, lo, hi) -> float:
-    """How far out a wall may go: 16 u, or half the gap to the nearest area facing it."""
-    if axis == 0:
-        near_lo, near_hi, t_lo, t_hi = nav.x_min, nav.x_max, nav.y_min, nav.y_max
-    else:
-        near_lo, near_hi, t_lo, t_hi = nav.y_min, nav.y_max, nav.x_min, nav.x_max
-    gap = (near_lo - coord) if sign > 0 else (coord - near_hi)
-    overlap = (np.minimum(t_hi, hi) - np.maximum(t_lo, lo)) > 0
-    dz = np.abs((nav.z_at_min + nav.z_at_max) / 2 - (nav.z_at_min[a] + nav.z_at_max[a]) / 2)
-    facing = overlap & (gap >= -TOUCH_TOL_U) & (gap < 2 * WALL_PUSH_U) & (dz < 128)
-    facing[a] = False
-    if not facing.any():
-        return WALL_PUSH_U
-    return float(max(0.0, min(WALL_PUSH_U, gap[facing].min() / 2)))
+@dataclass(frozen=True)
+class _OpenPart:
+    """A stretch [lo, hi] of an open side and the nearest area beyond it (-1: none near)."""
+
+    lo: float
+    hi: float
+    other: int
+    gap: float
 
 
-def _wall_piece(nav: NavMesh, a, axis, coord, sign, lo, hi, push, height, z_low) -> list:
-    """One wall segment with its floor strip; the ends grow by the push at convex corners."""
-    tris: list = []
+class _Side:
+    """One side of a nav area: its line, its outward direction and the areas beyond it."""
 
-    def point(along: float, across: float) -> tuple[float, float]:
-        return (across, along) if axis == 0 else (along, across)
+    def __init__(self, nav: NavMesh, area: int, axis: int, high: bool) -> None:
+        self.nav, self.area, self.axis = nav, area, axis
+        self.sign = 1.0 if high else -1.0
+        if axis == 0:  # the side is the line x = coord, running along y
+            self.lo, self.hi = nav.y_min[area], nav.y_max[area]
+            self.coord = nav.x_max[area] if high else nav.x_min[area]
+            self.near_lo, self.near_hi = nav.x_min, nav.x_max
+            self.t_lo, self.t_hi = nav.y_min, nav.y_max
+        else:  # the line y = coord, running along x
+            self.lo, self.hi = nav.x_min[area], nav.x_max[area]
+            self.coord = nav.y_max[area] if high else nav.y_min[area]
+            self.near_lo, self.near_hi = nav.y_min, nav.y_max
+            self.t_lo, self.t_hi = nav.x_min, nav.x_max
+        self.centre_z = (nav.z_at_min + nav.z_at_max) / 2
+        self.gap = (self.near_lo - self.coord) if high else (self.coord - self.near_hi)
 
-    out = coord + sign * push
-    lo_t, hi_t = (nav.y_min[a], nav.y_max[a]) if axis == 0 else (nav.x_min[a], nav.x_max[a])
-    # grow an end only at a corner of the area, where the perpendicular side is also open
-    grow_lo = push if abs(lo - lo_t) <= TOUCH_TOL_U else 0.0
-    grow_hi = push if abs(hi - hi_t) <= TOUCH_TOL_U else 0.0
-    z0 = height(a, *point(lo, coord))
-    z1 = height(a, *point(hi, coord))
-    if push > 0.5:
-        tris += _quad(
-            (*point(lo, coord), z0),
-            (*point(hi, coord), z1),
-            (*point(hi, out), z1),
-            (*point(lo, out), z0),
+    def point(self, along: float, across: float) -> tuple[float, float]:
+        return (across, along) if self.axis == 0 else (along, across)
+
+    def open_parts(self, lo: float, hi: float) -> list[_OpenPart]:
+        """Split [lo, hi] by the nearest area facing each stretch within 3 push widths."""
+        overlap = (np.minimum(self.t_hi, hi) - np.maximum(self.t_lo, lo)) > TOUCH_TOL_U
+        dz = np.abs(self.centre_z - self.centre_z[self.area])
+        near = overlap & (self.gap >= -TOUCH_TOL_U) & (self.gap <= 3 * WALL_PUSH_U)
+        near &= dz <= MAX_SHARED_STEP_U
+        near[self.area] = False
+        parts, rest = [], [(lo, hi)]
+        for b in sorted(np.nonzero(near)[0], key=lambda b: (self.gap[b], b)):
+            span = (max(lo, self.t_lo[b]), min(hi, self.t_hi[b]))
+            for p_lo, p_hi in rest:
+                c_lo, c_hi = max(p_lo, span[0]), min(p_hi, span[1])
+                if c_hi - c_lo > TOUCH_TOL_U:
+                    parts.append(_OpenPart(c_lo, c_hi, int(b), max(0.0, float(self.gap[b]))))
+            rest = [q for p in rest for q in _subtract(p, [span])]
+        parts += [_OpenPart(p_lo, p_hi, -1, np.inf) for p_lo, p_hi in rest]
+        return sorted(parts, key=lambda q: q.lo)
+
+    def faces(self, part: _OpenPart, height) -> list:
+        """Triangles for one open stretch, by what lies beyond it:
+
+        * nothing near: a wall pushed out by 16 u, full height (capped below floors overhead);
+        * an area at about the same height across a small gap: floor to the middle of the gap
+          (a hole in the mesh, not a wall), with a step face there if the heights differ;
+        * a lower area: a ledge; the floor runs to the pushed line, then a face goes down;
+        * a higher area: the foot of a box or ledge; a face goes up to the other's height.
+        In every case the floor is extended under the push.
+        """
+        z0 = height(self.area, *self.point(part.lo, self.coord))
+        z1 = height(self.area, *self.point(part.hi, self.coord))
+        if part.other < 0:
+            push = WALL_PUSH_U
+            return self._strip(part, push, z0, z1) + self._wall(part, push, z0, z1)
+        o0 = height(part.other, *self.point(part.lo, self.coord + self.sign * part.gap))
+        o1 = height(part.other, *self.point(part.hi, self.coord + self.sign * part.gap))
+        rise = (o0 + o1) / 2 - (z0 + z1) / 2
+        if abs(rise) <= JUMP_U and part.gap <= BRIDGE_MAX_GAP_U:
+            push = part.gap / 2
+            tris = self._strip(part, push, z0, z1)
+            if rise < -STEP_U:  # the higher side closes the step
+                tris += self._vertical(part, push, (z0, z1), (o0, o1))
+            return tris
+        push = min(WALL_PUSH_U, part.gap / 2)
+        tris = self._strip(part, push, z0, z1)
+        return tris + self._vertical(part, push, (z0, z1), (o0, o1))
+
+    def _strip(self, part: _OpenPart, width: float, z0: float, z1: float) -> list:
+        """The area's floor extended outward by `width`."""
+        if width <= 0.5:
+            return []
+        out = self.coord + self.sign * width
+        return _quad(
+            (*self.point(part.lo, self.coord), z0),
+            (*self.point(part.hi, self.coord), z1),
+            (*self.point(part.hi, out), z1),
+            (*self.point(part.lo, out), z0),
         )
-    top = WALL_HEIGHT_U
-    # cap below a floor overhead: an area above this wall's footprint
-    if axis == 0:
-        over = (nav.x_min <= out) & (nav.x_max >= out) & (nav.y_max > lo) & (nav.y_min < hi)
-    else:
-        over = (nav.y_min <= out) & (nav.y_max >= out) & (nav.x_max > lo) & (nav.x_min < hi)
-    clearance = z_low - max(z0, z1)
-    above = over & (clearance > 72)
-    if above.any():
-        top = min(top, float(clearance[above].min()) - 8)
-    a0, a1 = lo - grow_lo, hi + grow_hi
-    tris += _quad(
-        (*point(a0, out), z0),
-        (*point(a1, out), z1),
-        (*point(a1, out), z1 + top),
-        (*point(a0, out), z0 + top),
-    )
-    return tris
+
+    def _vertical(self, part: _OpenPart, push: float, za, zb) -> list:
+        """A vertical face on the pushed line between two height profiles."""
+        out = self.coord + self.sign * push
+        return _quad(
+            (*self.point(part.lo, out), za[0]),
+            (*self.point(part.hi, out), za[1]),
+            (*self.point(part.hi, out), zb[1]),
+            (*self.point(part.lo, out), zb[0]),
+        )
+
+    def _wall(self, part: _OpenPart, push: float, z0: float, z1: float) -> list:
+        """A full wall on the pushed line, grown at the area's corners, cut where it would stand
+        inside another area of about the same height, and capped below any floor overhead."""
+        nav = self.nav
+        out = self.coord + self.sign * push
+        a0 = part.lo - (push if abs(part.lo - self.lo) <= TOUCH_TOL_U else 0.0)
+        a1 = part.hi + (push if abs(part.hi - self.hi) <= TOUCH_TOL_U else 0.0)
+        across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
+        along = (self.t_hi > a0) & (self.t_lo < a1)
+        inside = across & along & (np.abs(self.centre_z - (z0 + z1) / 2) <= JUMP_U)
+        inside[self.area] = False
+        pieces = _subtract((a0, a1), list(zip(self.t_lo[inside], self.t_hi[inside], strict=True)))
+        clearance = np.minimum(nav.z_at_min, nav.z_at_max) - max(z0, z1)
+        overhead = across & along & (clearance > 72)
+        top = WALL_HEIGHT_U
+        if overhead.any():
+            top = min(top, float(clearance[overhead].min()) - 8)
+        return [
+            tri
+            for p_lo, p_hi in pieces
+            for tri in _quad(
+                (*self.point(p_lo, out), z0),
+                (*self.point(p_hi, out), z1),
+                (*self.point(p_hi, out), z1 + top),
+                (*self.point(p_lo, out), z0 + top),
+            )
+        ]
 
 
 @cache

@@ -102,9 +102,7 @@ class PhysicsWorld:
                     normal_z[lo + k] = hit[4][2]
         return fraction, normal_z
 
-    def first_floor_below(
-        self, points: np.ndarray, depth: float
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def first_floor_below(self, points: np.ndarray, depth: float) -> tuple[np.ndarray, np.ndarray]:
         """Height of the first surface straight below each point within `depth` (NaN if none).
 
         Returns (floor z, surface normal z).

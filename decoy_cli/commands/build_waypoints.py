@@ -1,0 +1,188 @@
+"""`decoy build-waypoints`: build the waypoint graph of the built-in map or of a user's mesh."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from decoy_cli.errors import DecoyError, GraphError
+from decoy_cli.waypoints.build import build_graph, canonical_map, read_manual_waypoints
+from decoy_cli.waypoints.lattice import LatticeParams
+from decoy_cli.waypoints.plot import plot_graph
+from decoy_cli.waypoints.quality import esta_positions, snap_quality
+from decoy_cli.world.meshfile import check_extent, read_mesh
+from decoy_cli.world.navmesh import load_navmesh, nav_world
+
+DEFAULT_OUT = Path("decoy-out") / "waypoints"
+
+
+def _parse_point(text: str, option: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not np.all(np.isfinite(values)):
+        raise GraphError(f"{option} wants three numbers x,y,z in metres, got {text!r}")
+    return values
+
+
+def build_waypoints(
+    map_name: str = typer.Option("dust2", "--map", help="Map whose places and spawns to use."),
+    mesh: Path | None = typer.Option(
+        None, "--mesh", help="A user mesh (.obj or awpy .tri) instead of the built-in nav world."
+    ),
+    units: str = typer.Option("hammer", "--units", help="Mesh units: hammer or m."),
+    scale: float | None = typer.Option(
+        None, "--scale", help="Metres per mesh unit (overrides --units)."
+    ),
+    up_axis: str = typer.Option("z", "--up-axis", help="Mesh axis that points up: z, y, -y, ..."),
+    offset: str = typer.Option("0,0,0", "--offset", help="Added to the mesh after scaling (m)."),
+    spacing: float = typer.Option(0.7, "--spacing", help="Lattice spacing in metres.", min=0.2),
+    seeds: list[str] = typer.Option(
+        [], "--seed", help="A seed point x,y,z in metres (repeatable; default: both spawns)."
+    ),
+    manual: Path | None = typer.Option(
+        None, "--manual", help="CSV of manual waypoints (header x,y,z; metres)."
+    ),
+    out: Path | None = typer.Option(
+        None, "--out", help="Graph file to write (default decoy-out/waypoints/<name>.npz)."
+    ),
+    plot: bool = typer.Option(True, "--plot/--no-plot", help="Write a PNG beside the graph."),
+    check_esta: Path | None = typer.Option(
+        None,
+        "--check-esta",
+        help="ESTA file or folder: report how its player positions snap to the new graph.",
+    ),
+    min_aligned: float = typer.Option(
+        0.5,
+        "--min-aligned",
+        help="With --check-esta: fail when fewer positions than this share snap within 0.5 m.",
+    ),
+) -> None:
+    """Build a waypoint graph: BFS lattice, drop pass, verification, pruning, manual points."""
+    console = Console()
+    map_id = canonical_map(map_name)
+    if mesh is None:
+        world = nav_world(map_id)
+        name = map_id
+    else:
+        world = read_mesh(
+            mesh, units=units, scale=scale, up_axis=up_axis, offset=_parse_point(offset, "--offset")
+        )
+        check_extent(world)
+        name = mesh.name.split(".")[0]
+    seed_points = np.array([_parse_point(s, "--seed") for s in seeds]) if seeds else None
+    manual_points = read_manual_waypoints(manual) if manual is not None else None
+    out = out or DEFAULT_OUT / f"{name}.npz"
+    params = LatticeParams(spacing=spacing)
+
+    started = time.perf_counter()
+    with Progress(
+        TextColumn("{task.description:<14}"),
+        BarColumn(),
+        TextColumn("{task.fields[info]}"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=False,
+    ) as progress:
+        tasks: dict[str, int] = {}
+
+        def report(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = progress.add_task(stage, total=total or None, info="")
+            info = f"{done:,} nodes" if not total else f"{done:,}/{total:,} capsule steps"
+            progress.update(tasks[stage], completed=done, total=total or None, info=info)
+
+        graph, result = build_graph(world, map_id, seed_points, params, manual_points, report)
+        for task in tasks.values():
+            progress.update(task, total=progress.tasks[task].completed or 1)
+    graph.save(out)
+    elapsed = time.perf_counter() - started
+    stats = result.stats
+
+    table = Table(title=f"waypoints of {world.source}")
+    table.add_column("stage")
+    table.add_column("result", justify="right")
+    table.add_column("seconds", justify="right")
+    table.add_row(
+        "lattice (BFS)",
+        f"{stats.lattice_nodes:,} nodes; "
+        + ", ".join(f"{k} {v:,}" for k, v in stats.lattice_edges.items() if k != "drop"),
+        f"{stats.seconds['lattice']:.1f}",
+    )
+    table.add_row(
+        "drop pass",
+        f"{stats.drop_edges:,} drop edges, {stats.drop_new_nodes:,} new nodes",
+        f"{stats.seconds['drop pass']:.1f}",
+    )
+    table.add_row(
+        "verification",
+        f"{stats.nudged_nodes:,} nodes nudged; removed "
+        + ", ".join(f"{k} {v:,}" for k, v in stats.verified_removed.items()),
+        f"{stats.seconds['verification']:.1f}",
+    )
+    table.add_row(
+        "pruning",
+        f"{stats.components_before:,} components -> 1; largest held "
+        f"{stats.largest_component_share:.1%}; {stats.pruned_nodes:,} nodes pruned",
+        f"{stats.seconds['pruning']:.1f}",
+    )
+    if manual_points is not None:
+        table.add_row(
+            "manual", f"{stats.manual_added} added, {stats.manual_dropped} unlinkable", ""
+        )
+    table.add_row(
+        "graph",
+        f"{stats.nodes:,} nodes, {sum(stats.edges.values()):,} edges: "
+        + ", ".join(f"{k} {v:,}" for k, v in stats.edges.items()),
+        f"{elapsed:.1f}",
+    )
+    console.print(table)
+    console.print(f"graph written to {out}")
+    if plot:
+        png = out.with_suffix(".png")
+        plot_graph(
+            graph,
+            png,
+            nav=load_navmesh(map_id),
+            removed_segments=result.removed_segments,
+            pruned_positions=result.pruned_positions,
+            title=f"{graph.num_nodes:,} waypoints, {graph.num_edges:,} edges ({world.source})",
+        )
+        console.print(f"plot written to {png}")
+    if check_esta is not None:
+        _alignment(console, graph, result, check_esta, min_aligned)
+
+
+def _alignment(console: Console, graph, result, path: Path, min_aligned: float) -> None:
+    quality = snap_quality(graph, esta_positions(path), result.pruned_positions)
+    table = Table(title=f"alignment: {quality.positions:,} alive positions of {path}")
+    table.add_column("distance to waypoint")
+    table.add_column("median (m)", justify="right")
+    table.add_column("p95 (m)", justify="right")
+    table.add_column("within 0.5 m", justify="right")
+    table.add_row(
+        "3-D", f"{quality.median_3d:.3f}", f"{quality.p95_3d:.3f}", f"{quality.within_3d:.2%}"
+    )
+    table.add_row(
+        "horizontal",
+        f"{quality.median_horizontal:.3f}",
+        f"{quality.p95_horizontal:.3f}",
+        f"{quality.within_horizontal:.2%}",
+    )
+    console.print(table)
+    console.print(
+        f"no waypoint on their floor: {quality.unsnapped:,}; "
+        f"nearest lattice node was pruned: {quality.on_pruned:.2%}"
+    )
+    if quality.within_horizontal < min_aligned:
+        raise DecoyError(
+            f"only {quality.within_horizontal:.1%} of the positions lie within 0.5 m of a "
+            "waypoint: the mesh looks misaligned (check --units, --scale, --up-axis, --offset)"
+        )

@@ -1,0 +1,134 @@
+"""From a world to a saved `WaypointGraph`: seeds, the lattice builder, places and regions.
+
+The built-in map's graph ships in the package (`builtin_graph()`); `build_graph()` rebuilds it,
+or builds one for a user's own mesh of the same map (places and regions always come from the
+map's nav mesh, which names the spots players talk about: TSpawn, BombsiteA, LongA, ...).
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import asdict
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.errors import GraphError
+from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
+from decoy_cli.world.navmesh import BUILTIN_MAP, REGION_PLACES, NavMesh, asset_dir, load_navmesh
+from decoy_cli.world.physics import PhysicsWorld
+from decoy_cli.world.world import World
+
+GRAPH_FILE = "waypoints.npz"
+MAP_ALIASES = {"dust2": BUILTIN_MAP, BUILTIN_MAP: BUILTIN_MAP}
+
+
+def canonical_map(name: str) -> str:
+    """'dust2' or 'de_dust2' -> 'de_dust2'; a GraphError for maps the project has no data for."""
+    try:
+        return MAP_ALIASES[name.lower()]
+    except KeyError:
+        known = ", ".join(sorted(MAP_ALIASES))
+        raise GraphError(f"unknown map {name!r}; this decoy knows: {known}") from None
+
+
+def default_seeds(nav: NavMesh) -> np.ndarray:
+    """The centres of the largest T-spawn and CT-spawn nav areas, metres: every playable spot
+    is reachable from a spawn."""
+    seeds = []
+    for place in ("TSpawn", "CTSpawn"):
+        idx = np.nonzero(nav.place == place)[0]
+        area = idx[np.argmax((nav.x_max - nav.x_min)[idx] * (nav.y_max - nav.y_min)[idx])]
+        seeds.append(
+            [
+                (nav.x_min[area] + nav.x_max[area]) / 2,
+                (nav.y_min[area] + nav.y_max[area]) / 2,
+                (nav.z_at_min[area] + nav.z_at_max[area]) / 2,
+            ]
+        )
+    return np.asarray(seeds) * HAMMER_TO_M
+
+
+def read_manual_waypoints(path: str | Path) -> np.ndarray:
+    """Manual waypoints from a CSV file with a header `x,y,z` (metres, Source axes)."""
+    path = Path(path)
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as error:
+        raise GraphError(f"cannot read manual waypoints {path}: {error.strerror}") from None
+    except (UnicodeDecodeError, csv.Error) as error:
+        raise GraphError(f"{path}: not a CSV file ({error})") from None
+    points = []
+    for line, row in enumerate(rows, start=2):
+        try:
+            points.append([float(row["x"]), float(row["y"]), float(row["z"])])
+        except (KeyError, TypeError, ValueError):
+            raise GraphError(
+                f"{path}, line {line}: expected numbers in columns x, y, z (metres)"
+            ) from None
+    result = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(result)):
+        raise GraphError(f"{path}: a manual waypoint has a NaN or infinite coordinate")
+    return result
+
+
+def build_graph(
+    world: World,
+    map_name: str = BUILTIN_MAP,
+    seeds: np.ndarray | None = None,
+    params: LatticeParams = LatticeParams(),
+    manual: np.ndarray | None = None,
+    progress: Progress = lambda stage, done, total: None,
+) -> tuple[WaypointGraph, LatticeResult]:
+    """Build the waypoint graph of a world of a known map; deterministic for equal inputs."""
+    nav = load_navmesh(map_name)
+    seed_points = default_seeds(nav) if seeds is None else np.asarray(seeds, dtype=np.float64)
+    with PhysicsWorld(world) as physics:
+        result = build_lattice(physics, seed_points, params, manual, progress)
+    places = nav.places
+    place_index = {name: k for k, name in enumerate(places)}
+    area = nav.area_of(result.positions)
+    node_place = np.array(
+        [place_index.get(str(nav.place[a]), -1) if a >= 0 else -1 for a in area], dtype=np.int16
+    )
+    regions = {
+        region: np.nonzero(node_place == place_index[place])[0]
+        for region, place in REGION_PLACES.items()
+    }
+    stats = result.stats.as_dict()
+    stats.pop("seconds")  # timings vary run to run; the file must not
+    graph = WaypointGraph(
+        positions=result.positions,
+        edge_source=result.edge_source,
+        edge_target=result.edge_target,
+        edge_kind=result.edge_kind,
+        edge_direction=result.edge_direction,
+        node_place=node_place,
+        place_names=places,
+        regions=regions,
+        meta={
+            "format_version": FORMAT_VERSION,
+            "map": map_name,
+            "world": {
+                "name": world.name,
+                "source": world.source,
+                "triangles": world.num_triangles,
+                "sha256": world.fingerprint(),
+            },
+            "params": asdict(params),
+            "seeds_m": np.round(seed_points, 6).tolist(),
+            "manual_waypoints": 0 if manual is None else len(manual),
+            "stats": stats,
+        },
+    )
+    return graph, result
+
+
+@cache
+def builtin_graph(map_name: str = BUILTIN_MAP) -> WaypointGraph:
+    """The waypoint graph shipped with the package for a built-in map (cached per process)."""
+    return WaypointGraph.load(asset_dir(canonical_map(map_name)) / GRAPH_FILE)

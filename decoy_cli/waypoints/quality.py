@@ -1,0 +1,94 @@
+"""How well a waypoint graph covers real player positions (snap quality, alignment check).
+
+Two distances are reported for every position: the 3-D distance to its floor-aware nearest
+waypoint, and the horizontal one. They differ for airborne players: about one real T position in
+ten is 0.4-1.1 m above the floor (jumps), so the 3-D figure mixes the data's jumps into the
+graph's coverage, while the horizontal one measures coverage alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.waypoints.graph import WaypointGraph
+
+ALIGNED_WITHIN_M = 0.5
+
+
+@dataclass(frozen=True)
+class SnapQuality:
+    """Snap distances of a set of positions to a graph (metres; shares in [0, 1])."""
+
+    positions: int
+    unsnapped: int  # no waypoint on the position's floor within the search radius
+    median_3d: float
+    p95_3d: float
+    within_3d: float
+    median_horizontal: float
+    p95_horizontal: float
+    within_horizontal: float
+    on_pruned: float | None  # share whose nearest lattice node was pruned (None: not known)
+
+    def as_dict(self) -> dict[str, float | int | None]:
+        return dict(self.__dict__)
+
+
+def snap_quality(
+    graph: WaypointGraph,
+    positions: np.ndarray,
+    pruned_positions: np.ndarray | None = None,
+    max_distance: float = 3.0,
+) -> SnapQuality:
+    """Snap every position (metres, (M, 3)) and summarise the distances."""
+    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    index, dist = graph.nearest(positions, max_distance=max_distance)
+    ok = index >= 0
+    horizontal = np.full(len(positions), np.inf)
+    horizontal[ok] = np.linalg.norm(positions[ok, :2] - graph.positions[index[ok], :2], axis=1)
+    on_pruned = None
+    if pruned_positions is not None:
+        on_pruned = 0.0
+        if len(pruned_positions):
+            both = WaypointGraph(
+                positions=np.vstack([graph.positions, pruned_positions]),
+                edge_source=np.zeros(0, np.int32),
+                edge_target=np.zeros(0, np.int32),
+                edge_kind=np.zeros(0, np.uint8),
+                edge_direction=np.zeros(0, np.uint8),
+                node_place=np.full(graph.num_nodes + len(pruned_positions), -1, np.int16),
+                place_names=[],
+                regions={},
+            )
+            nearest_any, _ = both.nearest(positions, max_distance=max_distance)
+            on_pruned = float(np.mean(nearest_any >= graph.num_nodes))
+
+    def pct(values: np.ndarray, q: float) -> float:
+        return float(np.percentile(values, q)) if len(values) else float("nan")
+
+    return SnapQuality(
+        positions=len(positions),
+        unsnapped=int(np.sum(~ok)),
+        median_3d=pct(dist[ok], 50),
+        p95_3d=pct(dist, 95) if ok.all() else pct(np.where(ok, dist, np.inf), 95),
+        within_3d=float(np.mean(dist <= ALIGNED_WITHIN_M)) if len(dist) else float("nan"),
+        median_horizontal=pct(horizontal[ok], 50),
+        p95_horizontal=pct(horizontal, 95),
+        within_horizontal=float(np.mean(horizontal <= ALIGNED_WITHIN_M))
+        if len(horizontal)
+        else float("nan"),
+        on_pruned=on_pruned,
+    )
+
+
+def esta_positions(path: str | Path) -> np.ndarray:
+    """Every alive player position (metres) in the rounds of a match file or folder."""
+    from decoy_cli.esta.reader import iter_match_files, read_match
+
+    chunks = []
+    for file in iter_match_files(path):
+        for round_ in read_match(file).rounds:
+            chunks.append(round_.position[round_.alive])
+    return np.concatenate(chunks) if chunks else np.zeros((0, 3))
