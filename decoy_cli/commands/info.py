@@ -1,0 +1,140 @@
+"""`decoy info PATH[:ROUND]`: what an ESTA match file, one of its rounds, or a folder holds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+from rich.table import Table
+
+from decoy_cli.errors import EstaError
+from decoy_cli.esta import Match, Round, iter_match_files, parse_round_address, read_match
+
+
+def info(
+    target: str = typer.Argument(
+        ...,
+        metavar="PATH[:ROUND]",
+        help="A match file (.json.xz or .json), FILE:ROUND for one round, or a folder of matches.",
+    ),
+) -> None:
+    """Show the rounds of a match file, the players of one round, or the matches in a folder."""
+    console = Console()
+    path = Path(target)
+    if path.is_dir():
+        _show_folder(console, path)
+    elif path.is_file():
+        _show_match(console, read_match(path))
+    else:
+        try:
+            file, num = parse_round_address(target)
+        except EstaError:
+            raise EstaError(f"{target}: no such file or folder") from None
+        _show_round(console, read_match(file).round(num))
+
+
+def _show_folder(console: Console, folder: Path) -> None:
+    """One row per match file: map, rounds read and failed; unreadable files fail the command."""
+    files = iter_match_files(folder)
+    table = Table(title=f"{folder}: {len(files)} match files")
+    for column in ("file", "map", "rounds", "failed rounds"):
+        table.add_column(column, justify="right" if "rounds" in column else "left", overflow="fold")
+    unreadable: list[str] = []
+    progress = Progress(
+        TextColumn("reading"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    with progress:
+        for file in progress.track(files):
+            try:
+                match = read_match(file)
+            except EstaError as error:
+                unreadable.append(str(error))
+                table.add_row(file.name, "[red]unreadable[/red]", "", "")
+                continue
+            table.add_row(
+                file.name,
+                match.map_name,
+                str(len(match.rounds)),
+                str(len(match.round_errors)),
+            )
+    console.print(table)
+    for message in unreadable:
+        console.print(f"[red]{message}[/red]", highlight=False)
+    if unreadable:
+        raise EstaError(f"{folder}: {len(unreadable)} of {len(files)} match files are unreadable")
+
+
+def _show_match(console: Console, match: Match) -> None:
+    """One row per round; rounds that failed are listed after the table and fail the command."""
+    table = Table(
+        title=f"{match.match_id}: {match.map_name or 'unknown map'}, {match.tick_rate} tick, "
+        f"{len(match.round_numbers)} rounds"
+    )
+    for column in ("round", "frames", "T", "CT", "plant tick", "winner", "reason"):
+        table.add_column(column, justify="right" if column != "reason" else "left")
+    for played in match.rounds:
+        seen = played.present.any(axis=1)
+        table.add_row(
+            str(played.round_num),
+            str(played.num_frames),
+            str(int(seen[played.side_indices("T")].sum())),
+            str(int(seen[played.side_indices("CT")].sum())),
+            _or_dash(played.bomb_plant_tick),
+            _or_dash(played.winning_side),
+            _or_dash(played.end_reason),
+        )
+    console.print(table)
+    for error in match.round_errors.values():
+        console.print(f"[red]{error}[/red]", highlight=False)
+    if match.round_errors:
+        failed = len(match.round_errors)
+        raise EstaError(
+            f"{match.path}: {failed} of {len(match.round_numbers)} rounds are unreadable"
+        )
+
+
+def _show_round(console: Console, played: Round) -> None:
+    """The round's facts and one row per player with frame counts."""
+    seconds = played.frame_seconds
+    span = f"{seconds[0]:.1f}-{seconds[-1]:.1f} s" if played.num_frames else "no frames"
+    console.print(
+        f"{played.match_id} round {played.round_num} ({played.map_name or 'unknown map'}): "
+        f"{played.num_frames} frames, {span}, ticks {_or_dash(played.start_tick)}-"
+        f"{_or_dash(played.end_tick)}, winner {_or_dash(played.winning_side)} "
+        f"({_or_dash(played.end_reason)}), plant tick {_or_dash(played.bomb_plant_tick)}; "
+        f"{len(played.damages)} damages, {len(played.kills)} kills, "
+        f"{len(played.bomb_events)} bomb events",
+        highlight=False,
+    )
+    if not played.players:
+        console.print("no player appears in any frame")
+        return
+    table = Table()
+    for column in ("player", "name", "side", "frames present", "frames alive", "last hp"):
+        table.add_column(
+            column, justify="right" if "frames" in column or "hp" in column else "left"
+        )
+    for row, player in enumerate(played.players):
+        known = np.flatnonzero(played.present[row])
+        last_hp = str(int(played.hp[row, known[-1]])) if known.size else "-"
+        table.add_row(
+            player.key,
+            player.name,
+            player.side,
+            str(int(played.present[row].sum())),
+            str(int(played.alive[row].sum())),
+            last_hp,
+        )
+    console.print(table)
+
+
+def _or_dash(value: object) -> str:
+    """The value as text, "-" for None."""
+    return "-" if value is None else str(value)

@@ -1,0 +1,25 @@
+"""ESTA match files (awpy 1.x JSON): reading, validation and round addressing.
+
+See decoy_cli/esta/reader.py for what is tolerated and what fails the file or only one round.
+"""
+
+from decoy_cli.esta.frames import MISSING, PlayerInfo
+from decoy_cli.esta.reader import (
+    Match,
+    Round,
+    iter_match_files,
+    load_round,
+    parse_round_address,
+    read_match,
+)
+
+__all__ = [
+    "MISSING",
+    "Match",
+    "PlayerInfo",
+    "Round",
+    "iter_match_files",
+    "load_round",
+    "parse_round_address",
+    "read_match",
+]

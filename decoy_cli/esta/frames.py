@@ -1,0 +1,317 @@
+"""The frames of one round turned into per-player arrays of shape (P, F), in metres.
+
+Players are keyed by `steamID` (as a string), falling back to `name` when the steamID is null or
+0 (awpy writes 0 for bots); their order inside a frame is not trusted. Rows are ordered T first,
+then CT, each by key. A player entry whose x, y or z is null cannot be placed: it counts as absent
+from that frame, like a player missing from the list. Absent cells hold NaN (position, yaw),
+`MISSING` (hp, armor), "" (weapon) and False (flags, `alive`, `present`). A NaN, infinite or
+off-map coordinate (beyond ±10,000 Hammer units) is an error, and so is an unknown weapon.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.esta.schema import FrameState, Invalid, PlayerState
+from decoy_cli.weapons import is_known
+
+Side = Literal["T", "CT"]
+
+MAX_COORD_U = 10_000.0
+"""Largest plausible |coordinate| in Hammer units; de_dust2 spans about ±3,500."""
+
+MISSING = -1
+"""hp and armor where the player is absent or the value is null."""
+
+_MAX_EXACT = 2.0**53
+"""Largest integer a float64 holds exactly: ticks and ids beyond it are corrupt."""
+
+
+@dataclass(frozen=True)
+class PlayerInfo:
+    """One player of a round: `key` is the steamID as a string, else the name."""
+
+    key: str
+    name: str
+    steam_id: int | None
+    side: Side
+
+
+@dataclass(frozen=True, eq=False)
+class FrameArrays:
+    """Everything the frames of one round hold, as arrays (see Round for the meaning)."""
+
+    ticks: np.ndarray
+    seconds: np.ndarray
+    players: list[PlayerInfo]
+    position: np.ndarray
+    yaw: np.ndarray
+    hp: np.ndarray
+    armor: np.ndarray
+    helmet: np.ndarray
+    has_defuser: np.ndarray
+    weapon: np.ndarray
+    alive: np.ndarray
+    present: np.ndarray
+    has_bomb: np.ndarray
+    bomb_position: np.ndarray
+    bomb_planted: np.ndarray
+    bombsite: np.ndarray
+
+
+def build_frames(
+    frames: list[FrameState],
+    tick_rate: int,
+    freeze_end_tick: int | None,
+    start_tick: int | None,
+) -> FrameArrays:
+    """Turn one round's frames into arrays; a bad frame raises Invalid naming frame and player."""
+    ticks = _ticks(frames)
+    seconds = _seconds(frames, ticks, tick_rate, freeze_end_tick, start_tick)
+    bomb_position = _bomb_position(frames, ticks)
+    players, arrays = _players(frames, ticks)
+    return FrameArrays(
+        ticks=ticks,
+        seconds=seconds,
+        players=players,
+        **arrays,
+        bomb_position=bomb_position,
+        bomb_planted=np.array([f.bombPlanted is True for f in frames], dtype=bool),
+        bombsite=np.array([f.bombsite or "" for f in frames], dtype=str),
+    )
+
+
+def _where(ticks: np.ndarray, frame: int) -> str:
+    """'frame j (tick t)' for messages."""
+    return f"frame {frame} (tick {ticks[frame]})" if frame < ticks.size else f"frame {frame}"
+
+
+def _ticks(frames: list[FrameState]) -> np.ndarray:
+    """(F,) int64 ticks; every frame needs one, and they must not decrease."""
+    raw = np.array([f.tick for f in frames], dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(raw) | (np.abs(raw) > _MAX_EXACT) | (raw != np.round(raw))
+    if bad.any():
+        j = int(np.argmax(bad))
+        raise Invalid(f"frame {j} has no valid tick ({frames[j].tick!r})")
+    ticks = raw.astype(np.int64)
+    back = np.flatnonzero(np.diff(ticks) < 0)
+    if back.size:
+        j = int(back[0]) + 1
+        raise Invalid(
+            f"frame {j} (tick {ticks[j]}) comes before frame {j - 1} (tick {ticks[j - 1]})"
+        )
+    return ticks
+
+
+def _seconds(
+    frames: list[FrameState],
+    ticks: np.ndarray,
+    tick_rate: int,
+    freeze_end_tick: int | None,
+    start_tick: int | None,
+) -> np.ndarray:
+    """Seconds since freeze-time end: `seconds` where given, else derived from the tick.
+
+    The reference tick for derived values is `freezeTimeEndTick`, else the one the frames with
+    `seconds` imply, else `startTick`, else the first frame's tick.
+    """
+    seconds = np.array([f.seconds for f in frames], dtype=np.float64)
+    missing = ~np.isfinite(seconds)
+    if not missing.any():
+        return seconds
+    known = ~missing
+    if freeze_end_tick is not None:
+        reference = float(freeze_end_tick)
+    elif known.any():
+        reference = float(np.median(ticks[known] - seconds[known] * tick_rate))
+    elif start_tick is not None:
+        reference = float(start_tick)
+    else:
+        reference = float(ticks[0])
+    seconds[missing] = (ticks[missing] - reference) / tick_rate
+    return seconds
+
+
+def _bomb_position(frames: list[FrameState], ticks: np.ndarray) -> np.ndarray:
+    """(F, 3) bomb position in metres, NaN where null."""
+    rows = [(b.x, b.y, b.z) if (b := f.bomb) is not None else (None, None, None) for f in frames]
+    position = np.array(rows, dtype=np.float64).reshape(len(frames), 3)
+    with np.errstate(invalid="ignore"):
+        off = (np.abs(position) > MAX_COORD_U).any(axis=1)
+    if off.any():
+        j = int(np.argmax(off))
+        x, y, z = position[j]
+        raise Invalid(
+            f"{_where(ticks, j)}: bomb position ({x:.1f}, {y:.1f}, {z:.1f}) u is off the map "
+            f"(beyond ±{MAX_COORD_U:,.0f} u)"
+        )
+    return position * HAMMER_TO_M
+
+
+def _steam_id(value: int | float, ticks: np.ndarray, frame: int) -> int | None:
+    """A non-null steamID as an int; 0 (bots) gives None."""
+    if isinstance(value, float):
+        if not (np.isfinite(value) and value == round(value) and abs(value) < _MAX_EXACT):
+            raise Invalid(f"{_where(ticks, frame)}: steamID {value!r} is not an integer")
+        value = int(value)
+    return value or None
+
+
+def _players(
+    frames: list[FrameState], ticks: np.ndarray
+) -> tuple[list[PlayerInfo], dict[str, np.ndarray]]:
+    """Gather every player entry, key it, validate it and scatter it into (P, F) arrays."""
+    entries: list[PlayerState] = []
+    frame_of: list[int] = []
+    side_of: list[Side] = []
+    for j, frame in enumerate(frames):
+        for side, team in (("T", frame.t), ("CT", frame.ct)):
+            if team is not None and team.players:
+                entries.extend(team.players)
+                frame_of.extend([j] * len(team.players))
+                side_of.extend([side] * len(team.players))
+
+    index: dict[str, int] = {}
+    infos: list[PlayerInfo] = []
+    player_of = np.empty(len(entries), dtype=np.int64)
+    for e, player in enumerate(entries):
+        raw_id = player.steamID
+        steam_id = None if raw_id is None else _steam_id(raw_id, ticks, frame_of[e])
+        key = str(steam_id) if steam_id is not None else player.name
+        if not key:
+            raise Invalid(f"{_where(ticks, frame_of[e])}: a player has neither steamID nor name")
+        i = index.get(key)
+        if i is None:
+            i = index[key] = len(infos)
+            infos.append(PlayerInfo(key, player.name or key, steam_id, side_of[e]))
+        elif infos[i].side != side_of[e]:
+            raise Invalid(f"{_where(ticks, frame_of[e])}: player {key} appears on both sides")
+        player_of[e] = i
+
+    # T before CT, each by key: a stable order whatever the order inside the frames.
+    order = sorted(range(len(infos)), key=lambda i: (infos[i].side != "T", infos[i].key))
+    rank = np.empty(len(infos), dtype=np.int64)
+    rank[order] = np.arange(len(infos))
+    players = [infos[i] for i in order]
+    player_of = rank[player_of]
+    frame_idx = np.array(frame_of, dtype=np.int64)
+    _check_unique(player_of, frame_idx, players, ticks, len(frames))
+
+    position, placed = _positions(entries, player_of, frame_idx, players, ticks)
+    hp = _counts(entries, "hp", player_of, frame_idx, players, ticks)
+    armor = _counts(entries, "armor", player_of, frame_idx, players, ticks)
+    weapons = _weapons(entries, player_of, frame_idx, players, ticks)
+    alive_flag = np.array([p.isAlive is True for p in entries], dtype=bool)
+    alive_known = np.array([p.isAlive is not None for p in entries], dtype=bool)
+    alive = np.where(alive_known, alive_flag, hp > 0)
+
+    shape = (len(players), len(frames))
+    p, f = player_of[placed], frame_idx[placed]
+
+    def scatter(values: np.ndarray, fill: object, dtype: object) -> np.ndarray:
+        """(P, F, ...) array holding each placed entry's value in its cell, `fill` elsewhere."""
+        out = np.full(shape + values.shape[1:], fill, dtype=dtype)
+        out[p, f] = values[placed]
+        return out
+
+    width = max((len(w) for w in weapons), default=1) or 1
+    yaw = np.array([pl.viewX for pl in entries], dtype=np.float64)
+    return players, dict(
+        position=scatter(position * HAMMER_TO_M, np.nan, np.float64),
+        yaw=scatter(yaw, np.nan, np.float64),
+        hp=scatter(hp, MISSING, np.int16),
+        armor=scatter(armor, MISSING, np.int16),
+        helmet=scatter(np.array([pl.hasHelmet is True for pl in entries], bool), False, bool),
+        has_defuser=scatter(np.array([pl.hasDefuse is True for pl in entries], bool), False, bool),
+        weapon=scatter(np.array(weapons, dtype=f"<U{width}"), "", f"<U{width}"),
+        alive=scatter(alive, False, bool),
+        present=scatter(np.ones(len(entries), dtype=bool), False, bool),
+        has_bomb=scatter(np.array([pl.hasBomb is True for pl in entries], bool), False, bool),
+    )
+
+
+def _check_unique(
+    player_of: np.ndarray,
+    frame_idx: np.ndarray,
+    players: list[PlayerInfo],
+    ticks: np.ndarray,
+    num_frames: int,
+) -> None:
+    """A player may appear once per frame."""
+    cell = player_of * max(num_frames, 1) + frame_idx
+    ordered = np.sort(cell)
+    repeated = ordered[1:][np.diff(ordered) == 0]
+    if repeated.size:
+        i, j = divmod(int(repeated[0]), max(num_frames, 1))
+        raise Invalid(f"{_where(ticks, j)}: player {players[i].key} appears twice")
+
+
+def _positions(
+    entries: list[PlayerState],
+    player_of: np.ndarray,
+    frame_idx: np.ndarray,
+    players: list[PlayerInfo],
+    ticks: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(E, 3) Hammer positions and which entries have one; NaN or off-map raises."""
+    position = np.array([(p.x, p.y, p.z) for p in entries], dtype=np.float64).reshape(
+        len(entries), 3
+    )
+    null = np.array([p.x is None or p.y is None or p.z is None for p in entries], dtype=bool)
+    with np.errstate(invalid="ignore"):
+        bad = ~null & ~(np.abs(position) <= MAX_COORD_U).all(axis=1)
+    if bad.any():
+        e = int(np.argmax(bad))
+        x, y, z = position[e]
+        raise Invalid(
+            f"{_where(ticks, int(frame_idx[e]))}: player {players[player_of[e]].key} position "
+            f"({x:.1f}, {y:.1f}, {z:.1f}) u is NaN or off the map (beyond ±{MAX_COORD_U:,.0f} u)"
+        )
+    return position, ~null
+
+
+def _counts(
+    entries: list[PlayerState],
+    field: str,
+    player_of: np.ndarray,
+    frame_idx: np.ndarray,
+    players: list[PlayerInfo],
+    ticks: np.ndarray,
+) -> np.ndarray:
+    """hp or armor as int16 per entry: MISSING where null or NaN; out of 0..32767 raises."""
+    values = np.array([getattr(p, field) for p in entries], dtype=np.float64)
+    known = np.isfinite(values)
+    with np.errstate(invalid="ignore"):
+        out_of_range = (values < 0) | (values > np.iinfo(np.int16).max)
+    bad = np.isinf(values) | (known & out_of_range)
+    if bad.any():
+        e = int(np.argmax(bad))
+        raise Invalid(
+            f"{_where(ticks, int(frame_idx[e]))}: player {players[player_of[e]].key} {field} "
+            f"{values[e]:g} is out of range"
+        )
+    return np.where(known, np.rint(np.where(known, values, 0)), MISSING).astype(np.int16)
+
+
+def _weapons(
+    entries: list[PlayerState],
+    player_of: np.ndarray,
+    frame_idx: np.ndarray,
+    players: list[PlayerInfo],
+    ticks: np.ndarray,
+) -> list[str]:
+    """`activeWeapon` per entry ("" where null); a name not in the weapon table raises."""
+    names = [p.activeWeapon or "" for p in entries]
+    for name in set(names):
+        if not is_known(name):
+            e = names.index(name)
+            raise Invalid(
+                f"{_where(ticks, int(frame_idx[e]))}: player {players[player_of[e]].key} holds "
+                f"unknown weapon {name!r}"
+            )
+    return names

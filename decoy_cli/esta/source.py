@@ -1,0 +1,124 @@
+"""From an ESTA file on disk to its top-level metadata and its rounds, still undecoded.
+
+xz is recognised by its magic bytes, not by the file name; anything else is read as plain JSON.
+msgspec splits the document into top-level values left as raw JSON, so each round is decoded on
+its own later and a bad round fails alone. Strict JSON has no NaN, but Python's `json` writes
+`NaN` for a float nan: a document msgspec rejects is parsed again with `json` (which accepts
+NaN), so that the reader can name the round, frame and player that hold the NaN.
+"""
+
+from __future__ import annotations
+
+import json
+import lzma
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import msgspec
+
+from decoy_cli.errors import EstaError
+from decoy_cli.esta.schema import Invalid, RoundHead, RoundState
+
+XZ_MAGIC = b"\xfd7zXZ\x00"
+
+_TOP_DECODER = msgspec.json.Decoder(dict[str, msgspec.Raw])
+_LIST_DECODER = msgspec.json.Decoder(list[msgspec.Raw])
+_ROUND_DECODER = msgspec.json.Decoder(RoundState)
+_HEAD_DECODER = msgspec.json.Decoder(RoundHead)
+_DECODE_ERRORS = (msgspec.MsgspecError, UnicodeDecodeError, RecursionError)
+"""What decoding a raw value can raise: the first pass skips values without checking UTF-8."""
+
+RoundSource = Any
+"""A `gameRounds` entry: msgspec.Raw (the fast path) or an already parsed object (NaN path)."""
+
+
+@dataclass
+class Document:
+    """A match file split into metadata (decoded) and rounds (not yet decoded)."""
+
+    top: dict[str, Any]
+    rounds: list[RoundSource]
+
+
+def read_bytes(path: Path) -> bytes:
+    """The file's JSON bytes, decompressed when the file is xz."""
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise EstaError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise EstaError(f"{path}: is a folder, not a match file") from None
+    except OSError as error:
+        raise EstaError(f"{path}: cannot read the file ({error.strerror})") from None
+    if data.startswith(XZ_MAGIC):
+        try:
+            data = lzma.decompress(data)
+        except (lzma.LZMAError, EOFError) as error:
+            raise EstaError(f"{path}: corrupt or truncated xz data ({error})") from None
+    return data
+
+
+def parse(path: Path, data: bytes) -> Document:
+    """Split the JSON document into metadata and raw rounds; file-level problems raise."""
+    try:
+        parts = _TOP_DECODER.decode(data)
+    except msgspec.ValidationError:
+        raise EstaError(f"{path}: not an ESTA match file (the JSON is not an object)") from None
+    except (msgspec.DecodeError, UnicodeDecodeError, RecursionError) as error:
+        return _parse_lenient(path, data, error)
+    if "gameRounds" not in parts:
+        raise EstaError(f"{path}: not an ESTA match file (no gameRounds)")
+    try:
+        rounds = _LIST_DECODER.decode(parts.pop("gameRounds"))
+    except msgspec.ValidationError:
+        raise EstaError(f"{path}: not an ESTA match file (gameRounds is not a list)") from None
+    try:
+        top = {key: msgspec.json.decode(raw) for key, raw in parts.items()}
+    except _DECODE_ERRORS as error:
+        raise EstaError(f"{path}: unreadable top-level metadata ({_describe(error)})") from None
+    return Document(top=top, rounds=list(rounds))
+
+
+def _parse_lenient(path: Path, data: bytes, strict_error: Exception) -> Document:
+    """Parse with Python's json, which accepts NaN and Infinity; still invalid: EstaError."""
+    try:
+        document = json.loads(data)
+    except (ValueError, RecursionError):
+        message = str(strict_error)
+        message = message[:1].lower() + message[1:]
+        raise EstaError(f"{path}: invalid JSON ({message})") from None
+    if not isinstance(document, dict):
+        raise EstaError(f"{path}: not an ESTA match file (the JSON is not an object)")
+    if "gameRounds" not in document:
+        raise EstaError(f"{path}: not an ESTA match file (no gameRounds)")
+    rounds = document.pop("gameRounds")
+    if not isinstance(rounds, list):
+        raise EstaError(f"{path}: not an ESTA match file (gameRounds is not a list)")
+    return Document(top=document, rounds=rounds)
+
+
+def decode_round(source: RoundSource) -> RoundState:
+    """Decode one round into typed structs; a wrong type raises Invalid with its JSON path."""
+    try:
+        if isinstance(source, msgspec.Raw):
+            return _ROUND_DECODER.decode(source)
+        return msgspec.convert(source, RoundState)
+    except _DECODE_ERRORS as error:
+        raise Invalid(_describe(error)) from None
+
+
+def round_number_hint(source: RoundSource) -> float | None:
+    """The round's `roundNum` alone, or None when even that cannot be decoded."""
+    try:
+        if isinstance(source, msgspec.Raw):
+            return _HEAD_DECODER.decode(source).roundNum
+        return msgspec.convert(source, RoundHead).roundNum
+    except _DECODE_ERRORS:
+        return None
+
+
+def _describe(error: Exception) -> str:
+    """msgspec's message with the JSON path made relative to the round."""
+    message = str(error).replace(" - at `$.", " at `").replace(" - at `$", " at `")
+    return message[:1].lower() + message[1:]
