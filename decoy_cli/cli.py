@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 
-import click
 import typer
 from typer.core import TyperGroup
 
@@ -18,13 +17,13 @@ _debug = False
 class _Group(TyperGroup):
     """Turns a `DecoyError` into one line on stderr and exit code 1 (a traceback with --debug)."""
 
-    def invoke(self, ctx: click.Context):  # type: ignore[override]
+    def invoke(self, ctx: typer.Context):  # type: ignore[override]
         try:
             return super().invoke(ctx)
         except DecoyError as error:
             if _debug:
                 raise
-            click.echo(f"error: {error}", err=True)
+            typer.echo(f"error: {error}", err=True)
             sys.exit(1)
 
 
