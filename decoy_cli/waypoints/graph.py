@@ -244,7 +244,10 @@ class WaypointGraph:
                 )
         except GraphError:
             raise
-        except (OSError, KeyError, ValueError, zipfile.BadZipFile, json.JSONDecodeError) as error:
+        except Exception as error:
+            # A damaged file fails in many ways (zlib.error, BadZipFile, tokenize.TokenError from
+            # the .npy header, NotImplementedError for an unknown zip method, TypeError or
+            # AttributeError for members of the wrong shape): all of them are a bad graph file.
             raise GraphError(f"{path}: not a readable waypoint graph ({error})") from None
         graph.validate(path)
         return graph

@@ -7,6 +7,7 @@ too, for looking at what the builder threw away.
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import numpy as np
@@ -78,12 +79,14 @@ def plot_graph(
     ax.legend(loc="lower right")
     ax.set_title(title or f"{graph.num_nodes} waypoints, {graph.num_edges} edges")
     path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp.png")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.tmp.png")
         fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
         tmp.replace(path)
     except OSError as error:
+        with contextlib.suppress(OSError):  # no half-written picture left behind
+            tmp.unlink()
         raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
     finally:
         plt.close(fig)

@@ -66,7 +66,13 @@ def snap_quality(
             on_pruned = float(np.mean(nearest_any >= graph.num_nodes))
 
     def pct(values: np.ndarray, q: float) -> float:
-        return float(np.percentile(values, q)) if len(values) else float("nan")
+        """Percentile; inf where it falls among unsnapped positions (inf - inf is not a NaN
+        warning on the user's terminal), NaN for no values."""
+        if not len(values):
+            return float("nan")
+        with np.errstate(invalid="ignore"):
+            result = float(np.percentile(values, q))
+        return np.inf if np.isnan(result) else result
 
     return SnapQuality(
         positions=len(positions),

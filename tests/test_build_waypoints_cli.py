@@ -1,0 +1,299 @@
+"""`decoy build-waypoints`: the shipped graph is current, outputs, user meshes, and every bad
+input ends as one `error: ...` line with exit code 1 and no half-written file."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from esta_fixtures import write_match
+from typer.testing import CliRunner, Result
+from worlds import fixture_room, room, seeds_of
+
+from decoy_cli.cli import app
+from decoy_cli.waypoints.build import GRAPH_FILE, build_graph
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.meshfile import read_mesh, write_obj, write_tri
+from decoy_cli.world.navmesh import asset_dir
+from decoy_cli.world.world import World
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+TSIDE = DATA / "esta_dust2_tside"
+SHIPPED = asset_dir() / GRAPH_FILE
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "200"}
+
+
+def build(*args: str) -> Result:
+    return runner.invoke(app, ["build-waypoints", *args], env=WIDE)
+
+
+def seed_arg(world: World) -> list[str]:
+    return ["--seed", ",".join(f"{v:g}" for v in world.meta["seed"])]
+
+
+def assert_one_error_line(result: Result, *fragments: str) -> None:
+    """Exit code 1, exactly one `error: ...` line on stderr, no traceback."""
+    assert result.exit_code == 1, result.output
+    assert isinstance(result.exception, SystemExit)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.output
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def small_room() -> World:
+    """A 6.3 m square room (a map is at least 5 m across); lattice lines 0.35 m from the walls."""
+    return room(6.3, 6.3)
+
+
+@pytest.fixture(scope="module")
+def small_obj(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("mesh") / "small.obj"
+    write_obj(small_room(), path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def fixture_obj(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("mesh") / "fixture_room.obj"
+    write_obj(fixture_room(), path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def esta_match(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_match(tmp_path_factory.mktemp("esta") / "fixture.json.xz")
+
+
+# ---- the built-in map (one full build, ~12 s, with every check on its output) ---------------
+
+
+def test_builtin_build(tmp_path: Path, subtests: pytest.Subtests) -> None:
+    """THE test that the shipped graph is current: rebuilding it gives the same bytes.
+
+    The build runs once; its table, plot and (when the real data is present) the alignment
+    check on real T-side positions are checked on the same run.
+    """
+    out = tmp_path / "dust2.npz"
+    args = ["--out", str(out)]
+    if TSIDE.is_dir():
+        args += ["--check-esta", str(TSIDE)]
+    result = build(*args)
+    assert result.exit_code == 0, result.output
+
+    with subtests.test("the shipped graph is reproduced byte for byte"):
+        assert out.read_bytes() == SHIPPED.read_bytes()
+
+    with subtests.test("summary table, graph file and plot"):
+        graph = WaypointGraph.load(out)
+        for stage in ("lattice (BFS)", "drop pass", "verification", "pruning", "graph"):
+            assert stage in result.stdout
+        assert f"{graph.num_nodes:,} nodes, {graph.num_edges:,} edges" in result.stdout
+        assert "built-in de_dust2 nav mesh" in result.stdout
+        assert f"graph written to {out}" in result.stdout
+        png = out.with_suffix(".png")
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 50_000
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["dust2.npz", "dust2.png"]
+        assert result.stderr == ""
+
+    with subtests.test("--check-esta on the real T-side positions"):
+        if not TSIDE.is_dir():
+            pytest.skip(f"real ESTA data not found at {TSIDE}")
+        count = re.search(r"alignment: ([\d,]+) alive positions", result.stdout)
+        assert count and int(count.group(1).replace(",", "")) > 100_000
+        row = re.search(r"horizontal\s*│\s*([\d.]+)\s*│\s*([\d.]+)\s*│\s*([\d.]+)%", result.stdout)
+        assert row, result.stdout
+        median, p95, within = (float(v) for v in row.groups())
+        assert median < 0.35 and p95 < 0.8 and within >= 90.0
+        assert "no waypoint on their floor" in result.stdout
+
+
+# ---- user meshes -------------------------------------------------------------------------------
+
+
+def test_user_obj_mesh_matches_the_library_build(tmp_path: Path, fixture_obj: Path) -> None:
+    out = tmp_path / "room.npz"
+    result = build(
+        "--mesh", str(fixture_obj), *seed_arg(fixture_room()), "--out", str(out), "--no-plot"
+    )
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["room.npz"]  # --no-plot: no PNG
+    assert "plot written" not in result.stdout
+    world = read_mesh(fixture_obj)
+    expected, _ = build_graph(world, seeds=seeds_of(fixture_room()))
+    expected.save(tmp_path / "library.npz")
+    assert out.read_bytes() == (tmp_path / "library.npz").read_bytes()
+    graph = WaypointGraph.load(out)
+    # lattice lines -7 + 0.7 k (k = -20..20) by 12 + 0.7 k (k = -6..6), all clear of the walls
+    assert graph.num_nodes == 41 * 13
+    assert "533 nodes" in result.stdout and f"waypoints of {fixture_obj}" in result.stdout
+
+
+def test_user_tri_mesh_with_plot(tmp_path: Path) -> None:
+    mesh = tmp_path / "small.tri"
+    write_tri(small_room(), mesh)
+    out = tmp_path / "out" / "small.npz"
+    result = build("--mesh", str(mesh), *seed_arg(small_room()), "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert WaypointGraph.load(out).num_nodes == 81
+    assert (tmp_path / "out" / "small.png").read_bytes()[:4] == b"\x89PNG"
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["small.npz", "small.png"]
+
+
+def test_user_mesh_in_metres_with_offset(tmp_path: Path) -> None:
+    mesh = tmp_path / "small_m.obj"
+    write_obj(small_room(), mesh, units="m")
+    out = tmp_path / "g.npz"
+    result = build(
+        "--mesh", str(mesh), "--units", "m", "--offset", "10,20,1", "--seed", "13.15,23.15,1",
+        "--out", str(out), "--no-plot",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    graph = WaypointGraph.load(out)
+    assert graph.num_nodes == 81
+    np.testing.assert_allclose(graph.positions[:, 2], 1.0, atol=1e-6)
+    assert graph.positions[:, 0].min() > 10.0 and graph.positions[:, 1].min() > 20.0
+
+
+def test_check_esta_on_the_fixture_passes(tmp_path: Path, fixture_obj, esta_match) -> None:
+    """The fixture room lies under every fixture player, so all of them snap within 0.5 m."""
+    result = build(
+        "--mesh", str(fixture_obj), *seed_arg(fixture_room()), "--out", str(tmp_path / "g.npz"),
+        "--no-plot", "--check-esta", str(esta_match),
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert re.search(r"alignment: \d+ alive positions", result.stdout)
+    row = re.search(r"horizontal\s*│\s*([\d.]+)\s*│\s*([\d.]+)\s*│\s*([\d.]+)%", result.stdout)
+    assert row and float(row.group(3)) == 100.0
+    assert "no waypoint on their floor: 0;" in result.stdout
+
+
+@pytest.mark.filterwarnings("error")  # a numpy warning would be a stray line on the terminal
+def test_check_esta_misaligned_mesh_fails(tmp_path: Path, fixture_obj, esta_match) -> None:
+    """The same room lifted 5 m: no fixture player is on its floor."""
+    args = [
+        "--mesh", str(fixture_obj), "--offset", "0,0,5", "--seed", "-7,12,5",
+        "--out", str(tmp_path / "g.npz"), "--no-plot", "--check-esta", str(esta_match),
+    ]  # fmt: skip
+    result = build(*args)
+    assert_one_error_line(result, "of the positions lie within 0.5 m", "misaligned")
+    assert "alignment:" in result.stdout
+    # with --min-aligned 0 the same check only reports
+    result = build(*args, "--min-aligned", "0")
+    assert result.exit_code == 0, result.output
+    assert re.search(r"horizontal\s*│\s*nan\s*│\s*inf\s*│\s*0\.00%", result.stdout)
+    assert "no waypoint on their floor: 88;" in result.stdout
+
+
+def test_check_esta_missing_path(tmp_path: Path, small_obj: Path) -> None:
+    result = build(
+        "--mesh", str(small_obj), *seed_arg(small_room()), "--out", str(tmp_path / "g.npz"),
+        "--no-plot", "--check-esta", str(tmp_path / "absent.json.xz"),
+    )  # fmt: skip
+    assert_one_error_line(result, "absent.json.xz", "no such file")
+
+
+# ---- bad input: one error line ----------------------------------------------------------------
+
+
+def test_wrong_up_axis(tmp_path: Path, fixture_obj: Path) -> None:
+    out = tmp_path / "g.npz"
+    result = build("--mesh", str(fixture_obj), "--up-axis", "y", "--out", str(out))
+    assert_one_error_line(result, str(fixture_obj), "not Z-up", "--up-axis y")
+    assert not out.exists()
+
+
+def test_wrong_units(tmp_path: Path) -> None:
+    mesh = tmp_path / "metres.obj"
+    write_obj(fixture_room(), mesh, units="m")
+    result = build("--mesh", str(mesh), "--out", str(tmp_path / "g.npz"))  # read as Hammer
+    assert_one_error_line(result, "too small for a map", "--units m")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["metres.obj"]
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "fragment"),
+    [
+        ("absent.obj", None, "no such mesh file"),
+        ("cut.tri", b"\0" * 35, "not a multiple of 36"),
+        ("bad.obj", b"v 0 0 0\nv 1 0 x\nv 0 1 0\nf 1 2 3\n", "line 2"),
+        ("faces.obj", b"v 0 0 0\nf 1 2 3\n", "face refers to vertex 2"),
+        ("mesh.stl", b"solid", "unknown mesh format"),
+    ],
+)
+def test_missing_or_corrupt_mesh(tmp_path: Path, name: str, content, fragment: str) -> None:
+    mesh = tmp_path / name
+    if content is not None:
+        mesh.write_bytes(content)
+    result = build("--mesh", str(mesh), "--out", str(tmp_path / "g.npz"))
+    assert_one_error_line(result, str(mesh), fragment)
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--seed", "1,2"], "--seed wants three numbers"),
+        (["--seed", "1,2,nan"], "--seed wants three numbers"),
+        (["--seed", "40,40,0"], "seed 0 at [40.0, 40.0, 0.0] m is not above a floor"),
+        (["--offset", "a,b,c"], "--offset wants three numbers"),
+        (["--map", "nuke"], "unknown map 'nuke'"),
+    ],
+)
+def test_bad_options(tmp_path: Path, small_obj: Path, args: list[str], fragment: str) -> None:
+    result = build("--mesh", str(small_obj), "--out", str(tmp_path / "g.npz"), *args)
+    assert_one_error_line(result, fragment)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_manual_waypoints(tmp_path: Path, small_obj: Path) -> None:
+    """A manual point inside the room is merged; one off the world stops the build."""
+    good = tmp_path / "good.csv"
+    good.write_text("x,y,z\n3.5,3.5,0.0\n")
+    out = tmp_path / "g.npz"
+    result = build("--mesh", str(small_obj), *seed_arg(small_room()), "--manual", str(good),
+                   "--out", str(out), "--no-plot")  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "1 added, 0 unlinkable" in result.stdout
+    assert WaypointGraph.load(out).num_nodes == 82
+    out.unlink()
+
+    off = tmp_path / "off.csv"
+    off.write_text("x,y,z\n3.5,3.5,0.0\n40.0,3.0,0.0\n")
+    result = build("--mesh", str(small_obj), *seed_arg(small_room()), "--manual", str(off),
+                   "--out", str(out), "--no-plot")  # fmt: skip
+    assert_one_error_line(result, "manual waypoint 1 at [40.0, 3.0, 0.0] m is not on a floor")
+    assert not out.exists()
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y\n1,2\n")
+    result = build("--mesh", str(small_obj), "--manual", str(bad), "--out", str(out))
+    assert_one_error_line(result, str(bad), "line 2", "columns x, y, z")
+    result = build("--mesh", str(small_obj), "--manual", str(tmp_path / "no.csv"))
+    assert_one_error_line(result, "cannot read manual waypoints")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "good.csv", "off.csv"]
+
+
+@pytest.mark.parametrize("where", ["under-a-file", "a-directory", "png-is-a-directory"])
+def test_unwritable_out(tmp_path: Path, small_obj: Path, where: str) -> None:
+    """One error line and nothing half-written: no temporary file stays in the folder."""
+    folder = tmp_path / "out"
+    folder.mkdir()
+    if where == "under-a-file":
+        (folder / "file").write_text("x")
+        out, expected = folder / "file" / "g.npz", ["file"]
+    elif where == "a-directory":
+        out, expected = folder / "g.npz", ["g.npz"]
+        out.mkdir()
+    else:  # the graph is written, its picture cannot be
+        out, expected = folder / "g.npz", ["g.npz", "g.png"]
+        (folder / "g.png").mkdir()
+    result = build("--mesh", str(small_obj), *seed_arg(small_room()), "--out", str(out))
+    assert_one_error_line(result, "cannot write")
+    assert sorted(p.name for p in folder.iterdir()) == expected
+    if where == "under-a-file":
+        assert (folder / "file").read_text() == "x"

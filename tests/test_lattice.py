@@ -1,0 +1,339 @@
+"""The lattice builder on hand-made worlds: counts, directions, edge kinds, connectivity, manual
+waypoints and determinism (tests/worlds.py describes each world)."""
+
+from __future__ import annotations
+
+from collections import Counter
+from functools import cache
+
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+from worlds import (
+    ALCOVE,
+    ALCOVE_POINT,
+    BOX,
+    BOX_Z,
+    DECK,
+    DECK_Z,
+    GAP_WALL_X,
+    LEDGE_X,
+    LEDGE_Z,
+    alcove_room,
+    gap_wall_world,
+    jump_box_world,
+    ledge_world,
+    overpass_world,
+    room,
+    seeds_of,
+)
+
+from decoy_cli.csgo import JUMP_HEIGHT_M
+from decoy_cli.errors import GraphError
+from decoy_cli.waypoints.build import build_graph, builtin_graph
+from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, build_lattice
+from decoy_cli.world.navmesh import REGION_PLACES
+from decoy_cli.world.physics import PhysicsWorld
+
+WORLDS = {
+    "room": room,
+    "ledge": ledge_world,
+    "jump box": jump_box_world,
+    "overpass": overpass_world,
+    "gap 0.8": lambda: gap_wall_world(0.8),
+    "gap 0.3": lambda: gap_wall_world(0.3),
+    "alcove": alcove_room,
+}
+
+
+@cache
+def lattice(name: str) -> LatticeResult:
+    """The lattice of a hand-made world from its seed (built once per test process)."""
+    world = WORLDS[name]()
+    with PhysicsWorld(world) as physics:
+        return build_lattice(physics, seeds_of(world))
+
+
+def edge_delta(result: LatticeResult) -> np.ndarray:
+    return result.positions[result.edge_target] - result.positions[result.edge_source]
+
+
+# ---- every world -------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_edge_direction_matches_geometry(name: str) -> None:
+    """N = +y, E = +x: the edge's horizontal heading lies in its direction's 45-degree sector."""
+    result = lattice(name)
+    delta = edge_delta(result)
+    heading = np.degrees(np.arctan2(delta[:, 0], delta[:, 1])) % 360  # clockwise from north
+    deviation = np.abs((heading - 45.0 * result.edge_direction + 180) % 360 - 180)
+    assert result.edge_direction.max() <= 7
+    assert deviation.max() < 22.5
+
+
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_one_edge_per_direction_and_no_loops(name: str) -> None:
+    result = lattice(name)
+    slots = Counter(zip(result.edge_source.tolist(), result.edge_direction.tolist(), strict=True))
+    assert max(slots.values()) == 1
+    pairs = Counter(zip(result.edge_source.tolist(), result.edge_target.tolist(), strict=True))
+    assert max(pairs.values()) == 1
+    assert not np.any(result.edge_source == result.edge_target)
+
+
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_strongly_connected_after_pruning(name: str) -> None:
+    result = lattice(name)
+    n = len(result.positions)
+    matrix = csr_matrix(
+        (np.ones(len(result.edge_source)), (result.edge_source, result.edge_target)), shape=(n, n)
+    )
+    count, _ = connected_components(matrix, directed=True, connection="strong")
+    assert count == 1
+    assert result.stats.components_after == 1
+    assert result.stats.nodes == n
+    assert len(result.pruned_positions) == result.stats.pruned_nodes
+
+
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_drop_edges_are_one_way_and_go_down(name: str) -> None:
+    """A drop's reverse is never walked or dropped: at most a jump climbs back (the box)."""
+    result = lattice(name)
+    kind = result.edge_kind
+    by_pair = {
+        (u, v): k
+        for u, v, k in zip(
+            result.edge_source.tolist(), result.edge_target.tolist(), kind.tolist(), strict=True
+        )
+    }
+    drops = np.nonzero(kind == EdgeKind.DROP)[0]
+    for e in drops:
+        back = by_pair.get((int(result.edge_target[e]), int(result.edge_source[e])))
+        assert back in (None, EdgeKind.JUMP)
+    # a drop ends lower; by more than a step except where the move first climbs a ramp and
+    # then falls off its side (the overpass): the profile, not the end heights, makes a drop
+    assert np.all(edge_delta(result)[drops, 2] < 0)
+    # walk edges are no steeper than a floor (normal z >= 0.7, about 45.6 degrees; a ramp edge
+    # may rise more than the step height); jumps rise, at most a crouch-jump, and by less than
+    # a step where the move jumps onto a ramp's side and walks down it
+    delta = edge_delta(result)
+    dz = delta[:, 2]
+    walk = kind == EdgeKind.WALK
+    max_slope = np.tan(np.arccos(LatticeParams().min_floor_normal_z))
+    assert np.all(np.abs(dz[walk]) <= max_slope * np.linalg.norm(delta[walk, :2], axis=1))
+    assert np.all(dz[kind == EdgeKind.JUMP] <= JUMP_HEIGHT_M + 1e-9)
+    assert np.all(dz[kind == EdgeKind.JUMP] > 0)
+
+
+# ---- the room ----------------------------------------------------------------------------------
+
+
+def test_room_is_a_full_7_by_7_lattice() -> None:
+    """A 5 x 5 m room seeded at its centre: lattice lines at 2.5 +- 0.7 k for k <= 3 all lie
+    0.4 m or more from the walls (wider than the agent radius), the next ones outside."""
+    result = lattice("room")
+    assert len(result.positions) == 49
+    xs = np.unique(np.round(result.positions[:, 0], 6))
+    np.testing.assert_allclose(xs, 2.5 + 0.7 * np.arange(-3, 4), atol=1e-9)
+    np.testing.assert_allclose(result.positions[:, 2], 0.0, atol=1e-6)
+    # the full 8-neighbourhood grid, both ways: 2 (2 * 7 * 6) straight + 2 (2 * 6 * 6) diagonal
+    assert len(result.edge_source) == 312
+    assert set(result.edge_kind.tolist()) == {EdgeKind.WALK}
+    assert result.stats.nudged_nodes == 0
+    np.testing.assert_allclose(np.linalg.norm(edge_delta(result), axis=1).min(), 0.7)
+
+
+def test_spacing_changes_the_node_count() -> None:
+    world = room()
+    with PhysicsWorld(world) as physics:
+        result = build_lattice(physics, seeds_of(world), LatticeParams(spacing=1.0))
+    # lines at 2.5 +- k for k <= 2 (0.5 .. 4.5 m)
+    assert len(result.positions) == 25
+
+
+# ---- ledge, box, overpass, gap -----------------------------------------------------------------
+
+
+def test_ledge_drops_one_way_and_never_climbs() -> None:
+    result = lattice("ledge")
+    src, dst = result.edge_source, result.edge_target
+    pos = result.positions
+    lower = (pos[:, 2] < 0.05) & (pos[:, 0] < LEDGE_X) & (pos[:, 1] < 4.0)
+    platform = np.abs(pos[:, 2] - LEDGE_Z) < 0.05
+    assert lower.sum() > 30 and platform.sum() > 30
+    up = lower[src] & platform[dst]
+    assert not up.any()
+    down = platform[src] & lower[dst]
+    assert down.sum() >= 5
+    assert np.all(result.edge_kind[down] == EdgeKind.DROP)
+    # every drop goes west off the face: W, SW or NW
+    assert set(result.edge_direction[down].tolist()) <= {5, 6, 7}
+    pairs = set(zip(src.tolist(), dst.tolist(), strict=True))
+    assert not any(
+        (v, u) in pairs for u, v in zip(src[down].tolist(), dst[down].tolist(), strict=True)
+    )
+    # the ramp lane keeps both floors in one strongly connected component
+    assert result.stats.largest_component_share == 1.0
+    ramp = (pos[:, 2] > 0.05) & (pos[:, 2] < LEDGE_Z - 0.02)
+    assert ramp.sum() >= 6
+
+
+def test_box_is_jumped_onto_and_dropped_off() -> None:
+    result = lattice("jump box")
+    pos, kind = result.positions, result.edge_kind
+    x0, y0, x1, y1 = BOX
+    top = np.abs(pos[:, 2] - BOX_Z) < 0.02
+    inside = (pos[:, 0] > x0) & (pos[:, 0] < x1) & (pos[:, 1] > y0) & (pos[:, 1] < y1)
+    assert np.array_equal(top, inside)
+    assert top.sum() == 4  # lattice lines 3.3 and 4.0 (seed 0.5 + 0.7 k) cross the box
+    src, dst = result.edge_source, result.edge_target
+    onto = ~top[src] & top[dst]
+    off = top[src] & ~top[dst]
+    assert onto.sum() == off.sum() == 20  # each top node has 5 floor neighbours
+    assert np.all(kind[onto] == EdgeKind.JUMP)
+    assert np.all(kind[off] == EdgeKind.DROP)
+    assert np.all(kind[~onto & ~off] == EdgeKind.WALK)
+    jumps = set(zip(src[onto].tolist(), dst[onto].tolist(), strict=True))
+    drops = set(zip(dst[off].tolist(), src[off].tolist(), strict=True))
+    assert jumps == drops
+
+
+@cache
+def overpass_graph() -> WaypointGraph:
+    world = overpass_world()
+    graph, _ = build_graph(world, seeds=seeds_of(world))
+    return graph
+
+
+def test_overpass_has_both_floors_at_the_same_spots() -> None:
+    graph = overpass_graph()
+    pos = graph.positions
+    x0, y0, x1, y1 = DECK
+    under = (pos[:, 0] > x0) & (pos[:, 0] < x1) & (pos[:, 1] > y0) & (pos[:, 1] < y1)
+    deck = under & (np.abs(pos[:, 2] - DECK_Z) < 0.02)
+    ground = under & (np.abs(pos[:, 2]) < 0.02)
+    assert deck.sum() >= 20
+    key = lambda rows: {tuple(np.round(p[:2], 6)) for p in rows}  # noqa: E731
+    assert key(pos[deck]) == key(pos[ground])
+
+
+@pytest.mark.parametrize("lift", [0.0, 0.3, 1.0])
+def test_overpass_nearest_stays_on_its_floor(lift: float) -> None:
+    """A player on the deck (or jumping above it) never snaps to the ground 4 m below, and one
+    on the ground under the deck never snaps up."""
+    graph = overpass_graph()
+    pos = graph.positions
+    x0, y0, x1, y1 = DECK
+    under = (pos[:, 0] > x0) & (pos[:, 0] < x1) & (pos[:, 1] > y0) & (pos[:, 1] < y1)
+    for floor_z in (DECK_Z, 0.0):
+        nodes = np.nonzero(under & (np.abs(pos[:, 2] - floor_z) < 0.02))[0]
+        queries = pos[nodes] + np.array([0.2, -0.15, lift])
+        index, distance = graph.nearest(queries)
+        assert np.all(index >= 0)
+        np.testing.assert_allclose(pos[index, 2], floor_z, atol=0.02)
+        assert np.all(distance < lift + 0.3)
+
+
+def test_wall_gap_one_agent_wide_connects_both_halves() -> None:
+    result = lattice("gap 0.8")
+    west = result.positions[:, 0] < GAP_WALL_X
+    assert west.sum() > 30 and (~west).sum() > 30
+    crossing = west[result.edge_source] != west[result.edge_target]
+    assert crossing.sum() >= 2  # both ways through the gap
+    assert np.all(np.abs(result.positions[result.edge_source[crossing], 1] - 3.0) < 0.5)
+
+
+def test_wall_gap_too_narrow_keeps_halves_apart() -> None:
+    result = lattice("gap 0.3")
+    assert len(result.positions) > 30
+    assert np.all(result.positions[:, 0] < GAP_WALL_X)
+
+
+# ---- manual waypoints, seeds, determinism ------------------------------------------------------
+
+
+def test_manual_waypoint_in_unreached_alcove_is_linked() -> None:
+    world = alcove_room()
+    x0, y0, x1, y1 = ALCOVE
+    plain = lattice("alcove")
+    in_alcove = lambda p: (p[:, 0] > x0) & (p[:, 0] < x1) & (p[:, 1] > y0) & (p[:, 1] < y1)  # noqa: E731
+    assert not in_alcove(plain.positions).any()  # the lattice does not get in by itself
+
+    with PhysicsWorld(world) as physics:
+        result = build_lattice(physics, seeds_of(world), manual=np.array([ALCOVE_POINT]))
+    assert result.stats.manual_added == 1 and result.stats.manual_dropped == 0
+    node = np.nonzero(in_alcove(result.positions))[0]
+    assert len(node) == 1
+    np.testing.assert_allclose(result.positions[node[0]], ALCOVE_POINT, atol=1e-6)
+    assert np.any(result.edge_source == node[0]) and np.any(result.edge_target == node[0])
+    assert len(result.positions) == len(plain.positions) + 1
+    slots = Counter(zip(result.edge_source.tolist(), result.edge_direction.tolist(), strict=True))
+    assert max(slots.values()) == 1
+
+
+def test_manual_waypoint_off_the_world_raises() -> None:
+    world = room()
+    with PhysicsWorld(world) as physics, pytest.raises(GraphError, match="manual waypoint 1"):
+        build_lattice(
+            physics, seeds_of(world), manual=np.array([[2.5, 2.5, 0.0], [40.0, 40.0, 0.0]])
+        )
+
+
+def test_manual_waypoint_far_above_the_floor_raises() -> None:
+    world = room()
+    with PhysicsWorld(world) as physics, pytest.raises(GraphError, match="not on a floor"):
+        build_lattice(physics, seeds_of(world), manual=np.array([[2.5, 2.5, 2.0]]))
+
+
+@pytest.mark.parametrize(
+    ("seeds", "message"),
+    [(np.zeros((0, 3)), "no seed points"), (np.array([[40.0, 40.0, 0.0]]), "not above a floor")],
+)
+def test_bad_seeds_raise(seeds: np.ndarray, message: str) -> None:
+    with PhysicsWorld(room()) as physics, pytest.raises(GraphError, match=message):
+        build_lattice(physics, seeds)
+
+
+def test_builds_are_deterministic(tmp_path) -> None:
+    world = jump_box_world()
+    first, _ = build_graph(world, seeds=seeds_of(world))
+    second, _ = build_graph(jump_box_world(), seeds=seeds_of(world))
+    for name in ("positions", "edge_source", "edge_target", "edge_kind", "edge_direction"):
+        np.testing.assert_array_equal(getattr(first, name), getattr(second, name))
+    first.save(tmp_path / "a.npz")
+    second.save(tmp_path / "b.npz")
+    assert (tmp_path / "a.npz").read_bytes() == (tmp_path / "b.npz").read_bytes()
+    assert first.meta["world"]["sha256"] == world.fingerprint()
+    assert first.meta["seeds_m"] == seeds_of(world).tolist()
+    # node order is canonical: sorted by x, then y, then z
+    order = np.lexsort(np.round(first.positions, 6).T[::-1])
+    np.testing.assert_array_equal(order, np.arange(first.num_nodes))
+
+
+# ---- the shipped de_dust2 graph ----------------------------------------------------------------
+
+
+def test_shipped_graph_invariants() -> None:
+    """The same invariants on the shipped graph (rebuilding it is the CLI test's job). Nudged
+    nodes bend some edges: a few dozen lie up to ~31 degrees off their compass direction, none
+    by half a sector or more."""
+    graph = builtin_graph()
+    count, _ = connected_components(graph.adjacency, directed=True, connection="strong")
+    assert count == 1
+    assert graph.num_nodes > 6000 and graph.num_edges > 40_000
+    slots = Counter(zip(graph.edge_source.tolist(), graph.edge_direction.tolist(), strict=True))
+    assert max(slots.values()) == 1
+    delta = graph.positions[graph.edge_target] - graph.positions[graph.edge_source]
+    heading = np.degrees(np.arctan2(delta[:, 0], delta[:, 1])) % 360
+    deviation = np.abs((heading - 45.0 * graph.edge_direction + 180) % 360 - 180)
+    assert deviation.max() < 45.0
+    assert np.mean(deviation < 22.5) > 0.998
+    for region in ("t_spawn", "ct_spawn", "bombsite_a", "bombsite_b"):
+        nodes = graph.region_of(region)
+        assert len(nodes) >= 20
+        places = {graph.place_names[p] for p in graph.node_place[nodes]}
+        assert places == {REGION_PLACES[region]}
+    assert np.mean(graph.node_place >= 0) > 0.95
