@@ -67,6 +67,7 @@ class LatticeParams:
     verify_step: float = 0.1
     verify_clearance: float = 0.03  # capsule floats this much above the step height
     max_nudge: float = 0.3  # a node the capsule does not fit at moves up to this far to fit
+    graze: float = 0.025  # penetration the capsule may have (the walls are approximate)
 
 
 @dataclass
@@ -251,7 +252,9 @@ def _nudge_nodes(
     and how many moved. Nodes with no such spot stay, and verification removes their edges."""
     float_h, cap_h = _capsule_dims(params)
     lift = np.array([0.0, 0.0, float_h + cap_h / 2])
-    blocked = np.nonzero(physics.capsules_blocked(positions + lift, params.agent_radius, cap_h))[0]
+    blocked = np.nonzero(
+        physics.capsules_blocked(positions + lift, params.agent_radius, cap_h, params.graze)
+    )[0]
     if len(blocked) == 0:
         return positions, 0
     angles = np.arange(16) * (np.pi / 8)
@@ -267,7 +270,7 @@ def _nudge_nodes(
         if not ok.any():
             continue
         cand = np.column_stack([xy[ok], z[ok]])
-        free = ~physics.capsules_blocked(cand + lift, params.agent_radius, cap_h)
+        free = ~physics.capsules_blocked(cand + lift, params.agent_radius, cap_h, params.graze)
         if free.any():
             moved[node] = cand[np.argmax(free)]  # offsets are ordered nearest first
             count += 1
@@ -307,7 +310,7 @@ def _verify(
     chunk = 16384
     for lo in range(0, len(all_centres), chunk):
         blocked[lo : lo + chunk] = physics.capsules_blocked(
-            all_centres[lo : lo + chunk], params.agent_radius, cap_height
+            all_centres[lo : lo + chunk], params.agent_radius, cap_height, params.graze
         )
         progress("verification", min(lo + chunk, len(all_centres)), len(all_centres))
     bad = np.zeros(len(edges), dtype=bool)

@@ -381,7 +381,7 @@ def _walls(nav: NavMesh, covered, height) -> list:
     for a in range(nav.num_areas):
         for axis in (0, 1):
             for high in (False, True):
-                side = _Side(nav, a, axis, high)
+                side = _Side(nav, a, axis, high, covered)
                 for lo, hi in _subtract((side.lo, side.hi), covered.get((a, axis * 2 + high), [])):
                     for part in side.open_parts(lo, hi):
                         tris += side.faces(part, height)
@@ -401,8 +401,9 @@ class _OpenPart:
 class _Side:
     """One side of a nav area: its line, its outward direction and the areas beyond it."""
 
-    def __init__(self, nav: NavMesh, area: int, axis: int, high: bool) -> None:
+    def __init__(self, nav: NavMesh, area: int, axis: int, high: bool, covered) -> None:
         self.nav, self.area, self.axis = nav, area, axis
+        self.covered = covered
         self.sign = 1.0 if high else -1.0
         if axis == 0:  # the side is the line x = coord, running along y
             self.lo, self.hi = nav.y_min[area], nav.y_max[area]
@@ -488,13 +489,26 @@ class _Side:
             (*self.point(part.lo, out), zb[0]),
         )
 
+    def _open_corner(self, end: float, high_end: bool) -> bool:
+        """True at a corner of the area whose other side is open there too (a convex corner
+        walled on both sides): only there does a wall grow past its end to close the corner.
+        Growing elsewhere would stick into the passage next to the corner."""
+        corner = self.hi if high_end else self.lo
+        if abs(end - corner) > TOUCH_TOL_U:
+            return False
+        other_key = (self.area, (1 - self.axis) * 2 + int(high_end))
+        return not any(
+            lo - TOUCH_TOL_U <= self.coord <= hi + TOUCH_TOL_U
+            for lo, hi in self.covered.get(other_key, [])
+        )
+
     def _wall(self, part: _OpenPart, push: float, z0: float, z1: float) -> list:
         """A full wall on the pushed line, grown at the area's corners, cut where it would stand
         inside another area of about the same height, and capped below any floor overhead."""
         nav = self.nav
         out = self.coord + self.sign * push
-        a0 = part.lo - (push if abs(part.lo - self.lo) <= TOUCH_TOL_U else 0.0)
-        a1 = part.hi + (push if abs(part.hi - self.hi) <= TOUCH_TOL_U else 0.0)
+        a0 = part.lo - (push if self._open_corner(part.lo, high_end=False) else 0.0)
+        a1 = part.hi + (push if self._open_corner(part.hi, high_end=True) else 0.0)
         across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
         along = (self.t_hi > a0) & (self.t_lo < a1)
         inside = across & along & (np.abs(self.centre_z - (z0 + z1) / 2) <= JUMP_U)

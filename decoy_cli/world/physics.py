@@ -142,10 +142,9 @@ class PhysicsWorld:
         index = {body: k for k, body in enumerate(self._capsules)}
         for lo in range(0, len(centres), pool):
             chunk = centres[lo : lo + pool]
-            for k, body in enumerate(self._capsules):
-                where = chunk[k].tolist() if k < len(chunk) else [0.0, 0.0, 1e6 + 10 * k]
+            for k, body in enumerate(self._capsules[: len(chunk)]):
                 p.resetBasePositionAndOrientation(
-                    body, where, [0, 0, 0, 1], physicsClientId=self.client
+                    body, chunk[k].tolist(), [0, 0, 0, 1], physicsClientId=self.client
                 )
             p.performCollisionDetection(physicsClientId=self.client)
             for contact in p.getContactPoints(bodyA=self.body, physicsClientId=self.client):
@@ -153,7 +152,23 @@ class PhysicsWorld:
                     k = index.get(contact[2])
                     if k is not None and k < len(chunk):
                         blocked[lo + k] = True
+            self._park(len(chunk))
         return blocked
+
+    def _park(self, count: int) -> None:
+        """Move the first `count` capsules far apart and away, and run a collision pass there.
+
+        Bullet keeps a contact manifold per overlapping pair and, after a body is teleported,
+        refreshes its old points instead of finding the new deepest one: a capsule moved from
+        one wall into another can report a graze instead of a deep penetration. Parking every
+        capsule where it overlaps nothing ends all pairs and their manifolds between batches.
+        """
+        p = self._p
+        for k, body in enumerate(self._capsules[:count]):
+            p.resetBasePositionAndOrientation(
+                body, [0.0, 0.0, 1e6 + 10 * k], [0, 0, 0, 1], physicsClientId=self.client
+            )
+        p.performCollisionDetection(physicsClientId=self.client)
 
     def _ensure_capsules(self, radius: float, height: float, pool: int = 1024) -> None:
         p = self._p
