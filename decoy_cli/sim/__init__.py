@@ -1,0 +1,1 @@
+"""The headless simulator: round state, movement, line of sight and combat, bomb rules, env."""
