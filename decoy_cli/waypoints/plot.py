@@ -55,11 +55,12 @@ def plot_graph(
     lines = LineCollection(segments[flat], array=height[flat], cmap="viridis", lw=0.4)
     ax.add_collection(lines)
     fig.colorbar(lines, ax=ax, shrink=0.6, label="height (m)")
+    # a ledge usually has a drop one way and a jump the other: draw the jump thinner on top
     ax.add_collection(
-        LineCollection(segments[kind == EdgeKind.JUMP], colors="#ff7f0e", lw=1.4, label="jump")
+        LineCollection(segments[kind == EdgeKind.DROP], colors="#d62728", lw=2.4, label="drop")
     )
     ax.add_collection(
-        LineCollection(segments[kind == EdgeKind.DROP], colors="#d62728", lw=1.4, label="drop")
+        LineCollection(segments[kind == EdgeKind.JUMP], colors="#ffbf00", lw=1.0, label="jump")
     )
     if removed_segments is not None and len(removed_segments):
         ax.add_collection(
