@@ -50,6 +50,8 @@ WALL_HEIGHT_U = 184.0
 """Wall height above its floor (3.5 m), capped below any floor overhead."""
 SEAM_MATCH_U = 24.0
 """Touching edges whose heights differ by less than this are fitted to meet (else a ledge)."""
+LEDGE_REACH_U = 128.0
+"""A lower floor this far beyond an open side makes the side a ledge (a drop), not a wall."""
 STEP_U = 18.0
 """The CS:GO step height."""
 JUMP_U = 64.0
@@ -425,7 +427,8 @@ class _Side:
         """Split [lo, hi] by the nearest area facing each stretch within 3 push widths."""
         overlap = (np.minimum(self.t_hi, hi) - np.maximum(self.t_lo, lo)) > TOUCH_TOL_U
         dz = np.abs(self.centre_z - self.centre_z[self.area])
-        near = overlap & (self.gap >= -TOUCH_TOL_U) & (self.gap <= 3 * WALL_PUSH_U)
+        below = (self.centre_z < self.centre_z[self.area] - JUMP_U) & (self.gap <= LEDGE_REACH_U)
+        near = overlap & (self.gap >= -TOUCH_TOL_U) & ((self.gap <= 3 * WALL_PUSH_U) | below)
         near &= dz <= MAX_SHARED_STEP_U
         near[self.area] = False
         parts, rest = [], [(lo, hi)]
