@@ -29,3 +29,9 @@ MAX_DROP_M = 210 * HAMMER_TO_M
 
 TICK_RATE = 60
 """Physics ticks per second of the simulator."""
+
+GRAVITY_M_S2 = 800 * HAMMER_TO_M
+"""Gravity (sv_gravity 800 u/s²)."""
+
+JUMP_SPEED_M_S = 301.99 * HAMMER_TO_M
+"""Upward speed a jump starts with (sqrt(2 * 800 * 57) u/s): a plain jump rises about 57 u."""
