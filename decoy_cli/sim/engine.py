@@ -1,0 +1,273 @@
+"""The simulator: one round of agents on the waypoint graph, tick by tick at 60 Hz.
+
+Each tick:
+
+1. agents that reached their waypoint (or finished a STOP) ask their policy for the next action
+   (asynchronous, on demand: the paper's 8 compass moves along graph edges, or STOP for a given
+   time, never collapsed);
+2. the mover advances every agent one tick along its edge;
+3. the bomb rules advance (plant, detonation, defuse, pickup);
+4. every `combat_every_ticks` ticks (by integer tick count) the combat step runs: line of sight
+   between all alive enemy pairs in one batch, the damage model on the visible pairs, damage
+   applied simultaneously; deaths drop the bomb and stop the agent;
+5. the round outcome is checked; state is recorded at the requested ticks.
+
+Every loop is bounded by the round's time limit (plus the bomb timer after a plant), so a run
+always ends. The policy, the mover, the damage model and the recording are pluggable; the engine
+itself knows nothing of ESTA data (the replay is one policy among others).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from decoy_cli.csgo import TICK_RATE
+from decoy_cli.sim.movement import Mover
+from decoy_cli.sim.state import Agents, Bomb, RoundOutcome, SimEvent
+from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.weapons import max_speed_m_s
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What an agent does next: a compass move (0..7) at a speed, or STOP for `hold_ticks`.
+
+    `speed` is m/s (capped by the weapon's maximum by the engine; None = full speed). `plant`
+    and `defuse` say whether the agent wants to plant or defuse while it stands still.
+    """
+
+    action: int
+    speed: float | None = None
+    hold_ticks: int = 30
+    plant: bool = False
+    defuse: bool = False
+
+
+class Policy(Protocol):
+    """Chooses the next action of an agent that is waiting for one."""
+
+    def decide(self, sim: Simulator, agent: int) -> Decision: ...
+
+
+@dataclass
+class SimConfig:
+    """Switches and rates of a simulated round."""
+
+    combat: bool = True
+    bomb: bool = True
+    combat_every_ticks: int = 30
+    tick_rate: int = TICK_RATE
+    max_ticks: int | None = None  # hard bound on the run (default: round time + bomb timer)
+
+
+@dataclass
+class Recording:
+    """Agent state sampled at requested ticks: arrays (S, N, ...) plus all events."""
+
+    ticks: np.ndarray
+    position: np.ndarray
+    yaw: np.ndarray
+    hp: np.ndarray
+    alive: np.ndarray
+    events: list[SimEvent] = field(default_factory=list)
+
+
+class Simulator:
+    """One round; build it, then `run()` (or `step()` yourself, as the environment does)."""
+
+    def __init__(
+        self,
+        graph: WaypointGraph,
+        agents: Agents,
+        mover: Mover,
+        policy: Policy,
+        rules,
+        bomb_carrier: int = -1,
+        combat=None,
+        config: SimConfig | None = None,
+        start_tick: int = 0,
+        record_ticks: Sequence[int] = (),
+        seed: int | None = None,
+    ) -> None:
+        self.graph = graph
+        self.agents = agents
+        self.mover = mover
+        self.policy = policy
+        self.rules = rules
+        self.combat = combat
+        self.config = config or SimConfig()
+        self.rng = np.random.default_rng(seed)
+        self.tick = start_tick
+        self.events: list[SimEvent] = []
+        self.outcome: RoundOutcome | None = None
+        n = agents.count
+        self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
+        self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
+        self.goal_node = np.full(n, -1, dtype=np.int64)
+        self.wants_plant = np.zeros(n, dtype=bool)
+        self.wants_defuse = np.zeros(n, dtype=bool)
+        self.decisions = np.zeros(n, dtype=np.int64)
+        self.mover.reset(
+            agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
+        )
+        self.bomb: Bomb = rules.start(agents, bomb_carrier)
+        self._record_at = np.asarray(sorted(set(int(t) for t in record_ticks)), dtype=np.int64)
+        s = len(self._record_at)
+        self.recording = Recording(
+            ticks=self._record_at,
+            position=np.full((s, n, 3), np.nan),
+            yaw=np.full((s, n), np.nan),
+            hp=np.zeros((s, n), dtype=np.int16),
+            alive=np.zeros((s, n), dtype=bool),
+            events=self.events,
+        )
+        self._next_record = 0
+        self._max_tick = start_tick + (
+            self.config.max_ticks
+            if self.config.max_ticks is not None
+            else rules.config.round_ticks + rules.config.bomb_ticks + 1
+        )
+        self._record()
+
+    # ---- the tick -----------------------------------------------------------------------------
+
+    @property
+    def done(self) -> bool:
+        return self.outcome is not None or self.tick >= self._max_tick
+
+    def step(self) -> list[SimEvent]:
+        """Advance one tick; returns the events of that tick."""
+        if self.done:
+            return []
+        start = len(self.events)
+        self.tick += 1
+        self._decide()
+        moved = self.mover.step()
+        agents = self.agents
+        agents.position[:] = self.mover.positions
+        moving = np.asarray(moved.moving, dtype=bool)
+        heading = np.asarray(self.mover.heading, dtype=np.float64)
+        agents.yaw[moving] = heading[moving]
+        arrived = np.asarray(moved.arrived, dtype=bool) & agents.alive
+        for agent in np.nonzero(arrived)[0]:
+            agents.node[agent] = self.goal_node[agent]
+            self.goal_node[agent] = -1
+            self.waiting[agent] = True
+        for agent in np.nonzero(np.asarray(moved.stuck, dtype=bool))[0]:
+            self.events.append(SimEvent(self.tick, "stuck", int(agent)))
+        for agent in np.nonzero(np.asarray(moved.teleported, dtype=bool))[0]:
+            self.events.append(SimEvent(self.tick, "teleport", int(agent)))
+        if self.config.bomb:
+            self.events += self.rules.step(
+                self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
+            )
+        if (
+            self.config.combat
+            and self.combat is not None
+            and self.tick % self.config.combat_every_ticks == 0
+        ):
+            alive_before = agents.alive.copy()
+            self.events += self.combat.run(agents, self.tick, self.rng)
+            for agent in np.nonzero(alive_before & ~agents.alive)[0]:
+                self._kill(int(agent))
+        self.outcome = self.rules.outcome(self.tick, agents, self.bomb)
+        if self.outcome is not None:
+            self.events.append(
+                SimEvent(
+                    self.tick,
+                    "round_end",
+                    data={"winner": self.outcome.winner, "reason": self.outcome.reason},
+                )
+            )
+        self._record()
+        return self.events[start:]
+
+    def run(self, until: Callable[[Simulator], bool] | None = None) -> Recording:
+        """Step until the round ends, the tick bound, or `until(sim)` says stop."""
+        while not self.done and not (until is not None and until(self)):
+            self.step()
+        return self.recording
+
+    def relocate(self, agent: int, node: int) -> None:
+        """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event."""
+        self.mover.place(agent, self.graph.positions[node])
+        self.agents.position[agent] = self.graph.positions[node]
+        self.agents.node[agent] = node
+        self.goal_node[agent] = -1
+        self.events.append(SimEvent(self.tick, "relocate", agent, data={"node": int(node)}))
+
+    def kill(self, agent: int, reason: str) -> None:
+        """Kill an agent from outside the combat step (a scripted death in a replay)."""
+        if self.agents.alive[agent]:
+            self.agents.alive[agent] = False
+            self.agents.hp[agent] = 0
+            self.events.append(SimEvent(self.tick, "death", agent, data={"reason": reason}))
+            self._kill(agent)
+
+    # ---- internals ----------------------------------------------------------------------------
+
+    def _kill(self, agent: int) -> None:
+        self.mover.remove(agent)
+        self.waiting[agent] = False
+        self.wants_plant[agent] = False
+        self.wants_defuse[agent] = False
+        if self.config.bomb:
+            self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
+
+    def _decide(self) -> None:
+        agents = self.agents
+        due = agents.alive & (
+            self.waiting | ((self.hold_until > 0) & (self.tick >= self.hold_until))
+        )
+        for agent in np.nonzero(due)[0]:
+            agent = int(agent)
+            self.hold_until[agent] = 0
+            self.waiting[agent] = False
+            decision = self.policy.decide(self, agent)
+            self.decisions[agent] += 1
+            self.wants_plant[agent] = decision.plant
+            self.wants_defuse[agent] = decision.defuse
+            if decision.action == STOP_ACTION:
+                self.mover.clear_goal(agent)
+                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
+                continue
+            edge = int(self.graph.out_edges[agents.node[agent], decision.action])
+            if edge < 0:  # an impossible move: stand still for one decision period
+                self.mover.clear_goal(agent)
+                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
+                self.events.append(
+                    SimEvent(self.tick, "invalid_action", agent, data={"action": decision.action})
+                )
+                continue
+            target = int(self.graph.edge_target[edge])
+            top = max_speed_m_s(str(agents.weapon[agent]))
+            speed = top if decision.speed is None else min(float(decision.speed), top)
+            self.goal_node[agent] = target
+            self.mover.set_goal(
+                agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed
+            )
+
+    def _record(self) -> None:
+        rec = self.recording
+        while self._next_record < len(self._record_at) and (
+            self._record_at[self._next_record] <= self.tick
+        ):
+            k = self._next_record
+            if self._record_at[k] == self.tick:
+                rec.position[k] = self.agents.position
+                rec.yaw[k] = self.agents.yaw
+                rec.hp[k] = self.agents.hp
+                rec.alive[k] = self.agents.alive
+            self._next_record += 1
+        if self.done:
+            # the round ended: later samples keep the final state
+            for k in range(self._next_record, len(self._record_at)):
+                rec.position[k] = self.agents.position
+                rec.yaw[k] = self.agents.yaw
+                rec.hp[k] = self.agents.hp
+                rec.alive[k] = self.agents.alive
+            self._next_record = len(self._record_at)
