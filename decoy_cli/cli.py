@@ -8,7 +8,7 @@ import typer
 from typer.core import TyperGroup
 
 from decoy_cli import __version__
-from decoy_cli.commands import build_waypoints, info, snap
+from decoy_cli.commands import build_waypoints, info, replay, snap
 from decoy_cli.errors import DecoyError
 
 _debug = False
@@ -56,4 +56,5 @@ def main(
 
 app.command("build-waypoints")(build_waypoints.build_waypoints)
 app.command("info")(info.info)
+app.command("replay")(replay.replay)
 app.command("snap")(snap.snap)

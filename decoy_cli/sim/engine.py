@@ -36,12 +36,15 @@ from decoy_cli.weapons import max_speed_m_s
 class Decision:
     """What an agent does next: a compass move (0..7) at a speed, or STOP for `hold_ticks`.
 
-    `speed` is m/s (capped by the weapon's maximum by the engine; None = full speed). `plant`
-    and `defuse` say whether the agent wants to plant or defuse while it stands still.
+    `speed` is m/s, capped by `max_speed` (None: the weapon's CS:GO maximum); None = full speed.
+    A replay may raise the cap above the weapon's where the data shows the player moving faster
+    (strafe-jumps, falls). `plant` and `defuse` say whether the agent wants to plant or defuse
+    while it stands still.
     """
 
     action: int
     speed: float | None = None
+    max_speed: float | None = None
     hold_ticks: int = 30
     plant: bool = False
     defuse: bool = False
@@ -244,8 +247,13 @@ class Simulator:
                 )
                 continue
             target = int(self.graph.edge_target[edge])
-            top = max_speed_m_s(str(agents.weapon[agent]))
+            top = (
+                max_speed_m_s(str(agents.weapon[agent]))
+                if decision.max_speed is None
+                else float(decision.max_speed)
+            )
             speed = top if decision.speed is None else min(float(decision.speed), top)
+            self.mover.set_max_speed(agent, top)
             self.goal_node[agent] = target
             self.mover.set_goal(
                 agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed

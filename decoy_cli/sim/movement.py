@@ -780,6 +780,14 @@ class PhysicsMover(_MoverBase):
         super().remove(agent)
         self._park(int(agent))
 
+    def close(self) -> None:
+        """Take the capsules out of the physics world (one world serves many rounds)."""
+        p, client = self.physics._p, self.physics.client
+        if client is not None:
+            for body in self._bodies:
+                p.removeBody(body, physicsClientId=client)
+        self._bodies = []
+
     def step(self) -> MoveStep:
         """Advance every agent by one tick (see the class docstring)."""
         flags, out = self._new_flags()

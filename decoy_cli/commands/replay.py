@@ -1,0 +1,143 @@
+"""`decoy replay FILE:ROUND`: replay one real round in the simulator and show how faithful it is."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.esta import load_round
+from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+from decoy_cli.replay.output import animate, player_metrics, plot_paths, write_replay
+from decoy_cli.replay.replayer import ReplayOptions, replay_round
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh, nav_world
+from decoy_cli.world.physics import PhysicsWorld
+
+DEFAULT_OUT = Path("decoy-out") / "replay"
+
+
+def replay(
+    address: str = typer.Argument(..., metavar="FILE:ROUND", help="The round, e.g. m.json.xz:3."),
+    combat: bool = typer.Option(
+        True, "--combat/--no-combat", help="Shooting (needs a damage model; see --help of models)."
+    ),
+    bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
+    mover: str = typer.Option(
+        "physics", "--mover", help="physics (pybullet capsules, collisions) or kinematic (numpy)."
+    ),
+    graph_file: Path | None = typer.Option(
+        None, "--graph", help="Waypoint graph (.npz from build-waypoints; default: built-in)."
+    ),
+    out: Path | None = typer.Option(
+        None, "--out", help="Output folder (default decoy-out/replay/<match>_r<round>)."
+    ),
+    gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
+) -> None:
+    """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
+    console = Console()
+    if mover not in ("physics", "kinematic"):
+        raise DecoyError(f"--mover must be physics or kinematic, not {mover!r}")
+    round_ = load_round(address)
+    if round_.map_name and round_.map_name != BUILTIN_MAP:
+        raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
+    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
+    damage_model = None  # the learned damage models arrive with their own issue
+    options = ReplayOptions(
+        combat=combat and damage_model is not None,
+        bomb=bomb,
+        mover=mover,
+        damage_model=damage_model,
+        seed=seed,
+    )
+    if combat and damage_model is None:
+        console.print(
+            "[yellow]no damage model is available yet: replaying without shooting "
+            "(deaths in the data are scripted)[/yellow]"
+        )
+    started = time.perf_counter()
+    with PhysicsWorld(nav_world()) as physics:
+        result = replay_round(round_, graph, physics, options)
+    seconds = time.perf_counter() - started
+    players = player_metrics(round_, result)
+
+    real = (round_.winning_side, round_.end_reason)
+    simulated = (result.outcome.winner, result.outcome.reason) if result.outcome else (None, None)
+    summary = {
+        "round": address,
+        "match_id": round_.match_id,
+        "round_num": round_.round_num,
+        "options": {"combat": options.combat, "bomb": bomb, "mover": mover, "seed": seed},
+        "outcome_original": {"winner": real[0], "reason": real[1]},
+        "outcome_replay": {"winner": simulated[0], "reason": simulated[1]},
+        "frames": int(round_.num_frames),
+        "wall_seconds": round(seconds, 3),
+        "stuck_episodes": int(players["stuck"].sum()),
+        "recoveries": int(players["recoveries"].sum()),
+        "relocations": int(players["relocations"].sum()),
+    }
+    folder = out or DEFAULT_OUT / f"{round_.match_id[:8]}_r{round_.round_num}"
+    write_replay(folder, round_, result, players, summary)
+    nav = load_navmesh()
+    plot_paths(
+        folder / "paths.png",
+        round_,
+        result,
+        nav,
+        title=f"{round_.match_id[:8]} round {round_.round_num}: original (dashed) vs replay",
+    )
+    if gif:
+        animate(folder / "round.gif", round_, result, nav)
+
+    console.print(
+        f"round {round_.round_num} of {round_.match_id}: {round_.num_frames} frames replayed in "
+        f"{seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
+        f"bomb {'on' if bomb else 'off'})"
+    )
+    outcome = Table(title="outcome")
+    outcome.add_column("")
+    outcome.add_column("winner")
+    outcome.add_column("reason")
+    outcome.add_row("original", str(real[0] or "not recorded"), str(real[1] or "not recorded"))
+    outcome.add_row(
+        "replay", str(simulated[0] or "undecided"), str(simulated[1] or "end of the data")
+    )
+    console.print(outcome)
+    for title, names in (
+        ("clock protocol", METRIC_NAMES_CLOCK),
+        ("paper protocol", METRIC_NAMES_PAPER),
+    ):
+        table = Table(title=f"{title} (metres)")
+        table.add_column("player")
+        table.add_column("side")
+        for name in names:
+            table.add_column(name, justify="right")
+        for _, row in players.iterrows():
+            table.add_row(
+                row["player"],
+                row["side"],
+                *("–" if not np.isfinite(row[name]) else f"{row[name]:.3f}" for name in names),
+            )
+        console.print(table)
+    timing = Table(title="timing and fate")
+    for column in ("player", "late share", "late p95 (s)", "stuck", "recoveries", "died", "death"):
+        timing.add_column(column, justify="right" if column != "player" else "left")
+    for _, row in players.iterrows():
+        timing.add_row(
+            row["player"],
+            f"{row['late_share']:.1%}" if np.isfinite(row["late_share"]) else "–",
+            f"{row['late_p95_s']:.2f}" if np.isfinite(row["late_p95_s"]) else "–",
+            str(row["stuck"]),
+            str(row["recoveries"]),
+            f"{'yes' if row['died_original'] else 'no'} / {'yes' if row['died_replay'] else 'no'}",
+            row["death"] or "–",
+        )
+    console.print(timing)
+    console.print(f"replay written to {folder}")
