@@ -1,0 +1,579 @@
+"""A PettingZoo `ParallelEnv` over the simulator: T against CT on the waypoint graph, one round
+per episode.
+
+Decisions are asynchronous, as in the engine: an agent decides when it reaches its waypoint or
+its STOP ends, never in between. `step(actions)` applies the actions of the agents that need a
+decision, then advances the simulator tick by tick until at least one alive agent needs the
+next one, or the round ends; so one environment step is one tick or more of game time. The
+observation tells each agent whether its action will be used (`needs_decision`), and its action
+mask then allows only STOP when it will not.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from numbers import Integral
+from typing import Any, ClassVar
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from decoy_cli.csgo import TICK_RATE
+from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
+from decoy_cli.sim.engine import Decision, SimConfig, Simulator
+from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
+from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones, seconds_to_ticks
+from decoy_cli.sim.state import Agents, Bomb, BombStatus
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.weapons import is_known
+from decoy_cli.world.navmesh import nav_world
+from decoy_cli.world.physics import PhysicsWorld
+from decoy_cli.world.world import World
+
+NUM_ACTIONS = 9
+"""Actions 0..7 move along the graph edge in compass direction N, NE, E, SE, S, SW, W, NW;
+8 is STOP."""
+
+DEFAULT_WEAPONS = {"T": "Glock-18", "CT": "USP-S"}
+"""The pistol each side starts a pistol round with."""
+
+POSITION_MARGIN_M = 2.0
+"""Added around the waypoints' bounding box before normalising positions: room for a jump's
+apex above the highest waypoint and for a physics agent's sidestep beyond the outermost one."""
+
+SLOT_FEATURES = 5
+"""Per teammate or enemy slot: alive, offset x, y, z, hp."""
+
+BOMB_STATES = ("none", "carried", "dropped", "planted", "defused", "exploded")
+"""The bomb status one-hot; "none" when the round has no bomb."""
+
+BOMB_SITES = ("A", "B")
+
+
+def observation_layout(teammate_slots: int, enemy_slots: int) -> dict[str, slice]:
+    """Where each entry lies in the observation vector (see `DecoyParallelEnv`)."""
+    sizes = {
+        "position": 3,
+        "yaw": 2,
+        "hp": 1,
+        "armor": 1,
+        "helmet": 1,
+        "defuse_kit": 1,
+        "has_bomb": 1,
+        "is_ct": 1,
+        "needs_decision": 1,
+        "teammates": teammate_slots * SLOT_FEATURES,
+        "enemies": enemy_slots * SLOT_FEATURES,
+        "bomb_state": len(BOMB_STATES),
+        "bomb_offset": 3,
+        "bomb_site": len(BOMB_SITES),
+        "plant_progress": 1,
+        "defuse_progress": 1,
+        "round_time_left": 1,
+        "bomb_time_left": 1,
+    }
+    layout, start = {}, 0
+    for name, size in sizes.items():
+        layout[name] = slice(start, start + size)
+        start += size
+    return layout
+
+
+class _ChosenActions:
+    """The engine's policy inside the environment: it hands over the decisions that `step`
+    collected for exactly the agents the engine asks at the step's first tick."""
+
+    def __init__(self) -> None:
+        self.pending: dict[int, Decision] = {}
+
+    def decide(self, sim: Simulator, agent: int) -> Decision:
+        try:
+            return self.pending.pop(agent)
+        except KeyError:
+            raise RuntimeError(
+                f"the simulator asked agent {agent} for a decision at tick {sim.tick}, "
+                "which the environment did not expect"
+            ) from None
+
+
+class DecoyParallelEnv(ParallelEnv):
+    """One CS:GO round on the waypoint graph as a PettingZoo parallel environment.
+
+    Agents: `t_0 .. t_{n_t-1}` then `ct_0 .. ct_{n_ct-1}`, spawned at distinct random waypoints
+    of the graph regions `t_spawn` and `ct_spawn`, 100 HP, no armor, the side's pistol (or
+    `weapons`, keyed by side "T"/"CT" or by agent name, agent names first). With `bomb`, a
+    random T carries the bomb.
+
+    Actions: Discrete(9). 0..7 move along the out-edge of the agent's waypoint in compass
+    direction N, NE, E, SE, S, SW, W, NW (N = +y, E = +x) at the weapon's full speed; the agent
+    decides again when it reaches the next waypoint. 8 is STOP: stand still for `stop_seconds`
+    (whole ticks, rounded up; 0.5 s = 30 ticks), then decide again. STOP is also the objective
+    action: a T carrying the bomb inside a bomb-site zone plants while it stands (3.2 s, so
+    several STOPs in a row), a CT in range of the planted bomb defuses. A move with no edge in
+    its direction (masked out) stands still like a STOP, without planting or defusing, and the
+    engine records an "invalid_action" event.
+
+    Asynchronous decisions: only agents with `needs_decision` (observation entry and info) have
+    their action applied; the action of any other agent is ignored (it is walking an edge or
+    holding a STOP) and its mask allows only STOP. `step` then runs the simulator until an
+    alive agent needs a decision or the round ends. An agent that needs a decision must get an
+    action (a ValueError otherwise); the others may be left out.
+
+    Observation: {"observation": float32 vector, "action_mask": int8 (9,)}, one length for every
+    agent. With S = max(n_t, n_ct) slots, the vector holds, in this order
+    (`observation_layout` gives the slices; `env.layout` those of this environment):
+
+    * position (3): own feet x, y, z, normalised to [-1, 1] by the waypoints' bounding box
+      grown by `POSITION_MARGIN_M` on every side (clipped);
+    * yaw (2): sin and cos of the own view yaw (0 = east, counter-clockwise);
+    * hp, armor (1 each): /100;
+    * helmet, defuse_kit, has_bomb, is_ct, needs_decision (1 each): 0 or 1;
+    * teammates (S-1 slots x 5): the other agents of the own side in index order (t_1, t_2...
+      for t_0): alive, offset x, y, z from the own feet divided by the grown box's size
+      (in [-1, 1], clipped), hp/100; all zeros for a dead teammate or an unused slot;
+    * enemies (S slots x 5): the agents of the other side in index order, same features;
+    * bomb_state (6): one-hot none, carried, dropped, planted, defused, exploded;
+    * bomb_offset (3): the bomb (its carrier while carried) from the own feet, scaled as the
+      slot offsets; zeros when there is no bomb;
+    * bomb_site (2): one-hot A, B once planted;
+    * plant_progress, defuse_progress (1 each): the fraction done of a plant or defuse under
+      way, else 0;
+    * round_time_left (1): of the 115 s round, frozen at the plant (a plant stops the clock);
+    * bomb_time_left (1): of the 40 s bomb timer while the bomb is planted, else 0.
+
+    Positions of all agents are visible to all (no fog of war). Length 12 + 10 S - 5 + 15:
+    72 for 5 against 5.
+
+    Action mask: 1 for each move with an out-edge at the agent's waypoint and for STOP, when the
+    agent needs a decision; otherwise only STOP.
+
+    Rewards: 0 during the round; at its end +1 to every agent of the winning side and -1 to the
+    losing side (agents still in the episode: one that died earlier left with 0). Terminations:
+    an agent that dies terminates (and leaves `self.agents`); at the round end every agent
+    does. Truncations are always False: the rules end every round within the engine's bound
+    (115 s, or the plant plus 40 s). Infos: "needs_decision" and "tick" (simulator tick of the
+    state) for every agent, plus "winner" and "reason" (ESTA names) at the round end.
+
+    Seeding: `reset(seed=...)` seeds a numpy Generator that draws the spawns, the bomb carrier
+    and the simulator's seed (combat randomness); `reset()` without a seed continues it. The
+    same seed and actions give the same round with either mover.
+
+    pybullet: the physics mover and combat (`damage_model`) need a pybullet client with the
+    world (`world`, default the built-in nav world); it is created at each reset and the
+    previous round's client is disconnected, and `close()` disconnects it. No damage model
+    ships with the simulator yet: without one there is no combat, and agents never die.
+
+    Rendering: `render_mode="rgb_array"` gives a top-down matplotlib picture (waypoints grey,
+    T orange, CT blue, dead agents light grey, the bomb a red star).
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"name": "decoy_dust2_v0", "render_modes": ["rgb_array"]}
+
+    def __init__(
+        self,
+        n_t: int = 5,
+        n_ct: int = 5,
+        graph: WaypointGraph | None = None,
+        world: World | None = None,
+        mover: str = "kinematic",
+        damage_model: DamageModel | None = None,
+        bomb: bool = True,
+        stop_seconds: float = 0.5,
+        weapons: Mapping[str, str] | None = None,
+        render_mode: str | None = None,
+    ) -> None:
+        for name, count in (("n_t", n_t), ("n_ct", n_ct)):
+            if isinstance(count, bool) or not isinstance(count, Integral) or count < 0:
+                raise ValueError(f"{name} must be an int >= 0, got {count!r}")
+        if n_t + n_ct == 0:
+            raise ValueError("a round needs at least one agent")
+        if mover not in ("kinematic", "physics"):
+            raise ValueError(f"unknown mover {mover!r} (kinematic or physics)")
+        if not stop_seconds > 0:
+            raise ValueError(f"stop_seconds must be > 0, got {stop_seconds!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"unknown render_mode {render_mode!r} (rgb_array or None)")
+        self.graph = builtin_graph() if graph is None else graph
+        self.world = world
+        self.mover_kind = mover
+        self.damage_model = damage_model
+        self.bomb = bool(bomb)
+        self.render_mode = render_mode
+        self.n_t, self.n_ct = int(n_t), int(n_ct)
+        self.stop_ticks = seconds_to_ticks(stop_seconds, TICK_RATE)
+
+        self._t_spawn = self.graph.region_of("t_spawn")
+        self._ct_spawn = self.graph.region_of("ct_spawn")
+        for side, count, nodes in (("T", n_t, self._t_spawn), ("CT", n_ct, self._ct_spawn)):
+            if count > len(nodes):
+                raise ValueError(
+                    f"{count} {side} agents do not fit the {len(nodes)} spawn waypoints"
+                )
+        self.possible_agents = [f"t_{k}" for k in range(n_t)] + [f"ct_{k}" for k in range(n_ct)]
+        self.agents: list[str] = []
+        self._index = {name: k for k, name in enumerate(self.possible_agents)}
+        self._sides = ["T"] * n_t + ["CT"] * n_ct
+        self._weapons = self._weapon_list(weapons or {})
+        self._rules = BombRules(SiteZones.from_graph(self.graph), RulesConfig(bomb_enabled=bomb))
+        self._map_name = str(self.graph.meta.get("map", ""))
+
+        slots = max(n_t, n_ct)
+        self.layout = observation_layout(slots - 1, slots)
+        self._obs_size = self.layout["bomb_time_left"].stop
+        low = np.zeros(self._obs_size, dtype=np.float32)
+        for name in ("position", "yaw", "bomb_offset"):
+            low[self.layout[name]] = -1.0
+        for name in ("teammates", "enemies"):
+            block = low[self.layout[name]].reshape(-1, SLOT_FEATURES)
+            block[:, 1:4] = -1.0
+        self._observation_spaces = {
+            agent: spaces.Dict(
+                {
+                    "observation": spaces.Box(low, np.ones_like(low), dtype=np.float32),
+                    "action_mask": spaces.Box(0, 1, (NUM_ACTIONS,), np.int8),
+                }
+            )
+            for agent in self.possible_agents
+        }
+        self._action_spaces = {
+            agent: spaces.Discrete(NUM_ACTIONS) for agent in self.possible_agents
+        }
+        self._mates, self._enemies = self._slot_tables(slots)
+        lo, hi = self.graph.positions.min(axis=0), self.graph.positions.max(axis=0)
+        self._centre = (lo + hi) / 2
+        self._half = (hi - lo) / 2 + POSITION_MARGIN_M
+
+        self._rng: np.random.Generator | None = None
+        self._sim: Simulator | None = None
+        self._policy = _ChosenActions()
+        self.physics: PhysicsWorld | None = None
+        """The pybullet client of the current round (None with the kinematic mover and no
+        combat, or after `close()`)."""
+        self._los: LineOfSight | None = None
+        self._view: _TopDownView | None = None
+
+    # ---- PettingZoo API -----------------------------------------------------------------------
+
+    def observation_space(self, agent: str) -> spaces.Dict:
+        return self._observation_spaces[agent]
+
+    def action_space(self, agent: str) -> spaces.Discrete:
+        return self._action_spaces[agent]
+
+    @property
+    def sim(self) -> Simulator | None:
+        """The simulator of the current round (None before the first reset or after close)."""
+        return self._sim
+
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, dict[str, Any]]]:
+        """Start a new round; `options` is not used."""
+        if seed is not None or self._rng is None:
+            self._rng = np.random.default_rng(seed)
+        rng = self._rng
+        nodes = np.concatenate(
+            [
+                rng.choice(self._t_spawn, size=self.n_t, replace=False),
+                rng.choice(self._ct_spawn, size=self.n_ct, replace=False),
+            ]
+        ).astype(np.int64)
+        agents = Agents.create(
+            names=self.possible_agents,
+            sides=self._sides,
+            positions=self.graph.positions[nodes],
+            nodes=nodes,
+            weapons=self._weapons,
+        )
+        carrier = int(rng.integers(self.n_t)) if self.bomb and self.n_t else -1
+        mover, combat = self._new_round_bodies()
+        self._policy = _ChosenActions()
+        self._sim = Simulator(
+            self.graph,
+            agents,
+            mover,
+            self._policy,
+            self._rules,
+            bomb_carrier=carrier,
+            combat=combat,
+            config=SimConfig(combat=combat is not None, bomb=self.bomb),
+            seed=int(rng.integers(2**63)),
+        )
+        self.agents = list(self.possible_agents)
+        return self._observe(self.agents), self._infos(self.agents)
+
+    def step(
+        self, actions: Mapping[str, Any]
+    ) -> tuple[
+        dict[str, dict[str, np.ndarray]],
+        dict[str, float],
+        dict[str, bool],
+        dict[str, bool],
+        dict[str, dict[str, Any]],
+    ]:
+        """Apply the actions of the agents that need a decision, then run the simulator until
+        an alive agent needs one or the round ends."""
+        sim = self._require_sim()
+        unknown = sorted(set(actions) - set(self.agents))
+        if unknown:
+            raise ValueError(f"actions for agents not in the episode: {', '.join(unknown)}")
+        live = list(self.agents)
+        due = self._due()
+        pending = {}
+        for name in live:
+            agent = self._index[name]
+            if due[agent]:
+                if name not in actions:
+                    raise ValueError(f"agent {name} needs a decision but was given no action")
+                pending[agent] = self._decision(agent, actions[name])
+        self._policy.pending = pending
+        sim.step()
+        if self._policy.pending:
+            raise RuntimeError(
+                f"the simulator did not ask agents {sorted(self._policy.pending)} for the "
+                "decision the environment collected"
+            )
+        while not sim.done and not self._due().any():
+            sim.step()
+
+        outcome = sim.outcome
+        alive = sim.agents.alive
+        rewards = dict.fromkeys(live, 0.0)
+        if outcome is not None:
+            for name in live:
+                rewards[name] = 1.0 if self._sides[self._index[name]] == outcome.winner else -1.0
+        terminations = {
+            name: bool(outcome is not None or not alive[self._index[name]]) for name in live
+        }
+        truncations = dict.fromkeys(live, False)
+        observations = self._observe(live)
+        infos = self._infos(live)
+        self.agents = [name for name in live if not terminations[name]]
+        return observations, rewards, terminations, truncations, infos
+
+    def render(self) -> np.ndarray | None:
+        """A top-down RGB picture (H, W, 3) uint8 of the round with render_mode "rgb_array"."""
+        if self.render_mode is None:
+            gymnasium.logger.warn("render() without a render_mode: pass render_mode='rgb_array'")
+            return None
+        sim = self._require_sim()
+        if self._view is None:
+            self._view = _TopDownView(self.graph, self._sides)
+        return self._view.draw(sim.agents, sim.bomb if self.bomb else None)
+
+    def close(self) -> None:
+        """Disconnect the pybullet client and drop the round; safe to call more than once."""
+        self._release_physics()
+        self._sim = None
+        self.agents = []
+        self._view = None
+
+    # ---- internals ----------------------------------------------------------------------------
+
+    def _require_sim(self) -> Simulator:
+        if self._sim is None:
+            raise RuntimeError("call reset() before step() or render()")
+        return self._sim
+
+    def _weapon_list(self, weapons: Mapping[str, str]) -> list[str]:
+        """Every agent's weapon: by agent name, else by side, else the side's pistol."""
+        unknown_keys = sorted(set(weapons) - {"T", "CT", *self.possible_agents})
+        if unknown_keys:
+            raise ValueError(
+                f"weapons are keyed by side (T, CT) or agent name, got {', '.join(unknown_keys)}"
+            )
+        bad = sorted(str(w) for w in weapons.values() if not isinstance(w, str) or not is_known(w))
+        if bad:
+            raise ValueError(f"unknown weapon {bad[0]!r} (use awpy display names like 'AK-47')")
+        return [
+            weapons.get(name, weapons.get(side, DEFAULT_WEAPONS[side]))
+            for name, side in zip(self.possible_agents, self._sides, strict=True)
+        ]
+
+    def _slot_tables(self, slots: int) -> tuple[np.ndarray, np.ndarray]:
+        """(N, S-1) teammate and (N, S) enemy agent indices of every agent, -1 = unused slot."""
+        n = len(self.possible_agents)
+        sides = np.asarray(self._sides)
+        mates = np.full((n, slots - 1), -1, dtype=np.int64)
+        enemies = np.full((n, slots), -1, dtype=np.int64)
+        for agent in range(n):
+            same = np.flatnonzero((sides == sides[agent]) & (np.arange(n) != agent))
+            other = np.flatnonzero(sides != sides[agent])
+            mates[agent, : len(same)] = same
+            enemies[agent, : len(other)] = other
+        return mates, enemies
+
+    def _new_round_bodies(self) -> tuple[Mover, CombatStep | None]:
+        """The round's mover and combat step, in a fresh pybullet client when they need one
+        (the previous round's client is disconnected first)."""
+        self._release_physics()
+        if self.mover_kind == "kinematic" and self.damage_model is None:
+            return KinematicMover(), None
+        self.physics = PhysicsWorld(self.world if self.world is not None else nav_world())
+        mover: Mover = (
+            PhysicsMover(self.physics) if self.mover_kind == "physics" else KinematicMover()
+        )
+        combat = None
+        if self.damage_model is not None:
+            self._los = LineOfSight(self.physics, len(self.possible_agents))
+            combat = CombatStep(self._los, self.damage_model, self._map_name)
+        return mover, combat
+
+    def _release_physics(self) -> None:
+        if self._los is not None:
+            self._los.close()
+            self._los = None
+        if self.physics is not None:
+            self.physics.close()
+            self.physics = None
+
+    def _due(self) -> np.ndarray:
+        """(N,) which agents the engine will ask for a decision at the next tick (the engine's
+        rule: alive, and waiting at a waypoint or at the end of a STOP)."""
+        sim = self._require_sim()
+        if sim.done:
+            return np.zeros(sim.agents.count, dtype=bool)
+        hold_over = (sim.hold_until > 0) & (sim.tick + 1 >= sim.hold_until)
+        return sim.agents.alive & (sim.waiting | hold_over)
+
+    def _decision(self, agent: int, action: Any) -> Decision:
+        """The engine decision for an agent's action (see the class docstring)."""
+        if isinstance(action, bool) or not isinstance(action, Integral):
+            raise ValueError(
+                f"{self.possible_agents[agent]}: an action is an int 0..8, got {action!r}"
+            )
+        action = int(action)
+        if not 0 <= action < NUM_ACTIONS:
+            raise ValueError(f"{self.possible_agents[agent]}: action {action} is not in 0..8")
+        if action != STOP_ACTION:
+            return Decision(action, hold_ticks=self.stop_ticks)
+        is_t = self._sides[agent] == "T"
+        return Decision(STOP_ACTION, hold_ticks=self.stop_ticks, plant=is_t, defuse=not is_t)
+
+    def _observe(self, names: list[str]) -> dict[str, dict[str, np.ndarray]]:
+        sim = self._require_sim()
+        agents, bomb, cfg, layout = sim.agents, sim.bomb, self._rules.config, self.layout
+        n = agents.count
+        pos = agents.position
+        due = self._due()
+        obs = np.zeros((n, self._obs_size), dtype=np.float64)
+        obs[:, layout["position"]] = np.clip((pos - self._centre) / self._half, -1.0, 1.0)
+        yaw = np.radians(agents.yaw)
+        obs[:, layout["yaw"]] = np.stack([np.sin(yaw), np.cos(yaw)], axis=1)
+        obs[:, layout["hp"].start] = agents.hp / 100.0
+        obs[:, layout["armor"].start] = agents.armor / 100.0
+        obs[:, layout["helmet"].start] = agents.helmet
+        obs[:, layout["defuse_kit"].start] = agents.has_defuser
+        has_bomb = self.bomb and bomb.status == BombStatus.CARRIED and bomb.carrier >= 0
+        if has_bomb:
+            obs[bomb.carrier, layout["has_bomb"].start] = 1.0
+        obs[:, layout["is_ct"].start] = agents.side == "CT"
+        obs[:, layout["needs_decision"].start] = due
+        obs[:, layout["teammates"]] = self._slots(self._mates, pos, agents.alive, agents.hp)
+        obs[:, layout["enemies"]] = self._slots(self._enemies, pos, agents.alive, agents.hp)
+        obs[:, layout["bomb_state"]] = np.eye(len(BOMB_STATES))[self._bomb_state(bomb)]
+        if self._bomb_state(bomb) != 0:
+            offset = (bomb.position - pos) / (2 * self._half)
+            obs[:, layout["bomb_offset"]] = np.clip(offset, -1.0, 1.0)
+        if bomb.site in BOMB_SITES:
+            obs[:, layout["bomb_site"].start + BOMB_SITES.index(bomb.site)] = 1.0
+        if bomb.planter >= 0:
+            obs[:, layout["plant_progress"].start] = bomb.plant_ticks / cfg.plant_ticks
+        if bomb.defuser >= 0:
+            kit = agents.has_defuser[bomb.defuser]
+            needed = cfg.defuse_kit_ticks if kit else cfg.defuse_ticks
+            obs[:, layout["defuse_progress"].start] = bomb.defuse_ticks / needed
+        clock = bomb.planted_tick if bomb.planted_tick >= 0 else sim.tick
+        obs[:, layout["round_time_left"].start] = np.clip(
+            (cfg.round_ticks - clock) / cfg.round_ticks, 0.0, 1.0
+        )
+        if bomb.status == BombStatus.PLANTED:
+            left = (bomb.planted_tick + cfg.bomb_ticks - sim.tick) / cfg.bomb_ticks
+            obs[:, layout["bomb_time_left"].start] = np.clip(left, 0.0, 1.0)
+
+        masks = np.zeros((n, NUM_ACTIONS), dtype=np.int8)
+        masks[:, STOP_ACTION] = 1
+        deciding = np.flatnonzero(due)
+        masks[deciding, :STOP_ACTION] = self.graph.out_edges[agents.node[deciding]] >= 0
+        vectors = obs.astype(np.float32)
+        return {
+            name: {"observation": vectors[k], "action_mask": masks[k]}
+            for name in names
+            for k in (self._index[name],)
+        }
+
+    def _slots(
+        self, table: np.ndarray, pos: np.ndarray, alive: np.ndarray, hp: np.ndarray
+    ) -> np.ndarray:
+        """(N, slots * 5) features of the agents a slot table names (zeros: dead or unused)."""
+        idx = np.maximum(table, 0)
+        valid = (table >= 0) & alive[idx]
+        offset = np.clip((pos[idx] - pos[:, None, :]) / (2 * self._half), -1.0, 1.0)
+        features = np.concatenate(
+            [np.ones((*idx.shape, 1)), offset, (hp[idx] / 100.0)[..., None]], axis=2
+        )
+        return (features * valid[..., None]).reshape(len(table), -1)
+
+    def _bomb_state(self, bomb: Bomb) -> int:
+        """Index into BOMB_STATES."""
+        if not self.bomb or (bomb.status == BombStatus.CARRIED and bomb.carrier < 0):
+            return 0
+        return 1 + int(bomb.status)
+
+    def _infos(self, names: list[str]) -> dict[str, dict[str, Any]]:
+        sim = self._require_sim()
+        due = self._due()
+        end = {}
+        if sim.outcome is not None:
+            end = {"winner": sim.outcome.winner, "reason": sim.outcome.reason}
+        return {
+            name: {"needs_decision": bool(due[self._index[name]]), "tick": sim.tick, **end}
+            for name in names
+        }
+
+
+class _TopDownView:
+    """A matplotlib figure of the map drawn once; each render moves the agents and the bomb."""
+
+    SIZE_PX = 512
+    COLOURS: ClassVar[dict[str, tuple[float, float, float, float]]] = {
+        "T": (0.93, 0.55, 0.13, 1.0),
+        "CT": (0.16, 0.38, 0.85, 1.0),
+        "dead": (0.8, 0.8, 0.8, 1.0),
+    }
+
+    def __init__(self, graph: WaypointGraph, sides: list[str]) -> None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        figure = Figure(figsize=(self.SIZE_PX / 100, self.SIZE_PX / 100), dpi=100)
+        self.canvas = FigureCanvasAgg(figure)
+        axes = figure.add_axes((0.0, 0.0, 1.0, 1.0))
+        axes.set_axis_off()
+        axes.set_aspect("equal")
+        xy = graph.positions[:, :2]
+        axes.scatter(xy[:, 0], xy[:, 1], s=0.5, c="0.7", linewidths=0)
+        lo, hi = xy.min(axis=0) - 1.0, xy.max(axis=0) + 1.0
+        axes.set_xlim(lo[0], hi[0])
+        axes.set_ylim(lo[1], hi[1])
+        self.sides = np.asarray(sides)
+        count = len(sides)
+        self.agents = axes.scatter(
+            np.zeros(count), np.zeros(count), s=60, edgecolors="black", linewidths=0.8, zorder=3
+        )
+        self.bomb = axes.scatter([], [], marker="*", s=180, c="red", edgecolors="black", zorder=4)
+
+    def draw(self, agents: Agents, bomb: Bomb | None) -> np.ndarray:
+        colours = np.array([self.COLOURS[str(side)] for side in self.sides])
+        colours[~agents.alive] = self.COLOURS["dead"]
+        self.agents.set_offsets(agents.position[:, :2])
+        self.agents.set_facecolors(colours)
+        show_bomb = bomb is not None and not (
+            bomb.status == BombStatus.CARRIED and bomb.carrier < 0
+        )
+        self.bomb.set_offsets(bomb.position[None, :2] if show_bomb else np.empty((0, 2)))
+        self.canvas.draw()
+        return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()
