@@ -34,7 +34,7 @@ PAPER_T = {
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path)
-    parser.add_argument("--mover", default="physics", choices=("physics", "kinematic"))
+    parser.add_argument("--mover", default="kinematic", choices=("physics", "kinematic"))
     parser.add_argument("--limit", type=int, default=0, help="only the first N files")
     parser.add_argument("--csv", type=Path, default=None)
     args = parser.parse_args()

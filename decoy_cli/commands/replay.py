@@ -30,7 +30,9 @@ def replay(
     ),
     bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
     mover: str = typer.Option(
-        "physics", "--mover", help="physics (pybullet capsules, collisions) or kinematic (numpy)."
+        "kinematic",
+        "--mover",
+        help="kinematic (default: measured the more faithful) or physics (capsules that collide).",
     ),
     graph_file: Path | None = typer.Option(
         None, "--graph", help="Waypoint graph (.npz from build-waypoints; default: built-in)."

@@ -29,6 +29,10 @@ from decoy_cli.replay.replayer import ReplayResult
 def player_metrics(round_: Any, result: ReplayResult) -> pd.DataFrame:
     """One row per player: identity, fate in both worlds, timing, and all ten metrics.
 
+    Columns: player, side, died_original, died_replay, death ("scripted", "simulated" or ""),
+    late_share, late_p95_s, stuck, recoveries, relocations, the ten `METRIC_NAMES`, and reason
+    (why the metrics are NaN, else None).
+
     Frames where the data lost the player (absent from the frame's player list; some rounds
     miss a player for many seconds) are left out of both trajectories: the original has no
     position there, and the replay's path across the gap is a shortest path, not something the
@@ -46,7 +50,8 @@ def player_metrics(round_: Any, result: ReplayResult) -> pd.DataFrame:
             rec.alive[:, p] & present[p],
         )
         died_original = bool(result.plan.plans[p].death_frame >= 0)
-        died_replay = bool(len(rec.alive) and not rec.alive[-1, p])
+        # a player never alive on the graph (absent) never lived in the replay: not a death
+        died_replay = bool(rec.alive[:, p].any() and not rec.alive[-1, p])
         rows.append(
             {
                 "player": player.name,

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.csgo import TICK_RATE
+from decoy_cli.errors import EstaError
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import CombatStep, LineOfSight
@@ -192,7 +193,12 @@ class ReplayOptions:
 
     combat: bool = True
     bomb: bool = True
-    mover: str = "physics"  # "physics" (pybullet capsules) or "kinematic" (numpy, no collisions)
+    # "kinematic" (compiled straight-line motion, agents pass through each other) or "physics"
+    # (pybullet capsules that block each other). Measured on the 385 real T rounds with combat
+    # and bomb off (benchmarks/replay_study.py): kinematic mean_dist 0.974 m (median 0.675),
+    # physics 1.014 m (median 0.694; teammates block each other, 0.5 stuck episodes a round),
+    # so the default is kinematic.
+    mover: str = "kinematic"
     damage_model: Any = None  # a decoy_cli.sim.combat.DamageModel; None: no shooting
     seed: int = 0
     map_name: str = "de_dust2"
@@ -205,7 +211,15 @@ def _tick_of(seconds: float) -> int:
 def replay_round(
     round_: Any, graph: WaypointGraph, physics: PhysicsWorld, options: ReplayOptions
 ) -> ReplayResult:
-    """Snap, plan and replay one round; see the module docstring."""
+    """Snap, plan and replay one round; see the module docstring.
+
+    A round without frames (an events-only round) raises EstaError: there is nothing to replay.
+    """
+    if len(round_.frame_seconds) == 0:
+        raise EstaError(
+            f"round {getattr(round_, 'round_num', '?')} has no frames (events only): "
+            "nothing to replay"
+        )
     plan = snap_round(round_, graph)
     players = plan.players
     n = len(players)
@@ -293,11 +307,13 @@ def replay_round(
     end_tick = int(frame_ticks[-1]) if len(frame_ticks) else start_tick
     try:
         while not sim.done and sim.tick < end_tick:
-            sim.step()
+            # Scripted deaths come before the step of the death frame's tick, which records the
+            # frame: the frame that shows the player dead in the data shows it dead here too.
             for i, tick in deaths.items():
-                if tick == sim.tick and agents.alive[i]:
+                if tick <= sim.tick + 1 and agents.alive[i]:
                     sim.kill(i, "scripted")
                     scripted[i] = True
+            sim.step()
             f = frame_of_tick.get(sim.tick)
             if f is not None:  # follow the weapon in hand, as the data shows it
                 for i in np.nonzero(agents.alive)[0]:

@@ -117,6 +117,8 @@ class Simulator:
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
+        for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
+            self.mover.remove(int(agent))
         self.bomb: Bomb = rules.start(agents, bomb_carrier)
         self._record_at = np.asarray(sorted(set(int(t) for t in record_ticks)), dtype=np.int64)
         s = len(self._record_at)

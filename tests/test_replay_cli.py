@@ -1,0 +1,192 @@
+"""`decoy replay FILE:ROUND` on a generated match whose players walk the shipped graph, its
+error lines, and one real round.
+
+The fixture match of tests/esta_fixtures.py is rewritten so that every player of rounds 1 and 2
+walks north along one straight run of de_dust2 waypoints in the T spawn, one waypoint per frame,
+each four waypoints (2.8 m) behind the next. Round 1 keeps the fixture's quirks: t3 dies at
+frame 3 and ct4 is missing from frame 2. Round 3 has no frames.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pytest
+from esta_fixtures import MATCH_ID, ROUND1_TICKS, make_match, write_match
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.esta import read_match
+from decoy_cli.metrics import METRIC_NAMES
+from decoy_cli.waypoints.build import builtin_graph
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+TSIDE = DATA / "esta_dust2_tside"
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "220"}
+
+RUN_START = (5.458, -19.007, 0.008)
+"""A T-spawn waypoint with a straight run of 40 walk edges north."""
+NAMES = ["t1", "t2", "t3", "t4", "BOT t5", "ct1", "ct2", "ct3", "ct4"]
+SPACING = 4  # waypoints between neighbours on the run
+
+REPLAY_FILES = ("replay.csv", "events.csv", "players.csv", "summary.json", "paths.png")
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+BOMB_KINDS = {"plant_begin", "plant", "plant_abort", "bomb_drop", "bomb_pickup", "explode"}
+
+
+def _run() -> list[int]:
+    graph = builtin_graph()
+    index, distance = graph.nearest(np.array([RUN_START]))
+    assert distance[0] < 0.01
+    run = [int(index[0])]
+    while len(run) < SPACING * len(NAMES) + 6:
+        run.append(int(graph.edge_target[graph.out_edges[run[-1], 0]]))
+    return run
+
+
+def on_graph_match() -> dict[str, Any]:
+    """The fixture match with every player on the shipped graph (see the module docstring)."""
+    document = make_match()
+    positions = builtin_graph().positions
+    run = _run()
+    for round_ in document["gameRounds"][:2]:
+        for j, frame in enumerate(round_["frames"]):
+            for team in ("t", "ct"):
+                for player in frame[team]["players"]:
+                    node = run[SPACING * NAMES.index(player["name"]) + j]
+                    x, y, z = positions[node] / HAMMER_TO_M
+                    player.update(x=x, y=y, z=z)
+    return document
+
+
+@pytest.fixture(scope="module")
+def match_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_match(tmp_path_factory.mktemp("replay") / "walk.json.xz", on_graph_match())
+
+
+def _invoke(*args: str):
+    return runner.invoke(app, ["replay", *args], env=WIDE)
+
+
+def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = _invoke(f"{match_file}:1", "--mover", "kinematic", "--out", str(out), "--gif")
+    assert result.exit_code == 0, result.output
+    for name in (*REPLAY_FILES, "round.gif"):
+        assert (out / name).stat().st_size > 0, name
+    assert (out / "paths.png").read_bytes().startswith(PNG_MAGIC)
+    assert (out / "round.gif").read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+
+    stdout = result.stdout
+    assert f"round 1 of {MATCH_ID}: {len(ROUND1_TICKS)} frames replayed" in stdout
+    assert "kinematic mover, combat off, bomb on" in stdout
+    for title in ("outcome", "clock protocol (metres)", "paper protocol (metres)"):
+        assert title in stdout
+    for name in (*METRIC_NAMES, *NAMES):
+        assert f" {name} " in stdout, name
+    assert "end of the data" in stdout  # nobody won: the data ends first
+    assert f"replay written to {out}" in stdout
+
+    frames, players = len(ROUND1_TICKS), len(NAMES)
+    table = pd.read_csv(out / "replay.csv", keep_default_na=False)
+    assert len(table) == frames * players
+    seconds = (np.array(ROUND1_TICKS) - 990) / 128
+    assert table["tick"].tolist() == np.repeat(np.round(seconds * 60), players).tolist()
+    t3 = table[table["player"] == "t3"]
+    assert t3["alive"].tolist() == [True, True, True, False]  # dead from frame 3, as in the data
+    assert t3["alive_original"].tolist() == [True, True, True, False]
+
+    per_player = pd.read_csv(out / "players.csv", keep_default_na=False).set_index("player")
+    assert per_player.loc["t3", "death"] == "scripted"
+    assert per_player["died_replay"].tolist() == [name == "t3" for name in per_player.index]
+    events = pd.read_csv(out / "events.csv")
+    assert events[["kind", "agent"]].values.tolist() == [["death", "t3"]]
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"] == {"combat": False, "bomb": True, "mover": "kinematic", "seed": 0}
+    assert summary["frames"] == frames and summary["round_num"] == 1
+    assert summary["outcome_original"] == {"winner": "T", "reason": "TerroristsWin"}
+    assert summary["outcome_replay"] == {"winner": None, "reason": None}
+
+
+def test_physics_mover_without_the_bomb(match_file: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = _invoke(f"{match_file}:2", "--mover", "physics", "--no-bomb", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert "physics mover, combat off, bomb off" in result.stdout
+    assert "no damage model" in result.stdout  # combat was asked for: the user is told
+    assert not (out / "round.gif").exists()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"]["bomb"] is False and summary["options"]["mover"] == "physics"
+    events = pd.read_csv(out / "events.csv")
+    assert not set(events["kind"]) & BOMB_KINDS
+
+
+@pytest.mark.parametrize(
+    ("target", "extra", "expected"),
+    [
+        ("{missing}:1", [], "error: {missing}: no such file"),
+        ("{file}:9", [], "error: {file}: no round 9 (rounds 1-3)"),
+        ("{file}:3", [], "error: round 3 has no frames (events only): nothing to replay"),
+        ("{file}", [], "error: {file}: not a round address (expected FILE:ROUND"),
+        ("{file}:1", ["--mover", "nonsense"], "error: --mover must be physics or kinematic"),
+        ("{file}:1", ["--out", "{blocker}"], "error: cannot create {blocker}: "),
+    ],
+    ids=["missing-file", "missing-round", "no-frames", "no-round", "bad-mover", "bad-out"],
+)
+def test_bad_input_is_one_error_line(
+    match_file: Path, tmp_path: Path, target: str, extra: list[str], expected: str
+) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    names = {"file": match_file, "missing": tmp_path / "nope.json.xz", "blocker": blocker}
+    args = [target.format(**names), *(a.format(**names) for a in extra)]
+    result = _invoke(*args, "--no-combat")
+    assert result.exit_code == 1
+    assert result.stderr.startswith(expected.format(**names))
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.output
+
+
+def test_a_round_of_another_map_is_refused(tmp_path: Path) -> None:
+    document = on_graph_match()
+    document["mapName"] = "de_inferno"
+    path = write_match(tmp_path / "inferno.json", document)
+    result = _invoke(f"{path}:1", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1
+    assert result.stderr == f"error: {path}:1: a de_inferno round; decoy replays de_dust2\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_real_round(tmp_path: Path) -> None:
+    files = sorted(TSIDE.glob("*.json.xz")) if TSIDE.is_dir() else []
+    if not files:
+        pytest.skip(f"real ESTA data not found at {TSIDE}")
+    match = read_match(files[0])
+    round_ = match.rounds[0]
+    out = tmp_path / "real"
+    result = _invoke(
+        f"{files[0]}:{round_.round_num}", "--mover", "kinematic", "--no-combat", "--out", str(out)
+    )
+    assert result.exit_code == 0, result.output
+    for name in REPLAY_FILES:
+        assert (out / name).stat().st_size > 0, name
+    table = pd.read_csv(out / "replay.csv")
+    assert len(table) == round_.num_frames * round_.num_players
+    assert np.array_equal(
+        table["tick"].to_numpy(), np.repeat(np.round(round_.frame_seconds * 60), 5)
+    )
+    per_player = pd.read_csv(out / "players.csv", keep_default_na=False)
+    assert len(per_player) == round_.num_players == 5
+    # Movement only: every death in the data is scripted at its time, and survivors survive.
+    assert per_player["died_replay"].tolist() == per_player["died_original"].tolist()
+    # The replay stays near the players: within a few metres on average.
+    assert per_player["mean_dist"].astype(float).max() < 5.0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["frames"] == round_.num_frames and summary["match_id"] == match.match_id
