@@ -48,7 +48,6 @@ HIT_GROUPS = ("Head", "Neck", "Chest", "Stomach", "Arm", "Leg")
 
 NO_HIT = -1
 
-_RAY_BATCH = 4095  # pybullet's rayTestBatch limit, see decoy_cli/world/physics.py
 _START_PAST_OWN_CAPSULE_M = 1e-3
 _PARK_Z = -1e6
 
@@ -184,19 +183,9 @@ class LineOfSight:
         cast = np.flatnonzero((t < 1.0) & (length > 0))  # else the eyes share one body: clear
         starts = eyes[first[cast]] + t[cast, None] * segment[cast]
         ends = eyes[second[cast]]
-        p = self._p
-        for lo in range(0, len(cast), _RAY_BATCH):
-            hits = p.rayTestBatch(
-                starts[lo : lo + _RAY_BATCH].tolist(),
-                ends[lo : lo + _RAY_BATCH].tolist(),
-                collisionFilterMask=LOS_GROUP,
-                physicsClientId=self.physics.client,
-            )
-            rows = cast[lo : lo + _RAY_BATCH]
-            if len(hits) != len(rows):
-                raise RuntimeError(f"pybullet returned {len(hits)} ray results for a batch")
-            hit = np.fromiter((self._owner.get(h[0], -2) if h[0] >= 0 else -1 for h in hits), int)
-            clear[rows] = (hit == -1) | (hit == second[rows])
+        hits = self.physics.cast_rays(starts, ends, LOS_GROUP)
+        hit = np.fromiter((self._owner.get(h[0], -2) if h[0] >= 0 else -1 for h in hits), int)
+        clear[cast] = (hit == -1) | (hit == second[cast])
         return clear
 
 

