@@ -12,8 +12,6 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +20,8 @@ import pandas as pd
 
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import OutputError
+from decoy_cli.figures import draw_nav_areas, save_figure
+from decoy_cli.files import write_atomic
 from decoy_cli.metrics import trajectory_metrics
 from decoy_cli.replay.replayer import ReplayResult
 
@@ -131,39 +131,8 @@ def write_replay(
         ("players.csv", players.to_csv(index=False)),
         ("summary.json", json.dumps(summary, indent=2, sort_keys=True, default=str) + "\n"),
     ):
-        written.append(_write_text(folder / name, content))
+        written.append(write_atomic(folder / name, content.encode()))
     return written
-
-
-def _write_text(path: Path, text: str) -> Path:
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    return path
-
-
-def _map_background(ax, nav) -> None:
-    from matplotlib.collections import PolyCollection
-
-    from decoy_cli.csgo import HAMMER_TO_M
-
-    boxes = np.stack(
-        [
-            np.column_stack([nav.x_min, nav.y_min]),
-            np.column_stack([nav.x_max, nav.y_min]),
-            np.column_stack([nav.x_max, nav.y_max]),
-            np.column_stack([nav.x_min, nav.y_max]),
-        ],
-        axis=1,
-    )
-    ax.add_collection(
-        PolyCollection(boxes * HAMMER_TO_M, facecolor="#e8e8e8", edgecolor="#d0d0d0", lw=0.3)
-    )
 
 
 def plot_paths(path: str | Path, round_: Any, result: ReplayResult, nav, title: str = "") -> None:
@@ -175,7 +144,7 @@ def plot_paths(path: str | Path, round_: Any, result: ReplayResult, nav, title: 
 
     rec = result.recording
     fig, ax = plt.subplots(figsize=(11, 11))
-    _map_background(ax, nav)
+    draw_nav_areas(ax, nav)
     colours = plt.get_cmap("tab10")
     for p, player in enumerate(result.plan.players):
         colour = colours(p % 10)
@@ -194,7 +163,7 @@ def plot_paths(path: str | Path, round_: Any, result: ReplayResult, nav, title: 
     ax.set_xlabel("x (m, east)")
     ax.set_ylabel("y (m, north)")
     ax.set_title(title)
-    _save(fig, Path(path))
+    save_figure(fig, path)
 
 
 def animate(path: str | Path, round_: Any, result: ReplayResult, nav, fps: int = 8) -> None:
@@ -209,7 +178,7 @@ def animate(path: str | Path, round_: Any, result: ReplayResult, nav, fps: int =
     sides = np.array([p.side for p in result.plan.players])
     colour = np.where(sides == "T", "#d62728", "#1f77b4")
     fig, ax = plt.subplots(figsize=(7, 7))
-    _map_background(ax, nav)
+    draw_nav_areas(ax, nav)
     ax.set_aspect("equal")
     ax.autoscale_view()
     replay_dots = ax.scatter([], [], s=30)
@@ -233,21 +202,6 @@ def animate(path: str | Path, round_: Any, result: ReplayResult, nav, fps: int =
     tmp = path.with_name(f".{path.name}.tmp.gif")
     try:
         anim.save(tmp, writer=PillowWriter(fps=fps))
-        tmp.replace(path)
-    except OSError as error:
-        tmp.unlink(missing_ok=True)
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    finally:
-        plt.close(fig)
-
-
-def _save(fig, path: Path) -> None:
-    import matplotlib.pyplot as plt
-
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(tmp, dpi=130, bbox_inches="tight")
         tmp.replace(path)
     except OSError as error:
         tmp.unlink(missing_ok=True)

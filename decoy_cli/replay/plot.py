@@ -17,8 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.errors import OutputError
+from decoy_cli.figures import draw_nav_areas, save_figure
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.rounds import RoundPlan
 from decoy_cli.replay.snapping import SnapStatus
@@ -53,7 +52,7 @@ def plot_round_plan(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import LineCollection
 
     positions = np.asarray(positions, dtype=np.float64)
     rows = range(len(plan.players)) if players is None else players
@@ -61,20 +60,7 @@ def plot_round_plan(
 
     fig, ax = plt.subplots(figsize=(12, 12))
     if nav is not None:
-        boxes = np.stack(
-            [
-                np.column_stack([nav.x_min, nav.y_min]),
-                np.column_stack([nav.x_max, nav.y_min]),
-                np.column_stack([nav.x_max, nav.y_max]),
-                np.column_stack([nav.x_min, nav.y_max]),
-            ],
-            axis=1,
-        )
-        ax.add_collection(
-            PolyCollection(
-                boxes * HAMMER_TO_M, facecolor="#ececec", edgecolor="#d0d0d0", lw=0.3, zorder=0
-            )
-        )
+        draw_nav_areas(ax, nav, facecolor="#ececec")
     pos = graph.positions
     edges = np.stack([pos[graph.edge_source, :2], pos[graph.edge_target, :2]], axis=1)
     ax.add_collection(LineCollection(edges, colors="#c4c4c4", lw=0.25, zorder=1))
@@ -164,7 +150,7 @@ def plot_round_plan(
     ax.set_ylabel("y (m, north)")
     ax.legend(loc="best", fontsize=8)
     ax.set_title(title)
-    _save(fig, Path(path), dpi)
+    save_figure(fig, path, dpi)
 
 
 def _path_segments(plan: PlayerPlan, chosen: np.ndarray, pos: np.ndarray) -> np.ndarray:
@@ -188,18 +174,3 @@ def _zoom(ax, drawn: list[np.ndarray]) -> None:
     centre, half = (low + high) / 2, np.maximum((high - low) / 2, MIN_SPAN_M / 2)
     ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
     ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
-
-
-def _save(fig, path: Path, dpi: int) -> None:
-    """Write the figure as PNG atomically; an OutputError when the path cannot be written."""
-    import matplotlib.pyplot as plt
-
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.tmp.png")
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        tmp.replace(path)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    finally:
-        plt.close(fig)

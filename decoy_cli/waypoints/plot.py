@@ -7,13 +7,11 @@ too, for looking at what the builder threw away.
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.errors import OutputError
+from decoy_cli.figures import draw_nav_areas, save_figure
 from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
 from decoy_cli.world.navmesh import NavMesh
 
@@ -37,12 +35,7 @@ def plot_graph(
 
     fig, ax = plt.subplots(figsize=(12, 12))
     if nav is not None:
-        boxes = [
-            [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-            for x0, y0, x1, y1 in zip(nav.x_min, nav.y_min, nav.x_max, nav.y_max, strict=True)
-        ]
-        polys = np.asarray(boxes) * HAMMER_TO_M
-        ax.add_collection(PolyCollection(polys, facecolor="#e6e6e6", edgecolor="#c8c8c8", lw=0.3))
+        draw_nav_areas(ax, nav)
     if floor_triangles is not None and len(floor_triangles):
         ax.add_collection(
             PolyCollection(floor_triangles[:, :, :2], facecolor="#e6e6e6", edgecolor="none")
@@ -79,15 +72,4 @@ def plot_graph(
     ax.set_ylabel("y (m, north)")
     ax.legend(loc="lower right")
     ax.set_title(title or f"{graph.num_nodes} waypoints, {graph.num_edges} edges")
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        tmp.replace(path)
-    except OSError as error:
-        with contextlib.suppress(OSError):  # no half-written picture left behind
-            tmp.unlink()
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    finally:
-        plt.close(fig)
+    save_figure(fig, path, dpi)

@@ -23,8 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M, PLAYER_HEIGHT_M, STEP_HEIGHT_M
-from decoy_cli.errors import GraphError, OutputError, WorldError
+from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, STEP_HEIGHT_M
+from decoy_cli.errors import GraphError, WorldError
+from decoy_cli.figures import draw_nav_areas, save_figure
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import NavMesh
 from decoy_cli.world.physics import PhysicsWorld
@@ -303,7 +304,7 @@ def plot_los_comparison(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import LineCollection
 
     panels = (
         (comparison.visible_a & ~comparison.visible_b, f"only {comparison.name_a} sees", "#1f77b4"),
@@ -312,18 +313,7 @@ def plot_los_comparison(
     fig, axes = plt.subplots(1, 2, figsize=(20, 10), sharex=True, sharey=True)
     for ax, (mask, label, colour) in zip(axes, panels, strict=True):
         if nav is not None:
-            boxes = np.stack(
-                [
-                    np.column_stack([nav.x_min, nav.y_min]),
-                    np.column_stack([nav.x_max, nav.y_min]),
-                    np.column_stack([nav.x_max, nav.y_max]),
-                    np.column_stack([nav.x_min, nav.y_max]),
-                ],
-                axis=1,
-            )
-            ax.add_collection(
-                PolyCollection(boxes * HAMMER_TO_M, facecolor="#e6e6e6", edgecolor="none")
-            )
+            draw_nav_areas(ax, nav, edgecolor="none")
         segments = comparison.pairs_a[mask][:, :, :2]
         ax.add_collection(LineCollection(segments, colors=colour, lw=0.5, alpha=0.25))
         middle = segments.mean(axis=1)
@@ -340,13 +330,4 @@ def plot_los_comparison(
         f"agreement {comparison.agreement:.1%} (both {confusion['both']:,}, "
         f"neither {confusion['neither']:,})"
     )
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.tmp.png")
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        tmp.replace(path)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    finally:
-        plt.close(fig)
+    save_figure(fig, path, dpi)

@@ -35,14 +35,14 @@ from __future__ import annotations
 import hashlib
 import numbers
 import os
-import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.errors import OutputError, WorldError
+from decoy_cli.errors import WorldError
+from decoy_cli.files import write_atomic
 from decoy_cli.world.world import World
 
 UNITS: dict[str, float] = {"hammer": HAMMER_TO_M, "m": 1.0}
@@ -140,14 +140,14 @@ def write_obj(world: World, path: str | os.PathLike[str], *, units: str = "hamme
         *(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices.tolist()),
         *(f"f {a} {b} {c}\n" for a, b, c in (indices + 1).tolist()),
     ]
-    _write_atomic(path, "".join(lines).encode("ascii"))
+    write_atomic(path, "".join(lines).encode("ascii"))
 
 
 def write_tri(world: World, path: str | os.PathLike[str], *, units: str = "hammer") -> None:
     """Write the world as an awpy-style `.tri` (float32, Hammer units by default), atomically."""
     path = Path(path)
     factor = _metres_per_unit(path, units, None)
-    _write_atomic(path, (world.triangles / factor).astype("<f4").tobytes())
+    write_atomic(path, (world.triangles / factor).astype("<f4").tobytes())
 
 
 def _metres_per_unit(path: Path, units: str, scale: float | None) -> float:
@@ -300,26 +300,3 @@ def _is_number(text: str, dtype: type[np.generic]) -> bool:
     except (ValueError, OverflowError):
         return False
     return True
-
-
-def _write_atomic(path: Path, payload: bytes) -> None:
-    """Write to a temporary file beside `path`, then rename: never a half-written mesh."""
-    if path.is_dir():
-        raise OutputError(f"cannot write {path}: it is a directory")
-    parent = path.parent if str(path.parent) else Path(".")
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=parent)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    try:
-        with os.fdopen(fd, "wb") as out:
-            out.write(payload)
-        os.chmod(tmp, 0o644)  # mkstemp makes the file private; a mesh is an ordinary file
-        os.replace(tmp, path)
-    except OSError as error:
-        Path(tmp).unlink(missing_ok=True)
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
