@@ -84,9 +84,7 @@ class LineOfSight:
             raise ValueError(f"capsule radius {radius} m does not fit a height of {height} m")
         if not 0 < eye_height < height:
             raise ValueError(f"eye height {eye_height} m is not inside a {height} m body")
-        import pybullet
-
-        self._p = pybullet
+        self._p = physics._p
         self.physics = physics
         self.count = count
         self.radius = float(radius)

@@ -16,6 +16,7 @@ pybullet is the physics engine of the whole project; this module owns the pitfal
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from typing import Self
 
@@ -30,12 +31,27 @@ _THREADED_RAYS = 512
 _MAX_VERTEX_ARRAY_TRIANGLES = 150_000
 
 
+def load_pybullet():
+    """Import pybullet without its "pybullet build time" banner on the terminal's stdout."""
+    if "pybullet" in sys.modules:
+        return sys.modules["pybullet"]
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), 1)
+            import pybullet
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+    return pybullet
+
+
 class PhysicsWorld:
     """A pybullet DIRECT client holding one static world mesh; use as a context manager."""
 
     def __init__(self, world: World) -> None:
-        import pybullet
-
+        pybullet = load_pybullet()
         self.world = world
         self._p = pybullet
         self.client = pybullet.connect(pybullet.DIRECT)
