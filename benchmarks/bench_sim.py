@@ -84,7 +84,7 @@ def run(count: int, mover_kind: str, decisions: int, seed: int) -> dict:
                 BombRules(zones, RulesConfig()),
                 bomb_carrier=0,
                 combat=CombatStep(los, NeverHits(), "de_dust2"),
-                config=SimConfig(combat=True, bomb=True),
+                config=SimConfig(combat=True),
                 seed=int(rng.integers(1 << 31)),
             )
             start_tick = sim.tick

@@ -289,7 +289,7 @@ def replay_round(
         rules,
         bomb_carrier=carrier,
         combat=combat,
-        config=SimConfig(combat=combat is not None, bomb=options.bomb),
+        config=SimConfig(combat=combat is not None),
         start_tick=start_tick,
         record_ticks=frame_ticks,
         seed=options.seed,

@@ -60,8 +60,7 @@ class Policy(Protocol):
 class SimConfig:
     """Switches and rates of a simulated round."""
 
-    combat: bool = True
-    bomb: bool = True
+    combat: bool = True  # the bomb's switch is the rules' own (RulesConfig.bomb_enabled)
     combat_every_ticks: int = 30
     tick_rate: int = TICK_RATE
     max_ticks: int | None = None  # hard bound on the run (default: round time + bomb timer)
@@ -166,10 +165,9 @@ class Simulator:
             self.events.append(SimEvent(self.tick, "stuck", int(agent)))
         for agent in np.nonzero(np.asarray(moved.teleported, dtype=bool))[0]:
             self.events.append(SimEvent(self.tick, "teleport", int(agent)))
-        if self.config.bomb:
-            self.events += self.rules.step(
-                self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
-            )
+        self.events += self.rules.step(
+            self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
+        )
         if (
             self.config.combat
             and self.combat is not None
@@ -220,14 +218,23 @@ class Simulator:
         self.waiting[agent] = False
         self.wants_plant[agent] = False
         self.wants_defuse[agent] = False
-        if self.config.bomb:
-            self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
+        self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
+
+    @property
+    def needs_decision(self) -> np.ndarray:
+        """(N,) bool: agents that will ask their policy for an action at the next tick."""
+        if self.done:
+            return np.zeros(self.agents.count, dtype=bool)
+        return self._due_at(self.tick + 1)
+
+    def _due_at(self, tick: int) -> np.ndarray:
+        """Alive agents waiting at a waypoint, or whose STOP ends by `tick`."""
+        expired = (self.hold_until > 0) & (tick >= self.hold_until)
+        return self.agents.alive & (self.waiting | expired)
 
     def _decide(self) -> None:
         agents = self.agents
-        due = agents.alive & (
-            self.waiting | ((self.hold_until > 0) & (self.tick >= self.hold_until))
-        )
+        due = self._due_at(self.tick)
         for agent in np.nonzero(due)[0]:
             agent = int(agent)
             self.hold_until[agent] = 0

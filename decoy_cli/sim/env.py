@@ -299,7 +299,7 @@ class DecoyParallelEnv(ParallelEnv):
             self._rules,
             bomb_carrier=carrier,
             combat=combat,
-            config=SimConfig(combat=combat is not None, bomb=self.bomb),
+            config=SimConfig(combat=combat is not None),
             seed=int(rng.integers(2**63)),
         )
         self.agents = list(self.possible_agents)
@@ -431,13 +431,8 @@ class DecoyParallelEnv(ParallelEnv):
             self.physics = None
 
     def _due(self) -> np.ndarray:
-        """(N,) which agents the engine will ask for a decision at the next tick (the engine's
-        rule: alive, and waiting at a waypoint or at the end of a STOP)."""
-        sim = self._require_sim()
-        if sim.done:
-            return np.zeros(sim.agents.count, dtype=bool)
-        hold_over = (sim.hold_until > 0) & (sim.tick + 1 >= sim.hold_until)
-        return sim.agents.alive & (sim.waiting | hold_over)
+        """(N,) which agents the engine will ask for a decision at the next tick."""
+        return self._require_sim().needs_decision
 
     def _decision(self, agent: int, action: Any) -> Decision:
         """The engine decision for an agent's action (see the class docstring)."""
