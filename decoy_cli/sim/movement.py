@@ -748,11 +748,6 @@ class PhysicsMover(_MoverBase):
         """(N,) pybullet body id of each agent's capsule."""
         return np.asarray(self._bodies[: self.n], dtype=np.int64)
 
-    def capsule_centres(self) -> np.ndarray:
-        """(N, 3) centres of the agents' capsules: the feet lifted by the float and half the
-        capsule."""
-        return self._pos + self._lift
-
     def sync_bodies(self) -> None:
         """Move the pybullet bodies of alive agents to the agents' positions (only those that
         moved since the last sync); call before casting rays that should hit agents."""

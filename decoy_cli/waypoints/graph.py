@@ -7,7 +7,7 @@ simulator directly. Queries:
 * `nearest(points)`: floor-aware nearest waypoint, vectorised. The search runs in a space whose
   z axis is stretched, and a candidate must lie within a vertical band around the query, so a
   player on the upper floor of a two-floor spot never snaps to the floor below (or above).
-* `shortest_path(a, b)` / `path_lengths(a, b)`: Dijkstra on edge lengths over the directed graph.
+* `shortest_path(a, b)` / `path_lengths(a)`: Dijkstra on edge lengths over the directed graph.
 
 Compass directions are numbered clockwise from north (N = +y, E = +x): 0 N, 1 NE, 2 E, 3 SE,
 4 S, 5 SW, 6 W, 7 NW. These are also the paper's 8 move actions; action 8 is STOP.
