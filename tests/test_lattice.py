@@ -148,10 +148,38 @@ def test_room_is_a_full_7_by_7_lattice() -> None:
 
 def test_spacing_changes_the_node_count() -> None:
     world = room()
+    params = LatticeParams(spacing=1.0, wall_nodes=False)
     with PhysicsWorld(world) as physics:
-        result = build_lattice(physics, seeds_of(world), LatticeParams(spacing=1.0))
+        result = build_lattice(physics, seeds_of(world), params)
     # lines at 2.5 +- k for k <= 2 (0.5 .. 4.5 m)
     assert len(result.positions) == 25
+
+
+def test_wall_nodes_stand_where_players_hug_the_walls() -> None:
+    """In a 5 m room with 1 m spacing the lattice lines are 0.5 m from the walls; a wall node
+    goes toward each wall as far as the capsule allows (wall - radius - 3 cm), linked both ways
+    to its parent and along the wall to its neighbours, never two edges in one direction."""
+    world = room()
+    params = LatticeParams(spacing=1.0)
+    with PhysicsWorld(world) as physics:
+        result = build_lattice(physics, seeds_of(world), params)
+    assert result.stats.wall_nodes == 20
+    assert len(result.positions) == 25 + 20
+    near = params.agent_radius + 0.03
+    xy = result.positions[:, :2]
+    on_wall = np.any(np.isclose(xy, near) | np.isclose(xy, 5.0 - near), axis=1)
+    assert on_wall.sum() == 20
+    walls = np.flatnonzero(on_wall)
+    degree = Counter(result.edge_source.tolist())
+    for node in walls:
+        # back to the parent, plus one or two along the wall (the corner ones have one)
+        assert degree[node] in (2, 3)
+    pairs = list(zip(result.edge_source.tolist(), result.edge_direction.tolist(), strict=True))
+    assert len(pairs) == len(set(pairs))
+    # every edge has its reverse, and the whole graph is one strongly connected component
+    edges = set(zip(result.edge_source.tolist(), result.edge_target.tolist(), strict=True))
+    assert all((v, u) in edges for u, v in edges)
+    assert result.stats.components_before == 1
 
 
 # ---- ledge, box, overpass, gap -----------------------------------------------------------------

@@ -322,8 +322,8 @@ def test_data_deaths_are_scripted_and_absent_players_dead_from_the_start(
 def test_an_absent_player_blocks_nobody(physics: PhysicsWorld) -> None:
     """A capsule mover must not keep a body for an agent that is dead from the start: a walker
     crossing the spot where the absent player is put arrives on time."""
-    line = straight_run(ABSENT_PARKING_NODE, direction=4, count=2)[::-1]  # from the south
-    line += straight_run(ABSENT_PARKING_NODE, direction=0, count=4)[1:]
+    # from the east onto the parking node (node 0, a wall node at the west edge of the map)
+    line = straight_run(ABSENT_PARKING_NODE, direction=2, count=6)[::-1]
     frames = len(line) + 2
     round_ = make_round(
         [Track("walker", "T", line + [line[-1]] * 2), Track("absent", "T", [-1] * frames)]

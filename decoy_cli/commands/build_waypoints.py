@@ -44,6 +44,12 @@ def build_waypoints(
     up_axis: str = typer.Option("z", "--up-axis", help="Mesh axis that points up: z, y, -y, ..."),
     offset: str = typer.Option("0,0,0", "--offset", help="Added to the mesh after scaling (m)."),
     spacing: float = typer.Option(0.7, "--spacing", help="Lattice spacing in metres.", min=0.2),
+    wall_nodes: bool = typer.Option(
+        True,
+        "--wall-nodes/--no-wall-nodes",
+        help="Add nodes half a spacing toward walls, where players stand (--no-wall-nodes: the "
+        "paper's pure lattice).",
+    ),
     seeds: list[str] = typer.Option(
         [], "--seed", help="A seed point x,y,z in metres (repeatable; default: both spawns)."
     ),
@@ -80,7 +86,7 @@ def build_waypoints(
     seed_points = np.array([_parse_point(s, "--seed") for s in seeds]) if seeds else None
     manual_points = read_manual_waypoints(manual) if manual is not None else None
     out = out or DEFAULT_OUT / f"{name}.npz"
-    params = LatticeParams(spacing=spacing)
+    params = LatticeParams(spacing=spacing, wall_nodes=wall_nodes)
 
     started = time.perf_counter()
     with Progress(
@@ -121,6 +127,12 @@ def build_waypoints(
         f"{stats.drop_edges:,} drop edges, {stats.drop_new_nodes:,} new nodes",
         f"{stats.seconds['drop pass']:.1f}",
     )
+    if "wall nodes" in stats.seconds:
+        table.add_row(
+            "wall nodes",
+            f"{stats.wall_nodes:,} nodes added",
+            f"{stats.seconds['wall nodes']:.1f}",
+        )
     table.add_row(
         "verification",
         f"{stats.nudged_nodes:,} nodes nudged; removed "

@@ -9,6 +9,13 @@
    crouch-jump) edges, in both directions where both pass.
 2. **Drop pass.** Moves whose profile falls by more than the step height (down to the safe-fall
    depth) become one-way drop edges; lower floors first found this way are flooded too.
+   **Wall nodes** (the project's addition, `wall_nodes`): where a node has no move in a cardinal
+   direction (a wall, a railing, a cliff edge), a node is added half a spacing that way if the
+   floor continues on the same level and the capsule fits there, linked to its parent both ways
+   and to the wall nodes of its lattice neighbours along the wall. Players hug walls: on the
+   pure lattice a wall-hugging position can be up to 0.7 m from every node, and 5.8% of all
+   real T positions were more than 0.5 m away horizontally (a quarter of them along one wall of
+   mid); wall nodes bring them within reach. Each node still has at most one edge per direction.
 3. **Verification.** A capsule is moved along every edge in pybullet, in steps of at most
    0.1 m, floating the step height above the floor (as the simulator moves agents); an edge
    along which it would penetrate the world is removed. First, a node where the capsule does not
@@ -68,6 +75,7 @@ class LatticeParams:
     verify_clearance: float = 0.03  # capsule floats this much above the step height
     max_nudge: float = 0.3  # a node the capsule does not fit at moves up to this far to fit
     graze: float = 0.025  # penetration the capsule may have (the walls are approximate)
+    wall_nodes: bool = True  # add nodes half a spacing toward walls (see the module docstring)
 
 
 @dataclass
@@ -79,6 +87,7 @@ class BuildStats:
     lattice_edges: dict[str, int] = field(default_factory=dict)
     drop_edges: int = 0
     drop_new_nodes: int = 0
+    wall_nodes: int = 0
     nudged_nodes: int = 0
     verified_removed: dict[str, int] = field(default_factory=dict)
     components_before: int = 0
@@ -139,13 +148,20 @@ class _Lattice:
 
 
 def _evaluate_moves(
-    physics: PhysicsWorld, sources: np.ndarray, directions: np.ndarray, params: LatticeParams
+    physics: PhysicsWorld,
+    sources: np.ndarray,
+    directions: np.ndarray,
+    params: LatticeParams,
+    scale: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Classify moves from source positions in compass directions: (EdgeKind or -1, target z)."""
+    """Classify moves from source positions in compass directions: (EdgeKind or -1, target z).
+
+    A move goes `scale` times the direction's lattice vector (default: the spacing)."""
     k = len(sources)
     if k == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
-    step = DIRECTION_VECTORS[directions].astype(np.float64) * params.spacing
+    scale = np.full(k, params.spacing) if scale is None else np.asarray(scale, dtype=np.float64)
+    step = DIRECTION_VECTORS[directions].astype(np.float64) * scale[:, None]
     target_xy = sources[:, :2] + step
     top = params.jump_height + 0.05
     start = np.column_stack([target_xy, sources[:, 2] + top])
@@ -236,6 +252,72 @@ def _flood(
                 nxt.append(v)
         frontier = nxt
         progress(stage, len(lattice.positions), 0)
+
+
+def _add_wall_nodes(
+    physics: PhysicsWorld,
+    positions: np.ndarray,
+    edges: list[tuple[int, int, int, int]],
+    params: LatticeParams,
+) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
+    """Add a node toward every cardinal direction a node has no move in, as close to the wall
+    as the capsule allows (half a spacing where no wall is in the way: a cliff edge), where the
+    floor continues level (a walk or step move) and the capsule fits; see the module docstring.
+    Returns the positions with the new nodes appended and the extended edge list."""
+    n = len(positions)
+    slot = {(u, d): (v, kind) for u, v, kind, d in edges}
+    cardinal = np.array([0, 2, 4, 6])
+    free = np.array([[(u, d) not in slot for d in cardinal] for u in range(n)]).reshape(n, 4)
+    parent, which = np.nonzero(free)
+    direction = cardinal[which]
+    offset = _wall_offsets(physics, positions[parent], direction, params)
+    useful = offset >= _MIN_WALL_OFFSET_M
+    parent, direction, offset = parent[useful], direction[useful], offset[useful]
+    kinds, z = _evaluate_moves(physics, positions[parent], direction, params, offset)
+    level = (kinds == EdgeKind.WALK) | (kinds == EdgeKind.STEP)
+    spot = np.column_stack(
+        [positions[parent, :2] + DIRECTION_VECTORS[direction] * offset[:, None], np.nan_to_num(z)]
+    )
+    float_h, cap_h = _capsule_dims(params)
+    centres = spot + np.array([0.0, 0.0, float_h + cap_h / 2])
+    fits = ~physics.capsules_blocked(centres, params.agent_radius, cap_h, params.graze)
+    keep = np.flatnonzero(level & fits)
+    wall_of: dict[tuple[int, int], int] = {}
+    out = list(edges)
+    for k, m in enumerate(keep.tolist()):
+        u, d, w = int(parent[m]), int(direction[m]), n + k
+        wall_of[(u, d)] = w
+        out.append((u, w, int(kinds[m]), d))
+        out.append((w, u, int(kinds[m]), (d + 4) % 8))
+    for (u, d), w in wall_of.items():
+        for side in ((d + 2) % 8, (d + 6) % 8):
+            neighbour = slot.get((u, side))
+            if neighbour is None or neighbour[1] not in (EdgeKind.WALK, EdgeKind.STEP):
+                continue
+            other = wall_of.get((neighbour[0], d))
+            if other is not None:
+                out.append((w, other, int(neighbour[1]), side))
+    return np.vstack([positions, spot[keep]]), out
+
+
+_MIN_WALL_OFFSET_M = 0.15
+"""A wall node nearer its parent than this adds no coverage worth an extra node."""
+
+
+def _wall_offsets(
+    physics: PhysicsWorld, sources: np.ndarray, directions: np.ndarray, params: LatticeParams
+) -> np.ndarray:
+    """How far toward each direction a wall node can stand: up to the nearest wall (rays at
+    knee, waist and head height) minus the capsule radius, else half a spacing; at most the
+    spacing less `_MIN_WALL_OFFSET_M` (beyond that it would crowd the next lattice point)."""
+    reach = DIRECTION_VECTORS[directions].astype(np.float64) * params.spacing
+    heights = (params.step_height + 0.05, 0.5 * params.agent_height, params.agent_height - 0.05)
+    starts = np.concatenate([sources + np.array([0.0, 0.0, h]) for h in heights])
+    ends = starts + np.tile(np.column_stack([reach, np.zeros(len(sources))]), (len(heights), 1))
+    fraction, _ = physics.ray_test(starts, ends)
+    wall = fraction.reshape(len(heights), -1).min(axis=0) * params.spacing
+    offset = np.where(np.isfinite(wall), wall - params.agent_radius - 0.03, params.spacing / 2)
+    return np.minimum(offset, params.spacing - _MIN_WALL_OFFSET_M)
 
 
 def _capsule_dims(params: LatticeParams) -> tuple[float, float]:
@@ -374,9 +456,16 @@ def build_lattice(
         _flood(physics, lattice, new_nodes, params, edges, drops, progress, "drop pass")
     stats.seconds["drop pass"] = time.perf_counter() - clock
 
+    positions = np.asarray(lattice.positions)
+    if params.wall_nodes:
+        clock = time.perf_counter()
+        positions, edges = _add_wall_nodes(physics, positions, edges, params)
+        stats.wall_nodes = len(positions) - len(lattice.positions)
+        stats.seconds["wall nodes"] = time.perf_counter() - clock
+
     # stage 3: verification with a moving capsule
     clock = time.perf_counter()
-    positions, stats.nudged_nodes = _nudge_nodes(physics, np.asarray(lattice.positions), params)
+    positions, stats.nudged_nodes = _nudge_nodes(physics, positions, params)
     edge_arr = np.asarray(edges, dtype=np.int64).reshape(-1, 4)
     keep = _verify(physics, positions, edge_arr, params, progress)
     removed = edge_arr[~keep]
