@@ -128,7 +128,7 @@ def test_nav_world_shape_and_bounds(nav: NavMesh, world: World) -> None:
     x0, y1 = radar["pos_x"] * HAMMER_TO_M, radar["pos_y"] * HAMMER_TO_M
     assert x0 <= low[0] and high[0] <= x0 + side
     assert y1 - side <= low[1] and high[1] <= y1
-    assert world.meta == {"kind": "navmesh", "areas": 1118}
+    assert world.meta == {"kind": "navmesh", "areas": 1118, "patches": 1}
 
 
 def test_shipped_graph_was_built_from_this_world(world: World) -> None:
@@ -247,3 +247,38 @@ def test_capsules_blocked_in_walls_free_on_open_floor(nav: NavMesh, world, physi
     # sunk into the floor, the same open-floor capsules are blocked
     sunk = open_floor - 0.3 * UP
     assert physics.capsules_blocked(sunk, radius, height).all()
+
+
+MID_STEP = (-5.9, 25.75)
+"""On the step in front of the mid boxes (metres), where real T players stand at z -1.314 m."""
+
+
+def test_patch_adds_the_mid_step(physics: PhysicsWorld) -> None:
+    z, normal_z = physics.first_floor_below(np.array([[*MID_STEP, 0.0]]), 3.0)
+    np.testing.assert_allclose(z, -69 * HAMMER_TO_M, atol=1e-6)
+    assert normal_z[0] > 0.99
+    box = navmesh.load_patches()
+    assert box.shape == (1, 6)
+    assert (box[:, 4] > box[:, 5]).all()  # the top is above the bottom
+
+
+def test_a_ledge_face_ends_at_the_higher_floor(physics: PhysicsWorld) -> None:
+    """The mid floor's north side faces the boxes' nav area 50 u away: the face ends at the
+    boxes' top instead of standing 3.5 m tall, so a jump from the step onto the boxes is open
+    (blocked at knee height by the face, clear above the top)."""
+    box_top = -0.545
+    start, end = np.array([MID_STEP[0], 25.75]), np.array([MID_STEP[0], 26.5])
+    knee = np.array([[*start, box_top - 0.3]]), np.array([[*end, box_top - 0.3]])
+    above = np.array([[*start, box_top + 0.4]]), np.array([[*end, box_top + 0.4]])
+    assert not physics.line_of_sight(*knee)[0]
+    assert physics.line_of_sight(*above)[0]
+
+
+def test_mid_boxes_are_reached_from_mid_by_the_step() -> None:
+    """Mid floor -> step (jump) -> boxes (jump): a few metres, not the 28 m detour round the
+    back that the graph had without the step."""
+    graph = builtin_graph()
+    floor, box = graph.nearest(np.array([[-6.44, 24.39, -2.4], [-6.09, 26.49, -0.54]]))[0]
+    path = graph.shortest_path(int(floor), int(box))
+    length = np.linalg.norm(np.diff(graph.positions[path], axis=0), axis=1).sum()
+    assert length < 4.0

@@ -15,6 +15,15 @@ world that a physics engine can use:
   16 u (half a player hull) short of the real walls, so walls are pushed out by up to 16 u, capped
   at half the gap to the next area, and the floor is extended under the push.
 
+* **Patches.** Solid boxes the nav mesh lacks but real players stand on, one per row of
+  `world_patches.csv` (Hammer units, with what each is and the evidence). The one so far is the
+  step in front of the mid boxes: without it the boxes were reachable only from behind, a 28 m
+  detour, and a quarter of all replay lateness on the real T rounds came from there.
+* **Ledge faces.** A side facing a floor more than a jump higher or lower within 128 u gets a
+  face up (or down) to that floor instead of a full 3.5 m wall, so the top of a box or ledge
+  stays open to a jump from below (the mid boxes again: their nav area starts 50 u behind the
+  face).
+
 Everything is computed in Hammer units and returned in metres. Line of sight in this world is
 approximate: holes in the nav mesh become walls, and windows, low cover and door gaps vanish.
 """
@@ -427,8 +436,9 @@ class _Side:
         """Split [lo, hi] by the nearest area facing each stretch within 3 push widths."""
         overlap = (np.minimum(self.t_hi, hi) - np.maximum(self.t_lo, lo)) > TOUCH_TOL_U
         dz = np.abs(self.centre_z - self.centre_z[self.area])
-        below = (self.centre_z < self.centre_z[self.area] - JUMP_U) & (self.gap <= LEDGE_REACH_U)
-        near = overlap & (self.gap >= -TOUCH_TOL_U) & ((self.gap <= 3 * WALL_PUSH_U) | below)
+        other_level = np.abs(self.centre_z - self.centre_z[self.area]) > JUMP_U
+        near = overlap & (self.gap >= -TOUCH_TOL_U)
+        near &= (self.gap <= 3 * WALL_PUSH_U) | (other_level & (self.gap <= LEDGE_REACH_U))
         near &= dz <= MAX_SHARED_STEP_U
         near[self.area] = False
         parts, rest = [], [(lo, hi)]
@@ -534,14 +544,43 @@ class _Side:
         ]
 
 
+def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
+    """Boxes missing from a built-in map's nav mesh, (B, 6) Hammer units: x_min, y_min, x_max,
+    y_max, z_top, z_bottom (none when the map has no `world_patches.csv`)."""
+    path = asset_dir(map_name) / "world_patches.csv"
+    if not path.is_file():
+        return np.zeros((0, 6))
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    keys = ("x_min", "y_min", "x_max", "y_max", "z_top", "z_bottom")
+    return np.array([[float(r[k]) for k in keys] for r in rows]).reshape(-1, 6)
+
+
+def box_triangles(x_min, y_min, x_max, y_max, z_top, z_bottom) -> np.ndarray:
+    """A closed box's top and four sides, (10, 3, 3) (the bottom is never seen)."""
+    top = [
+        (x_min, y_min, z_top),
+        (x_max, y_min, z_top),
+        (x_max, y_max, z_top),
+        (x_min, y_max, z_top),
+    ]
+    low = [(x, y, z_bottom) for x, y, _ in top]
+    tris = [[top[0], top[1], top[2]], [top[0], top[2], top[3]]]
+    for i in range(4):
+        j = (i + 1) % 4
+        tris += [[low[i], low[j], top[j]], [low[i], top[j], top[i]]]
+    return np.array(tris, dtype=np.float64)
+
+
 @cache
 def nav_world(map_name: str = BUILTIN_MAP) -> World:
     """The built-in triangle world of a map, in metres (cached per process)."""
     nav = load_navmesh(map_name)
-    tris = build_nav_triangles(nav) * HAMMER_TO_M
+    boxes = [box_triangles(*b) for b in load_patches(map_name)]
+    tris = np.concatenate([build_nav_triangles(nav), *boxes]) * HAMMER_TO_M
     return World(
         triangles=tris,
         name=map_name,
         source=f"built-in {map_name} nav mesh (awpy 1.3.1)",
-        meta={"kind": "navmesh", "areas": nav.num_areas},
+        meta={"kind": "navmesh", "areas": nav.num_areas, "patches": len(boxes)},
     )
