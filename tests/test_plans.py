@@ -167,7 +167,13 @@ def test_snap_reasons_for_unsnapped_frames() -> None:
         SnapStatus.NO_WAYPOINT,
         SnapStatus.NO_WAYPOINT,
     ]
-    assert snap.counts() == {"SNAPPED": 1, "NOT_ALIVE": 1, "NO_POSITION": 1, "NO_WAYPOINT": 2}
+    assert snap.counts() == {
+        "SNAPPED": 1,
+        "NOT_ALIVE": 1,
+        "NO_POSITION": 1,
+        "NO_WAYPOINT": 2,
+        "AIRBORNE": 0,
+    }
     assert snap.num_unsnappable == 2
 
 
@@ -185,6 +191,28 @@ def test_snap_is_floor_aware() -> None:
     snap = snap_positions(graph, positions, np.ones(3, bool))
     assert snap.node.tolist() == [9 + 4, 4, -1]
     assert snap.status[2] == SnapStatus.NO_WAYPOINT
+
+
+def test_snap_leaves_frames_in_the_air_unsnapped() -> None:
+    """A frame more than AIRBORNE_M above the world's floor is a jump or a fall: not snapped,
+    whatever floor lies near; where the floor is unknown (NaN) the frame snaps as usual."""
+    graph = grid5()
+    positions = np.array(
+        [[0.0, 0.0, 0.0], [0.7, 0.0, 0.3], [1.4, 0.0, 0.9], [2.1, 0.0, 0.9], [2.8, 0.0, 0.0]]
+    )
+    floor = np.array([0.0, 0.0, 0.0, np.nan, 0.0])
+    snap = snap_positions(graph, positions, np.ones(5, bool), floor_z=floor)
+    assert snap.status.tolist() == [
+        SnapStatus.SNAPPED,
+        SnapStatus.SNAPPED,  # 0.3 m up: a step or a stair, not the air
+        SnapStatus.AIRBORNE,
+        SnapStatus.SNAPPED,  # floor unknown: the usual rule (a node up to 1.25 m below)
+        SnapStatus.SNAPPED,
+    ]
+    assert snap.node[2] == -1 and np.isnan(snap.error_m[2])
+    assert snap.counts()["AIRBORNE"] == 1
+    with pytest.raises(EstaError, match="floor heights"):
+        snap_positions(graph, positions, np.ones(5, bool), floor_z=np.zeros(4))
 
 
 def test_snap_rejects_bad_shapes() -> None:

@@ -24,6 +24,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK
 from decoy_cli.replay.output import player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
+from decoy_cli.replay.snapping import SnapStatus
 from decoy_cli.sim.rules import BOMB_TARGET_BOXES, RulesConfig, SiteZones
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind
@@ -317,6 +318,21 @@ def test_data_deaths_are_scripted_and_absent_players_dead_from_the_start(
     assert table["death"].tolist() == ["", "scripted", "", "", ""]
     assert table.loc[ABSENT, "reason"] == "original alive in fewer than 2 frames"
     assert table.loc[[ALIVE, DIES, VANISHES, CT], "reason"].isna().all()
+
+
+def test_a_jump_is_not_a_target(physics: PhysicsWorld) -> None:
+    """A frame 1 m above the floor (a jump) is not snapped: the walker passes under it on its
+    path, on time, instead of being sent to some floor near the jump."""
+    run = straight_run(node_at(RUN_START), direction=0, count=2 * 9 - 1)[::2]
+    round_ = make_round([Track("jumper", "T", run)])
+    round_.position[0, 4, 2] += 1.0
+    result = replay(round_, physics, "kinematic")
+    status = result.plan.snaps[0].status
+    assert status[4] == SnapStatus.AIRBORNE
+    assert (np.delete(status, 4) == SnapStatus.SNAPPED).all()
+    assert np.nanmax(result.logs[0].lateness_s) == 0
+    replayed = result.recording.position[4, 0]
+    np.testing.assert_allclose(replayed[:2], round_.position[0, 4, :2], atol=0.15)
 
 
 def test_an_absent_player_blocks_nobody(physics: PhysicsWorld) -> None:

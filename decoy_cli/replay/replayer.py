@@ -220,7 +220,7 @@ def replay_round(
             f"round {getattr(round_, 'round_num', '?')} has no frames (events only): "
             "nothing to replay"
         )
-    plan = snap_round(round_, graph)
+    plan = snap_round(round_, graph, physics=physics)
     players = plan.players
     n = len(players)
     first = [int(p.target_frame[0]) if len(p.target_node) else 0 for p in plan.plans]

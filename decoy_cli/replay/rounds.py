@@ -3,6 +3,8 @@
 `snap_round` takes anything with the attributes of the ESTA reader's `Round` (duck-typed, so this
 module does not import the reader): `position` (P, F, 3) metres, NaN where absent; `alive` (P, F)
 bool; `weapon` (P, F) weapon names; `frame_seconds` (F,); `players`, each with `name` and `side`.
+Given the physics world, frames in the air are found by a ray down from each position and left
+unsnapped (see `decoy_cli.replay.snapping`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,12 @@ from decoy_cli.replay.snapping import (
     snap_positions,
 )
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.physics import PhysicsWorld
+
+_FLOOR_RAY_LIFT_M = 0.1
+"""The ray down starts this far above the feet, so the floor the player stands on is found."""
+_FLOOR_RAY_DEPTH_M = 4.0
+"""Deeper than any fall in the data between two frames; below that, the floor is unknown."""
 
 SUMMARY_COLUMNS = (
     "player",
@@ -75,9 +83,15 @@ class RoundPlan:
 
 
 def snap_round(
-    round_: Any, graph: WaypointGraph, *, max_distance: float = DEFAULT_MAX_SNAP_M
+    round_: Any,
+    graph: WaypointGraph,
+    *,
+    max_distance: float = DEFAULT_MAX_SNAP_M,
+    physics: PhysicsWorld | None = None,
 ) -> RoundPlan:
     """Snap every player of a round to the graph and build its timed plan (one shared path cache).
+
+    With `physics` (the world the graph was built on), frames in the air are not snapped.
 
     Inconsistent round arrays raise EstaError; an unknown weapon name raises EstaError.
     """
@@ -93,11 +107,18 @@ def snap_round(
         if array.shape != shape:
             raise EstaError(f"round {name} have shape {array.shape}, expected {shape}")
 
+    floor_z = np.full(shape, np.nan)
+    if physics is not None:
+        finite = np.isfinite(positions).all(axis=2)
+        lifted = positions[finite] + np.array([0.0, 0.0, _FLOOR_RAY_LIFT_M])
+        floor_z[finite] = physics.first_floor_below(lifted, _FLOOR_RAY_DEPTH_M)[0]
     paths = PathCache(graph)
     snaps: list[SnapResult] = []
     plans: list[PlayerPlan] = []
     for p in range(len(players)):
-        snap = snap_positions(graph, positions[p], alive[p], max_distance=max_distance)
+        snap = snap_positions(
+            graph, positions[p], alive[p], max_distance=max_distance, floor_z=floor_z[p]
+        )
         present = np.isfinite(positions[p]).all(axis=1)
         plan = build_plan(
             graph, snap.node, seconds, alive[p], weapons[p], present=present, paths=paths

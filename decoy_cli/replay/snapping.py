@@ -4,6 +4,12 @@ Every alive frame with a position is looked up in one batched `WaypointGraph.nea
 player on the upper floor of a two-floor spot never snaps to the floor below. Frames that cannot
 be snapped keep node -1 and error NaN, and say why in `status`, so they are counted, never
 silently dropped.
+
+Given the height of the world's floor under each position, frames more than `AIRBORNE_M` above
+it (a jump, a fall off a ledge) are not snapped either: a player in the air is at no waypoint,
+and the floor-aware lookup would put it on whatever lower floor lies nearest (a box beside the
+fall), a target the replay then has to detour to. The plan goes through those frames on the
+path between the frames before and after.
 """
 
 from __future__ import annotations
@@ -24,6 +30,10 @@ waypoint, and a jumping player about 1.2 m; a position farther than this from ev
 its floor is off the graph, and snapping it would invent a location.
 """
 
+AIRBORNE_M = 0.4
+"""Height above the world's floor from which a frame counts as in the air (a crouch-jump rises
+1.2 m; players on the nav world's floors stand within a few centimetres of them)."""
+
 WITHIN_M = 0.5
 """Snap error the summary counts as good (the share of frames within it is reported)."""
 
@@ -35,6 +45,7 @@ class SnapStatus(IntEnum):
     NOT_ALIVE = 1  # dead (or absent) in this frame: nothing to snap
     NO_POSITION = 2  # alive but without a finite position in the data
     NO_WAYPOINT = 3  # no waypoint on the position's floor within the snap distance
+    AIRBORNE = 4  # more than AIRBORNE_M above the world's floor: jumping or falling
 
 
 @dataclass(frozen=True)
@@ -72,11 +83,14 @@ def snap_positions(
     positions: np.ndarray,
     alive: np.ndarray,
     max_distance: float = DEFAULT_MAX_SNAP_M,
+    floor_z: np.ndarray | None = None,
 ) -> SnapResult:
     """Snap each alive frame's position (metres, shape (F, 3)) to its floor-aware nearest waypoint.
 
     `alive` is (F,) bool. Dead frames, frames without a finite position and positions with no
     waypoint on their floor within `max_distance` get node -1 and error NaN, with their reason.
+    `floor_z` (F,), the world's floor height under each position (NaN where none is known), marks
+    the frames in the air.
     """
     pos = np.asarray(positions, dtype=np.float64)
     alive = np.asarray(alive, dtype=bool)
@@ -94,7 +108,16 @@ def snap_positions(
     finite = np.isfinite(pos).all(axis=1)
     status[alive & ~finite] = SnapStatus.NO_POSITION
 
-    query = np.flatnonzero(alive & finite)
+    candidates = alive & finite
+    if floor_z is not None:
+        floor_z = np.asarray(floor_z, dtype=np.float64)
+        if floor_z.shape != (len(pos),):
+            raise EstaError(f"floor heights have shape {floor_z.shape}, expected ({len(pos)},)")
+        with np.errstate(invalid="ignore"):
+            airborne = candidates & (pos[:, 2] - floor_z > AIRBORNE_M)
+        status[airborne] = SnapStatus.AIRBORNE
+        candidates &= ~airborne
+    query = np.flatnonzero(candidates)
     if len(query):
         index, distance = graph.nearest(pos[query], max_distance=max_distance)
         found = index >= 0
