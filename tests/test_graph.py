@@ -363,3 +363,16 @@ def test_snap_quality_with_unsnapped_positions() -> None:
         quality = snap_quality(graph, between)
     assert quality.p95_3d == np.inf and np.isnan(quality.median_3d)
     assert quality.within_3d == 0.0
+
+
+def test_snap_quality_on_the_ground() -> None:
+    """With the floor under each position, the airborne ones are counted and left out of the
+    grounded share: a jump 1 m up is 1 m from its waypoint, not a gap in the graph."""
+    graph = two_floor_graph()
+    positions = np.array([[1.1, 1.0, 0.0], [3.0, 3.0, 0.2], [1.0, 1.0, 1.0], [1.0, 1.0, 0.9]])
+    floor = np.array([0.0, 0.0, 0.0, np.nan])  # the last floor is unknown: counted as ground
+    quality = snap_quality(graph, positions, floor_z=floor)
+    assert quality.airborne == 1
+    assert quality.within_3d == pytest.approx(0.5)
+    assert quality.grounded_within_3d == pytest.approx(2 / 3)
+    assert snap_quality(graph, positions).airborne is None

@@ -18,6 +18,8 @@ from decoy_cli.waypoints.plot import plot_graph
 from decoy_cli.waypoints.quality import esta_positions, snap_quality
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
+from decoy_cli.world.physics import PhysicsWorld
+from decoy_cli.world.world import World
 
 DEFAULT_OUT = Path("decoy-out") / "waypoints"
 
@@ -169,11 +171,17 @@ def build_waypoints(
         )
         console.print(f"plot written to {png}")
     if check_esta is not None:
-        _alignment(console, graph, result, check_esta, min_aligned)
+        _alignment(console, graph, result, world, check_esta, min_aligned)
 
 
-def _alignment(console: Console, graph, result, path: Path, min_aligned: float) -> None:
-    quality = snap_quality(graph, esta_positions(path), result.pruned_positions)
+def _alignment(
+    console: Console, graph, result, world: World, path: Path, min_aligned: float
+) -> None:
+    positions = esta_positions(path)
+    with PhysicsWorld(world) as physics:
+        lifted = positions + np.array([0.0, 0.0, 0.1])
+        floor_z = physics.first_floor_below(lifted, 4.0)[0] if len(positions) else None
+    quality = snap_quality(graph, positions, result.pruned_positions, floor_z=floor_z)
     table = Table(title=f"alignment: {quality.positions:,} alive positions of {path}")
     table.add_column("distance to waypoint")
     table.add_column("median (m)", justify="right")
@@ -182,6 +190,13 @@ def _alignment(console: Console, graph, result, path: Path, min_aligned: float) 
     table.add_row(
         "3-D", f"{quality.median_3d:.3f}", f"{quality.p95_3d:.3f}", f"{quality.within_3d:.2%}"
     )
+    if quality.grounded_within_3d is not None:
+        table.add_row(
+            f"3-D, on the ground ({quality.positions - quality.airborne:,})",
+            "",
+            "",
+            f"{quality.grounded_within_3d:.2%}",
+        )
     table.add_row(
         "horizontal",
         f"{quality.median_horizontal:.3f}",

@@ -20,7 +20,7 @@ from enum import IntEnum
 import numpy as np
 
 from decoy_cli.errors import EstaError, GraphError
-from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.graph import AIRBORNE_M, WaypointGraph
 
 DEFAULT_MAX_SNAP_M = 2.0
 """Farthest a position may lie from its waypoint (3-D, metres) and still snap.
@@ -29,10 +29,6 @@ The lattice spacing is 0.7 m, so a position on the graph's floors lies within ab
 waypoint, and a jumping player about 1.2 m; a position farther than this from every waypoint on
 its floor is off the graph, and snapping it would invent a location.
 """
-
-AIRBORNE_M = 0.4
-"""Height above the world's floor from which a frame counts as in the air (a crouch-jump rises
-1.2 m; players on the nav world's floors stand within a few centimetres of them)."""
 
 WITHIN_M = 0.5
 """Snap error the summary counts as good (the share of frames within it is reported)."""

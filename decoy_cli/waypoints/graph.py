@@ -60,6 +60,9 @@ class EdgeKind(IntEnum):
 # players at the foot of boxes snapped onto the box top.)
 SNAP_MAX_ABOVE_M = 0.4
 SNAP_MAX_BELOW_M = 1.25
+AIRBORNE_M = 0.4
+"""Height above the world's floor from which a position counts as in the air (a jump or a
+fall; a crouch-jump rises 1.2 m, players on the nav world's floors stand within centimetres)."""
 _Z_STRETCH = 4.0
 _CANDIDATES = 12
 

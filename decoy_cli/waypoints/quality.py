@@ -3,7 +3,9 @@
 Two distances are reported for every position: the 3-D distance to its floor-aware nearest
 waypoint, and the horizontal one. They differ for airborne players: about one real T position in
 ten is 0.4-1.1 m above the floor (jumps), so the 3-D figure mixes the data's jumps into the
-graph's coverage, while the horizontal one measures coverage alone.
+graph's coverage, while the horizontal one measures coverage alone. Given the world's floor
+height under each position, the 3-D share is also reported for the positions on the ground
+(at most `AIRBORNE_M` above the floor), which is the graph's coverage of where players stand.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.graph import AIRBORNE_M, WaypointGraph
 
 ALIGNED_WITHIN_M = 0.5
 
@@ -31,6 +33,8 @@ class SnapQuality:
     p95_horizontal: float
     within_horizontal: float
     on_pruned: float | None  # share whose nearest lattice node was pruned (None: not known)
+    airborne: int | None = None  # positions more than AIRBORNE_M above the floor (None: unknown)
+    grounded_within_3d: float | None = None  # within_3d over the positions on the ground
 
     def as_dict(self) -> dict[str, float | int | None]:
         return dict(self.__dict__)
@@ -41,8 +45,10 @@ def snap_quality(
     positions: np.ndarray,
     pruned_positions: np.ndarray | None = None,
     max_distance: float = 3.0,
+    floor_z: np.ndarray | None = None,
 ) -> SnapQuality:
-    """Snap every position (metres, (M, 3)) and summarise the distances."""
+    """Snap every position (metres, (M, 3)) and summarise the distances; `floor_z` (M,), the
+    world's floor height under each position (NaN: unknown), separates the airborne ones."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     index, dist = graph.nearest(positions, max_distance=max_distance)
     ok = index >= 0
@@ -86,7 +92,20 @@ def snap_quality(
         if len(horizontal)
         else float("nan"),
         on_pruned=on_pruned,
+        **_grounded(positions, dist, floor_z),
     )
+
+
+def _grounded(positions: np.ndarray, dist: np.ndarray, floor_z: np.ndarray | None) -> dict:
+    """The airborne count and the 3-D share within reach on the ground (none without floors)."""
+    if floor_z is None:
+        return {}
+    floor_z = np.asarray(floor_z, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        airborne = positions[:, 2] - floor_z > AIRBORNE_M
+    ground = dist[~airborne]
+    share = float(np.mean(ground <= ALIGNED_WITHIN_M)) if len(ground) else float("nan")
+    return {"airborne": int(airborne.sum()), "grounded_within_3d": share}
 
 
 def esta_positions(path: str | Path) -> np.ndarray:
