@@ -501,3 +501,35 @@ def test_a_round_without_frames_is_an_error(physics: PhysicsWorld) -> None:
     round_ = make_round([Track("t1", "T", [])], ticks=np.zeros(0, dtype=np.int64))
     with pytest.raises(EstaError, match="round 1 has no frames"):
         replay(round_, physics, "kinematic")
+
+
+class Misses:
+    """Test damage model: every visible pair misses (combat runs, nobody is hurt)."""
+
+    def __call__(self, batch, rng: np.random.Generator):
+        from decoy_cli.sim.combat import DamageResult
+
+        none = np.zeros(len(batch), dtype=np.int64)
+        return DamageResult(damage=none, hit_group=none - 1, hit=none.astype(bool))
+
+
+@pytest.mark.parametrize("play_out", [True, False])
+def test_an_undecided_round_is_played_out(physics: PhysicsWorld, play_out: bool) -> None:
+    """The data ends (10 s) with a T in T spawn and a CT in CT spawn, both alive, no plant:
+    played on, the clock ends the round at 115 s for the CT; not played on, it is undecided."""
+    frames = 21
+    ct_spot = int(builtin_graph().region_of("ct_spawn")[0])
+    round_ = make_round(
+        [
+            Track("t", "T", [node_at(STILL_SPOT)] * frames),
+            Track("ct", "CT", [ct_spot] * frames, weapons="M4A4"),
+        ]
+    )
+    options = ReplayOptions(combat=True, damage_model=Misses(), play_out=play_out)
+    result = replay_round(round_, builtin_graph(), physics, options)
+    assert result.recording.alive.all()  # the recording stays at the data's frames
+    if play_out:
+        assert (result.outcome.winner, result.outcome.reason) == ("CT", "TargetSaved")
+        assert result.played_out_s == pytest.approx(115.0 - round_.frame_seconds[-1], abs=0.1)
+    else:
+        assert result.outcome is None and result.played_out_s == 0.0

@@ -164,6 +164,7 @@ class ReplayResult:
     events: list[SimEvent] = field(default_factory=list)
     stuck: np.ndarray | None = None  # (P,) stuck episodes
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
+    played_out_s: float = 0.0  # game seconds simulated after the data's last frame (play_out)
 
     def lateness_table(self) -> pd.DataFrame:
         """Per player: share of targets reached late, p95 and max lateness (s), relocations."""
@@ -200,6 +201,13 @@ class ReplayOptions:
     # so the default is kinematic.
     mover: str = "kinematic"
     damage_model: Any = None  # a decoy_cli.sim.combat.DamageModel; None: no shooting
+    # With combat on, a round still undecided when the data ends (the replay's fights went
+    # otherwise than the real ones) is played on, every agent holding its last waypoint and
+    # planting or defusing where the data did, until the rules end it (elimination, the bomb,
+    # the clock). Real frames end at the round's end, so without this most replays of a
+    # combat round end "undecided" and outcome agreement measures nothing. The result says
+    # which outcomes were decided after the data (`ReplayResult.played_out_s`).
+    play_out: bool = True
     seed: int = 0
     map_name: str = "de_dust2"
 
@@ -318,7 +326,12 @@ def replay_round(
                     if weapon_frames[i, f]:
                         agents.weapon[i] = weapon_frames[i, f]
                         mover.set_max_speed(int(i), max_speed_m_s(str(weapon_frames[i, f])))
-
+        played_from = sim.tick
+        if options.play_out and combat is not None and not sim.done:
+            # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later
+            limit = max(sim.tick, rules.config.round_ticks) + rules.config.bomb_ticks + 1
+            while not sim.done and sim.tick < limit:
+                sim.step()
     finally:
         if combat is not None:
             combat.los.close()
@@ -334,6 +347,7 @@ def replay_round(
         events=sim.events,
         stuck=np.asarray(mover.stuck_events).copy(),
         recoveries=np.asarray(mover.recoveries).copy(),
+        played_out_s=(sim.tick - played_from) / TICK_RATE,
     )
 
 
