@@ -282,3 +282,14 @@ def test_mid_boxes_are_reached_from_mid_by_the_step() -> None:
     path = graph.shortest_path(int(floor), int(box))
     length = np.linalg.norm(np.diff(graph.positions[path], axis=0), axis=1).sum()
     assert length < 4.0
+
+
+def test_pybullet_imports_without_its_banner() -> None:
+    """pybullet prints "pybullet build time: ..." from C at import; users must not see it."""
+    import subprocess
+    import sys
+
+    code = "from decoy_cli.world.physics import load_pybullet; load_pybullet(); print('ok')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout == "ok\n"
+    assert "build time" not in done.stderr

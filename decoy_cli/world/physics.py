@@ -15,6 +15,7 @@ pybullet is the physics engine of the whole project; this module owns the pitfal
 
 from __future__ import annotations
 
+import ctypes
 import os
 import sys
 import tempfile
@@ -32,18 +33,28 @@ _MAX_VERTEX_ARRAY_TRIANGLES = 150_000
 
 
 def load_pybullet():
-    """Import pybullet without its "pybullet build time" banner on the terminal's stdout."""
+    """Import pybullet without its "pybullet build time" banner on the terminal.
+
+    The banner is a C-level print at import (to stderr, or stdout on some builds), so both file
+    descriptors point to /dev/null while pybullet is imported, and the C library's buffers are
+    flushed there before they are restored. A failed import still raises as usual.
+    """
     if "pybullet" in sys.modules:
         return sys.modules["pybullet"]
     sys.stdout.flush()
-    saved = os.dup(1)
+    sys.stderr.flush()
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
     try:
         with open(os.devnull, "w") as devnull:
-            os.dup2(devnull.fileno(), 1)
+            for fd in saved:
+                os.dup2(devnull.fileno(), fd)
             import pybullet
+
+            ctypes.CDLL(None).fflush(None)
     finally:
-        os.dup2(saved, 1)
-        os.close(saved)
+        for fd, copy in saved.items():
+            os.dup2(copy, fd)
+            os.close(copy)
     return pybullet
 
 
