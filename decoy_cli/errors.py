@@ -22,3 +22,11 @@ class EstaError(DecoyError):
 
 class OutputError(DecoyError):
     """An output path that cannot be written."""
+
+
+class ModelError(DecoyError):
+    """A damage model that cannot be used: missing, corrupt or incompatible files or inputs."""
+
+
+class DownloadError(DecoyError):
+    """A file that cannot be fetched or fails verification: HTTP error, timeout, short body."""

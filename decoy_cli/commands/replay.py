@@ -10,6 +10,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from decoy_cli.damage import load_damage_model
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import load_round
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
@@ -26,7 +27,7 @@ DEFAULT_OUT = Path("decoy-out") / "replay"
 def replay(
     address: str = typer.Argument(..., metavar="FILE:ROUND", help="The round, e.g. m.json.xz:3."),
     combat: bool = typer.Option(
-        True, "--combat/--no-combat", help="Shooting (needs a damage model; see --help of models)."
+        True, "--combat/--no-combat", help="Shooting, with the damage models of --models."
     ),
     bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
     mover: str = typer.Option(
@@ -42,6 +43,13 @@ def replay(
     ),
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
+    models: str = typer.Option(
+        "shipped",
+        "--models",
+        help='Damage models for shooting: "shipped" (decoy_cli/models), "none" (no shooting: '
+        "deaths in the data are scripted) or a model folder (e.g. from `decoy models "
+        "import-decoy`).",
+    ),
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
     console = Console()
@@ -51,7 +59,7 @@ def replay(
     if round_.map_name and round_.map_name != BUILTIN_MAP:
         raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
     graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
-    damage_model = None  # the learned damage models arrive with their own issue
+    damage_model = load_damage_model(models) if combat else None
     options = ReplayOptions(
         combat=combat and damage_model is not None,
         bomb=bomb,
@@ -61,8 +69,8 @@ def replay(
     )
     if combat and damage_model is None:
         console.print(
-            "[yellow]no damage model is available yet: replaying without shooting "
-            "(deaths in the data are scripted)[/yellow]"
+            "[yellow]--models none: replaying without shooting (deaths in the data are "
+            "scripted)[/yellow]"
         )
     started = time.perf_counter()
     with PhysicsWorld(nav_world()) as physics:
@@ -77,6 +85,8 @@ def replay(
         "match_id": round_.match_id,
         "round_num": round_.round_num,
         "options": {"combat": options.combat, "bomb": bomb, "mover": mover, "seed": seed},
+        "damage_models": models if options.combat else None,
+        "played_out_s": round(result.played_out_s, 3),
         "outcome_original": {"winner": real[0], "reason": real[1]},
         "outcome_replay": {"winner": simulated[0], "reason": simulated[1]},
         "frames": int(round_.num_frames),
@@ -108,9 +118,13 @@ def replay(
     outcome.add_column("winner")
     outcome.add_column("reason")
     outcome.add_row("original", str(real[0] or "not recorded"), str(real[1] or "not recorded"))
-    outcome.add_row(
-        "replay", str(simulated[0] or "undecided"), str(simulated[1] or "end of the data")
-    )
+    if result.outcome is None:
+        replayed = ("undecided", "end of the data")
+    elif result.played_out_s > 0:
+        replayed = (simulated[0], f"{simulated[1]} ({result.played_out_s:.1f} s after the data)")
+    else:
+        replayed = simulated
+    outcome.add_row("replay", *map(str, replayed))
     console.print(outcome)
     for title, names in (
         ("clock protocol", METRIC_NAMES_CLOCK),

@@ -1,4 +1,4 @@
-"""Event lists of one round (damages, kills, bomb events) as typed pandas DataFrames.
+"""Event lists of one round (damages, kills, bomb events, flashes) as typed pandas DataFrames.
 
 Columns are the awpy 1.x ones of decoy_cli/esta/schema.py, in that order, whatever keys a file
 has (a missing key gives nulls, an unknown key is dropped). Dtypes: nullable `Int64` for counts,

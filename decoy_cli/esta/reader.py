@@ -41,6 +41,7 @@ from decoy_cli.esta.frames import PlayerInfo, Side, build_frames
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
     DAMAGE_COLUMNS,
+    FLASH_COLUMNS,
     KILL_COLUMNS,
     Invalid,
     RoundState,
@@ -59,7 +60,8 @@ class Round:
     absent), `hp` and `armor` int16 (-1 where absent or null), `helmet`, `has_defuser`, `alive`,
     `present`, `has_bomb` bool (False where absent), `weapon` str ("" where none or absent).
     Per-frame: `frame_ticks` int64, `frame_seconds` float64, `bomb_position` (F, 3) metres (NaN
-    when null), `bomb_planted` bool, `bombsite` str. Events: `damages`, `kills`, `bomb_events`.
+    when null), `bomb_planted` bool, `bombsite` str. Events: `damages`, `kills`, `bomb_events`,
+    `flashes` (attacker = the thrower, player = the flashed player).
     `start_tick`/`end_tick` fall back to the first/last frame tick when null (None if no frames).
     """
 
@@ -87,6 +89,7 @@ class Round:
     damages: pd.DataFrame
     kills: pd.DataFrame
     bomb_events: pd.DataFrame
+    flashes: pd.DataFrame
     winning_side: Side | None
     end_reason: str | None
     bomb_plant_tick: int | None
@@ -261,6 +264,7 @@ def _build_round(
         damages=build_table("damages", state.damages, DAMAGE_COLUMNS, ticks),
         kills=build_table("kills", state.kills, KILL_COLUMNS, ticks),
         bomb_events=build_table("bomb_events", state.bombEvents, BOMB_EVENT_COLUMNS, ticks),
+        flashes=build_table("flashes", state.flashes, FLASH_COLUMNS, ticks),
         winning_side=winning_side,
         end_reason=state.roundEndReason or None,
         bomb_plant_tick=_optional_int(state.bombPlantTick, "bombPlantTick"),

@@ -174,6 +174,32 @@ BOMB_EVENT_COLUMNS: dict[str, Kind] = {
 }
 """Bomb event columns, in the awpy 1.x order."""
 
+FLASH_COLUMNS: dict[str, Kind] = {
+    "tick": "int",
+    "seconds": "float",
+    "clockTime": "str",
+    "attackerSteamID": "steamid",
+    "attackerName": "str",
+    "attackerTeam": "str",
+    "attackerSide": "str",
+    "attackerX": "float",
+    "attackerY": "float",
+    "attackerZ": "float",
+    "attackerViewX": "float",
+    "attackerViewY": "float",
+    "playerSteamID": "steamid",
+    "playerName": "str",
+    "playerTeam": "str",
+    "playerSide": "str",
+    "playerX": "float",
+    "playerY": "float",
+    "playerZ": "float",
+    "playerViewX": "float",
+    "playerViewY": "float",
+    "flashDuration": "float",
+}
+"""Flash events (attacker = thrower, player = the flashed player), in the awpy 1.x order."""
+
 
 def _event_struct(name: str, columns: dict[str, Kind]) -> type[msgspec.Struct]:
     """A struct with one optional field per column, typed as the column kind decodes."""
@@ -185,6 +211,7 @@ def _event_struct(name: str, columns: dict[str, Kind]) -> type[msgspec.Struct]:
 DamageEvent = _event_struct("DamageEvent", DAMAGE_COLUMNS)
 KillEvent = _event_struct("KillEvent", KILL_COLUMNS)
 BombEvent = _event_struct("BombEvent", BOMB_EVENT_COLUMNS)
+FlashEvent = _event_struct("FlashEvent", FLASH_COLUMNS)
 
 
 class RoundHead(msgspec.Struct):
@@ -207,3 +234,4 @@ class RoundState(msgspec.Struct):
     damages: list[DamageEvent] | None = None
     kills: list[KillEvent] | None = None
     bombEvents: list[BombEvent] | None = None
+    flashes: list[FlashEvent] | None = None

@@ -21,6 +21,7 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from decoy_cli.csgo import TICK_RATE
+from decoy_cli.damage import load_damage_model
 from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
 from decoy_cli.sim.engine import Decision, SimConfig, Simulator
 from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
@@ -161,10 +162,14 @@ class DecoyParallelEnv(ParallelEnv):
     and the simulator's seed (combat randomness); `reset()` without a seed continues it. The
     same seed and actions give the same round with either mover.
 
+    Combat: `damage_model` is a `DamageModel` (decoy_cli/sim/combat.py) or a model choice for
+    `decoy_cli.damage.load_damage_model`: "shipped", "none" or the path of a model folder (DIP
+    and DOG, e.g. written by `decoy models import-decoy`). None or "none": no combat, and agents
+    never die.
+
     pybullet: the physics mover and combat (`damage_model`) need a pybullet client with the
     world (`world`, default the built-in nav world); it is created at each reset and the
-    previous round's client is disconnected, and `close()` disconnects it. No damage model
-    ships with the simulator yet: without one there is no combat, and agents never die.
+    previous round's client is disconnected, and `close()` disconnects it.
 
     Rendering: `render_mode="rgb_array"` gives a top-down matplotlib picture (waypoints grey,
     T orange, CT blue, dead agents light grey, the bomb a red star).
@@ -179,7 +184,7 @@ class DecoyParallelEnv(ParallelEnv):
         graph: WaypointGraph | None = None,
         world: World | None = None,
         mover: str = "kinematic",
-        damage_model: DamageModel | None = None,
+        damage_model: DamageModel | str | None = None,
         bomb: bool = True,
         stop_seconds: float = 0.5,
         weapons: Mapping[str, str] | None = None,
@@ -199,7 +204,9 @@ class DecoyParallelEnv(ParallelEnv):
         self.graph = builtin_graph() if graph is None else graph
         self.world = world
         self.mover_kind = mover
-        self.damage_model = damage_model
+        self.damage_model = (
+            load_damage_model(damage_model) if isinstance(damage_model, str) else damage_model
+        )
         self.bomb = bool(bomb)
         self.render_mode = render_mode
         self.n_t, self.n_ct = int(n_t), int(n_ct)

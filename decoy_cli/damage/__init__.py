@@ -1,0 +1,58 @@
+"""Learned damage models, DIP and DOG (the paper's combat), with torch imported lazily.
+
+* features.py: the model inputs, built in one place for training and simulation (numpy only);
+* networks.py: DipNet and DogNet (torch);
+* model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
+* paper.py: import of the paper's published checkpoints;
+* combat.py: `LearnedDamage`, the simulator's `DamageModel` over a DIP and a DOG.
+
+Importing this package does not import torch; `load_damage_model` does, when it loads a model.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from decoy_cli.errors import ModelError
+
+if TYPE_CHECKING:
+    from decoy_cli.sim.combat import DamageModel
+
+SHIPPED_MODELS = Path(__file__).resolve().parents[1] / "models"
+"""The project's own trained DIP and DOG, shipped inside the package."""
+
+CHOICES_HELP = '"shipped" (the models in decoy_cli/models), "none" (no shooting) or a model folder'
+
+
+def shipped_models_installed() -> bool:
+    """True when the package holds its trained DIP and DOG."""
+    return (SHIPPED_MODELS / "dip.json").is_file() and (SHIPPED_MODELS / "dog.json").is_file()
+
+
+def load_damage_model(choice: str) -> DamageModel | None:
+    """The damage model a user chose: "shipped", "none" (None: no shooting) or the path of a
+    model folder holding both DIP and DOG (e.g. written by `decoy models import-decoy`).
+
+    A missing or incompatible folder is one ModelError line.
+    """
+    if choice == "none":
+        return None
+    if choice == "shipped":
+        folder = SHIPPED_MODELS
+        if not shipped_models_installed():
+            raise ModelError(
+                f"no shipped damage models in {folder}: pass a model folder "
+                "(e.g. from `decoy models import-decoy`) or none"
+            )
+    else:
+        folder = Path(choice).expanduser()
+        if not folder.is_dir():
+            raise ModelError(f"{choice}: no such model folder (expected {CHOICES_HELP})")
+    from decoy_cli.damage.combat import LearnedDamage
+    from decoy_cli.damage.model_folder import load_dip, load_dog
+
+    return LearnedDamage(load_dip(folder), load_dog(folder))
+
+
+__all__ = ["CHOICES_HELP", "SHIPPED_MODELS", "load_damage_model", "shipped_models_installed"]
