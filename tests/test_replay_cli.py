@@ -77,7 +77,9 @@ def _invoke(*args: str):
 
 def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    result = _invoke(f"{match_file}:1", "--mover", "kinematic", "--out", str(out), "--gif")
+    result = _invoke(
+        f"{match_file}:1", "--mover", "kinematic", "--no-combat", "--out", str(out), "--gif"
+    )
     assert result.exit_code == 0, result.output
     for name in (*REPLAY_FILES, "round.gif"):
         assert (out / name).stat().st_size > 0, name
@@ -118,10 +120,11 @@ def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_pat
 
 def test_physics_mover_without_the_bomb(match_file: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    result = _invoke(f"{match_file}:2", "--mover", "physics", "--no-bomb", "--out", str(out))
+    args = (f"{match_file}:2", "--mover", "physics", "--no-bomb", "--models", "none")
+    result = _invoke(*args, "--out", str(out))
     assert result.exit_code == 0, result.output
     assert "physics mover, combat off, bomb off" in result.stdout
-    assert "no damage model" in result.stdout  # combat was asked for: the user is told
+    assert "--models none" in result.stdout  # combat was asked for: the user is told
     assert not (out / "round.gif").exists()
     summary = json.loads((out / "summary.json").read_text())
     assert summary["options"]["bomb"] is False and summary["options"]["mover"] == "physics"
@@ -190,3 +193,23 @@ def test_a_real_round(tmp_path: Path) -> None:
     assert per_player["mean_dist"].astype(float).max() < 5.0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["frames"] == round_.num_frames and summary["match_id"] == match.match_id
+
+
+SAMPLE = (
+    Path(__file__).resolve().parents[1] / "examples" / "sample" / "synthetic-dust2-seed0.json.xz"
+)
+
+
+def test_replay_shoots_with_the_shipped_models_and_decides_the_round(tmp_path: Path) -> None:
+    """By default the replay shoots with the shipped DIP and DOG; a round the data leaves open
+    is played on until the rules end it, and the summary says so."""
+    out = tmp_path / "out"
+    result = _invoke(f"{SAMPLE}:2", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert "combat on" in result.stdout
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["damage_models"] == "shipped"
+    assert summary["outcome_replay"]["winner"] in ("T", "CT")
+    assert summary["played_out_s"] >= 0
+    events = pd.read_csv(out / "events.csv")
+    assert "damage" in set(events["kind"])

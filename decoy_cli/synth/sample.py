@@ -1,0 +1,164 @@
+"""The synthetic ESTA sample: scripted rounds played in the simulator, written as one match file.
+
+No real ESTA file may ship with the project, so `decoy evaluate` has a built-in sample made here:
+`play_match` plays `rounds` scripted 5-on-5 rounds on the built-in de_dust2 graph (strategies
+and loadouts drawn from `numpy.random.default_rng([seed, round])`, combat through the given
+damage model, bomb rules on) and `write_sample` writes them as `synthetic-dust2-seed<N>.json.xz`.
+The file says what it is: matchID `synthetic-dust2-seed<N>`, clientName `decoy make-sample`,
+and a top-level `provenance` key (as the real T-side files have) with `"synthetic": true`, the
+command that made it and what it does and does not record. Same seed and damage model, same
+bytes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from decoy_cli import __version__
+from decoy_cli.esta.writer import MatchRecord, write_match
+from decoy_cli.sim.combat import DamageModel
+from decoy_cli.sim.rules import SiteZones
+from decoy_cli.synth.loadouts import buy_kind, side_loadouts
+from decoy_cli.synth.player import DEMO_TICK_RATE, PlayedRound, Team, play_round
+from decoy_cli.synth.routes import TEAM_SIZE, Places, plan_round
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.navmesh import BUILTIN_MAP, nav_world
+from decoy_cli.world.physics import PhysicsWorld
+
+MAX_ROUNDS = 30
+HALF_ROUNDS = 15
+CLIENT_NAME = "decoy make-sample"
+TEAM = Team(
+    names=tuple(f"{side}-{k}" for side in ("T", "CT") for k in range(1, TEAM_SIZE + 1)),
+    steam_ids=tuple(range(11, 11 + TEAM_SIZE)) + tuple(range(21, 21 + TEAM_SIZE)),
+    sides=("T",) * TEAM_SIZE + ("CT",) * TEAM_SIZE,
+)
+"""The ten synthetic players. Their steamIDs (11-15 T, 21-25 CT: two digits, so the reader's
+order by steamID string is T-1..T-5, CT-1..CT-5) are no real account's (real steamID64s are
+above 7.6e16), so nothing can be mistaken for a real player."""
+
+TEAM_NAMES = {"T": "Synthetic T", "CT": "Synthetic CT"}
+
+
+def sample_match_id(seed: int) -> str:
+    return f"synthetic-dust2-seed{seed}"
+
+
+def sample_file_name(seed: int) -> str:
+    return f"{sample_match_id(seed)}.json.xz"
+
+
+@dataclass
+class SampleMatch:
+    """The played match: what is written, and each round as played."""
+
+    match: MatchRecord
+    rounds: list[PlayedRound]
+
+
+def play_match(
+    rounds: int,
+    seed: int,
+    damage_model: DamageModel | None,
+    models_label: str,
+    graph: WaypointGraph | None = None,
+    on_round: Callable[[PlayedRound], None] | None = None,
+) -> SampleMatch:
+    """Play `rounds` scripted rounds; `models_label` names the damage model in the provenance
+    (e.g. "shipped" or "none"); `on_round` is called after each round (progress)."""
+    if not 1 <= rounds <= MAX_ROUNDS:
+        raise ValueError(f"a match has 1 to {MAX_ROUNDS} rounds, not {rounds}")
+    if seed < 0:
+        raise ValueError(f"the seed must be >= 0, not {seed}")
+    graph = builtin_graph() if graph is None else graph
+    places = Places(graph)
+    zones = SiteZones.from_graph(graph)
+    physics = PhysicsWorld(nav_world()) if damage_model is not None else None
+    played: list[PlayedRound] = []
+    cursor = 0
+    previous_winner: str | None = None
+    try:
+        for k in range(rounds):
+            rng = np.random.default_rng([seed, k + 1])
+            plan = plan_round(places, zones, rng)
+            buys = {
+                side: buy_kind(k, side, previous_winner, HALF_ROUNDS, rng) for side in ("T", "CT")
+            }
+            loadouts = side_loadouts("T", buys["T"], TEAM_SIZE, rng) + side_loadouts(
+                "CT", buys["CT"], TEAM_SIZE, rng
+            )
+            result = play_round(
+                graph,
+                places,
+                zones,
+                plan,
+                loadouts,
+                TEAM,
+                round_num=k + 1,
+                start_tick=cursor,
+                seed=int(rng.integers(2**63)),
+                damage_model=damage_model,
+                physics=physics,
+                buys=buys,
+            )
+            played.append(result)
+            cursor = result.record.end_official_tick
+            previous_winner = result.record.winning_side
+            if on_round is not None:
+                on_round(result)
+    finally:
+        if physics is not None:
+            physics.close()
+    match = MatchRecord(
+        match_id=sample_match_id(seed),
+        map_name=BUILTIN_MAP,
+        tick_rate=DEMO_TICK_RATE,
+        rounds=[r.record for r in played],
+        team_names=TEAM_NAMES,
+        provenance=provenance(rounds, seed, models_label, combat=damage_model is not None),
+        client_name=CLIENT_NAME,
+    )
+    return SampleMatch(match, played)
+
+
+def provenance(rounds: int, seed: int, models_label: str, combat: bool) -> dict[str, Any]:
+    """The `provenance` key of a sample file: synthetic, how it was made, what it holds."""
+    return {
+        "synthetic": True,
+        "generator": CLIENT_NAME,
+        "command": f"decoy make-sample --rounds {rounds} --seed {seed} --models {models_label}",
+        "decoy_version": __version__,
+        "seed": seed,
+        "damage_models": models_label,
+        "combat": combat,
+        "note": (
+            "Not real CS:GO data: scripted rounds played in decoy's simulator on the de_dust2 "
+            "waypoint graph (both teams on plausible routes, bomb rules on, combat "
+            f"{'on' if combat else 'off'}), written in the ESTA (awpy 1.x) format."
+        ),
+        "recorded": (
+            "both teams' players at 2 frames per second, bomb, damages, kills, bomb events, "
+            "round winners and end reasons"
+        ),
+        "not_recorded": "grenades, weapon fires, flashes, cash, ammunition, armor damage",
+    }
+
+
+def write_sample(
+    out_dir: str | Path,
+    rounds: int,
+    seed: int,
+    damage_model: DamageModel | None,
+    models_label: str,
+    on_round: Callable[[PlayedRound], None] | None = None,
+) -> tuple[Path, SampleMatch]:
+    """Play the sample and write it to `out_dir/synthetic-dust2-seed<seed>.json.xz`."""
+    sample = play_match(rounds, seed, damage_model, models_label, on_round=on_round)
+    path = write_match(sample.match, Path(out_dir) / sample_file_name(seed))
+    return path, sample
