@@ -6,7 +6,8 @@ Times, after JIT warm-up, the exact DTW and discrete Fréchet kernels on a 310 x
 longest ESTA rounds at 2 Hz) and on the paper protocol's 451 x 451 pair, `similaritymeasures` on
 the same pair for comparison (a few repeats: it is slow), and the throughput of
 `trajectory_metrics` (all ten metrics, both protocols) on synthetic player-rounds of realistic
-length (150-300 frames, random walks at running speed with an early death in some rounds).
+length (150-300 frames, random walks at running speed with an early death in some rounds): the
+same measurement as the metric section of `decoy bench` (`decoy_cli.bench.metrics`).
 """
 
 from __future__ import annotations
@@ -22,9 +23,8 @@ import numba
 import numpy as np
 import similaritymeasures
 
-from decoy_cli.metrics import dtw, frechet, trajectory_metrics
-
-RUN_SPEED_M_PER_FRAME = 2.4  # ~250 u/s at 2 Hz frames
+from decoy_cli.bench.metrics import metric_throughput, walk
+from decoy_cli.metrics import dtw, frechet
 
 
 def time_calls(call: Callable[[], object], repeats: int) -> list[float]:
@@ -35,34 +35,6 @@ def time_calls(call: Callable[[], object], repeats: int) -> list[float]:
         call()
         times.append(time.perf_counter() - start)
     return times
-
-
-def walk(rng: np.random.Generator, frames: int) -> np.ndarray:
-    """A random walk in the x-y plane at running speed, with a little height variation."""
-    heading = np.cumsum(rng.normal(scale=0.4, size=frames))
-    step = RUN_SPEED_M_PER_FRAME * rng.uniform(0.3, 1.0, size=frames)
-    xy = np.cumsum(np.c_[np.cos(heading) * step, np.sin(heading) * step], axis=0)
-    z = np.cumsum(rng.normal(scale=0.05, size=frames))
-    return np.c_[xy, z]
-
-
-def player_rounds(
-    rng: np.random.Generator, count: int
-) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """Synthetic (original, alive, simulated, alive) player-rounds of 150-300 frames."""
-    rounds = []
-    for _ in range(count):
-        frames = int(rng.integers(150, 301))
-        original = walk(rng, frames)
-        simulated = original + np.cumsum(rng.normal(scale=0.3, size=(frames, 3)), axis=0)
-        original_alive = np.ones(frames, dtype=bool)
-        simulated_alive = np.ones(frames, dtype=bool)
-        if rng.random() < 0.5:
-            original_alive[int(rng.integers(frames // 3, frames)) :] = False
-        if rng.random() < 0.5:
-            simulated_alive[int(rng.integers(frames // 3, frames)) :] = False
-        rounds.append((original, original_alive, simulated, simulated_alive))
-    return rounds
 
 
 def row(label: str, times: list[float]) -> str:
@@ -111,17 +83,12 @@ def main() -> None:
         f"|frechet - oracle| = {abs(frechet(a, b) - similaritymeasures.frechet_dist(a, b)):.3g}"
     )
 
-    rounds = player_rounds(rng, args.pairs)
-    trajectory_metrics(*rounds[0])  # warm-up
-    start = time.perf_counter()
-    evaluated = sum(trajectory_metrics(*r).reason is None for r in rounds)
-    elapsed = time.perf_counter() - start
-    mean_frames = np.mean([r[0].shape[0] for r in rounds])
+    result = metric_throughput(args.pairs, seed=1)
     print(
-        f"trajectory_metrics (10 metrics, both protocols): {len(rounds)} player-rounds "
-        f"(mean {mean_frames:.0f} frames, {evaluated} evaluated) in {elapsed:.3f} s = "
-        f"{len(rounds) / elapsed:.0f} player-rounds/s ({elapsed / len(rounds) * 1e3:.3f} ms each), "
-        "1 thread"
+        f"trajectory_metrics (10 metrics, both protocols): {result['pairs']} player-rounds "
+        f"(mean {result['mean_frames']:.0f} frames, {result['evaluated']} evaluated) in "
+        f"{result['wall_s']:.3f} s = {result['pairs_per_s']:.0f} player-rounds/s "
+        f"({result['ms_per_pair']:.3f} ms each), 1 thread"
     )
 
 

@@ -1,0 +1,227 @@
+"""`decoy bench` as data: the sections, their sizes, one fresh process each, and the report.
+
+Every section runs in its own spawned process, so that its peak memory is its own and one
+section's caches do not speed up the next. The peak is VmHWM (see `machine.peak_rss_mb`): a
+spawned process's ru_maxrss starts at its parent's RSS on Linux; it is reported beside it.
+
+The damage model is checked once in the calling process (`check_damage_model`); a model that
+cannot be loaded is reported and the sections fall back to line of sight without inference
+(`NeverHits`), labelled as such.
+"""
+
+from __future__ import annotations
+
+import datetime
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from decoy_cli import __version__
+from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
+from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
+from decoy_cli.bench.simspeed import (
+    AGENT_COUNTS,
+    MOVERS,
+    PAPER_DECISIONS,
+    PAPER_TICKS_PER_S,
+    NeverHits,
+    speed_table,
+)
+from decoy_cli.errors import DecoyError
+
+REPORT_FORMAT = 1
+
+SECTIONS = ("table1", "combat_step", "replay", "metrics", "reader")
+"""Section keys of the report, in the order they run."""
+
+DATA_SECTIONS = ("replay", "reader")
+"""Sections that need match files; skipped, with the reason, when there are none."""
+
+MODEL_SECTIONS = ("table1", "combat_step", "replay")
+"""Sections that run the damage model (the others do not load it, nor torch)."""
+"""Sections that need match files; skipped, with the reason, when there are none."""
+
+PAPER = "DECOY paper (Wang, Ustun, McGroarty, WSC 2025), Table 1"
+
+
+@dataclass(frozen=True)
+class BenchConfig:
+    """What to run and how much of it: the full benchmark, or a quick smoke run."""
+
+    quick: bool
+    models: str
+    mover: str = "physics"
+    seed: int = 0
+    agent_counts: tuple[int, ...] = AGENT_COUNTS
+    decisions: int = PAPER_DECISIONS
+    combat_repeats: int = 300
+    replay_rounds: int | None = None
+    metric_pairs: int = 2000
+    reader_files: int | None = None
+
+    @classmethod
+    def create(cls, quick: bool, models: str, mover: str = "physics", seed: int = 0):
+        """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
+        round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
+        if mover not in MOVERS:
+            raise DecoyError(f"--mover must be one of {', '.join(MOVERS)}, not {mover!r}")
+        if not quick:
+            return cls(quick=False, models=models, mover=mover, seed=seed)
+        return cls(
+            quick=True,
+            models=models,
+            mover=mover,
+            seed=seed,
+            agent_counts=(2, 10),
+            decisions=1_000,
+            combat_repeats=20,
+            replay_rounds=3,
+            metric_pairs=100,
+            reader_files=2,
+        )
+
+
+@dataclass(frozen=True)
+class ModelStatus:
+    """The damage model the sections use, as the report states it."""
+
+    choice: str
+    loaded: bool
+    label: str
+    error: str | None = None
+
+
+def check_damage_model(choice: str) -> ModelStatus:
+    """Try to load the chosen damage model; on failure say why (the sections fall back)."""
+    from decoy_cli.damage import load_damage_model
+
+    if choice == "none":
+        return ModelStatus(choice, False, "none (--models none): line of sight only, no inference")
+    try:
+        model = load_damage_model(choice)
+    except DecoyError as error:
+        return ModelStatus(
+            choice,
+            False,
+            "none (loading failed): line of sight only, no inference",
+            error=str(error),
+        )
+    if model is None:
+        return ModelStatus(choice, False, "none: line of sight only, no inference")
+    return ModelStatus(choice, True, f"learned DIP + DOG ({choice})")
+
+
+def run_section(name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None):
+    """Run one section in this process; its result with wall time and peak memory."""
+    from decoy_cli.bench.combat import step_costs
+    from decoy_cli.bench.metrics import metric_throughput
+
+    model = None
+    if status.loaded and name in MODEL_SECTIONS:
+        from decoy_cli.damage import load_damage_model
+
+        model = load_damage_model(status.choice)
+    started = time.perf_counter()
+    result: dict[str, Any]
+    if name == "table1":
+        rows = speed_table(config.agent_counts, config.decisions, model, config.mover, config.seed)
+        result = {
+            "mover": config.mover,
+            "decisions_per_row": config.decisions,
+            "damage_model": status.label,
+            "paper": {"source": PAPER, "ticks_per_s": PAPER_TICKS_PER_S},
+            "rows": [row.to_dict() for row in rows],
+        }
+    elif name == "combat_step":
+        rows = step_costs(model or NeverHits(), 5, config.combat_repeats, config.seed)
+        result = {"damage_model": status.label, "rows": rows}
+    elif name == "replay":
+        data = _needed(data, name)
+        result = replay_throughput(data.files, config.replay_rounds, model, config.seed)
+        result |= {"data": data.describe(), "damage_model": status.label if model else None}
+    elif name == "metrics":
+        result = metric_throughput(config.metric_pairs, config.seed)
+    elif name == "reader":
+        data = _needed(data, name)
+        files = data.files[: config.reader_files] if config.reader_files else data.files
+        result = reader_throughput(files) | {"data": data.describe()}
+    else:
+        raise ValueError(f"no bench section {name!r}; the sections are {', '.join(SECTIONS)}")
+    return result | {
+        "section_wall_s": time.perf_counter() - started,
+        "peak_rss_mb": peak_rss_mb(),
+        "ru_maxrss_mb": ru_maxrss_mb(),
+    }
+
+
+def _needed(data: BenchData | None, name: str) -> BenchData:
+    if data is None:
+        raise ValueError(f"the {name} section needs match files")
+    return data
+
+
+def _quiet_process() -> None:
+    """Start a section process with stdout on /dev/null (its results go back as data) and
+    pybullet imported without its banner (see `load_pybullet`)."""
+    from decoy_cli.world.physics import load_pybullet
+
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.close(devnull)
+    load_pybullet()
+
+
+def run_isolated(
+    name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None
+) -> dict[str, Any]:
+    """`run_section` in a fresh spawned process; a failure becomes {"error": one line}."""
+    if name in DATA_SECTIONS and data is None:
+        return {
+            "skipped": "no match files: neither the real data "
+            "(../shared/data/esta_dust2_tside) nor the sample (examples/sample/) exists; "
+            "pass --data FOLDER"
+        }
+    context = multiprocessing.get_context("spawn")
+    try:
+        with ProcessPoolExecutor(
+            max_workers=1, mp_context=context, initializer=_quiet_process
+        ) as pool:
+            return pool.submit(run_section, name, config, status, data).result()
+    except DecoyError as error:
+        return {"error": str(error)}
+    except BrokenProcessPool:
+        return {"error": f"the {name} process died (killed, or crashed in native code)"}
+
+
+def report(
+    config: BenchConfig,
+    status: ModelStatus,
+    data: BenchData | None,
+    sections: dict[str, dict[str, Any]],
+    machine: dict[str, Any],
+) -> dict[str, Any]:
+    """The whole benchmark as one JSON-ready document; `machine` as `machine_info()` said at
+    the start (the load average at the end is added)."""
+    return {
+        "format": REPORT_FORMAT,
+        "decoy": __version__,
+        "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "quick": config.quick,
+        "config": {k: v for k, v in asdict(config).items() if k != "models"},
+        "machine": machine,
+        "load_average_end": load_average(),
+        "damage_model": asdict(status),
+        "data": data.describe() if data is not None else None,
+        "sections": sections,
+        "peak_rss_mb_main": peak_rss_mb(),
+        "ru_maxrss_mb_main": ru_maxrss_mb(),
+    }
+
+
+def failed_sections(sections: dict[str, dict[str, Any]]) -> list[str]:
+    """Names of the sections that ended in an error."""
+    return [name for name, result in sections.items() if "error" in result]

@@ -1,0 +1,185 @@
+"""Simulator speed as in the DECOY paper's Table 1: physics ticks per second by agent count.
+
+Agents (half T, half CT) start at random waypoints of their spawns and take random valid actions
+(a STOP holds 0.5 s) until the requested number of agent decisions, headless, with every
+mechanic on: the mover, the bomb rules, and the combat step every 30 ticks (batched line of
+sight between all alive enemy pairs, then the damage model on the visible pairs). Rounds that
+end (time, bomb, or elimination once the model kills) are restarted with new agents until the
+decision count is reached; every restart is inside the timed run, as in the paper's loop.
+
+Without a damage model the combat step runs line of sight and batch building with `NeverHits`,
+a model that never hits: its rows leave out the cost of inference and must say so.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from decoy_cli.csgo import TICK_RATE
+from decoy_cli.sim.combat import CombatBatch, CombatStep, DamageModel, DamageResult, LineOfSight
+from decoy_cli.sim.engine import Decision, SimConfig, Simulator
+from decoy_cli.sim.movement import KinematicMover, PhysicsMover
+from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
+from decoy_cli.sim.state import Agents
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.world.navmesh import nav_world
+from decoy_cli.world.physics import PhysicsWorld
+
+AGENT_COUNTS = (2, 6, 10, 20, 100)
+"""The paper's Table 1 rows."""
+
+PAPER_DECISIONS = 10_000
+"""Agent decisions per row in the paper's Table 1."""
+
+PAPER_TICKS_PER_S: dict[int, float | None] = {2: 4322.0, 6: None, 10: 966.0, 20: 487.0, 100: 99.6}
+"""The paper's physics ticks per second by agent count (None: no value recorded here)."""
+
+MOVERS = ("physics", "kinematic")
+
+
+class NeverHits:
+    """A damage model under which no pair is hit: the combat step without inference."""
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        k = len(batch)
+        return DamageResult(np.zeros(k, np.int64), np.full(k, -1, np.int8), np.zeros(k, bool))
+
+
+class RandomPolicy:
+    """A random valid action per decision; STOP holds 0.5 s and plants where it can."""
+
+    def __init__(self, rng: np.random.Generator) -> None:
+        self.rng = rng
+
+    def decide(self, sim: Simulator, agent: int) -> Decision:
+        mask = sim.graph.action_mask(int(sim.agents.node[agent]))
+        action = int(self.rng.choice(np.flatnonzero(mask)))
+        return Decision(action, hold_ticks=30, plant=action == STOP_ACTION)
+
+
+@dataclass
+class SpeedRow:
+    """One Table 1 row: totals over the restarted rounds of one agent count."""
+
+    agents: int
+    mover: str
+    rounds: int
+    ticks: int
+    decisions: int
+    kills: int
+    wall_s: float
+    cpu_s: float
+    game_s: float
+    ticks_per_s: float
+    time_scale: float
+    paper_ticks_per_s: float | None
+    ratio_to_paper: float | None
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _spawn_agents(graph: WaypointGraph, count: int, rng: np.random.Generator) -> Agents:
+    """count // 2 T at T-spawn waypoints, the rest CT at CT-spawn waypoints, rifles."""
+    n_t = count // 2
+    t_nodes = rng.choice(graph.region_of("t_spawn"), n_t, replace=False)
+    ct_nodes = rng.choice(graph.region_of("ct_spawn"), count - n_t, replace=False)
+    nodes = np.concatenate([t_nodes, ct_nodes])
+    return Agents.create(
+        names=[f"t_{i}" for i in range(n_t)] + [f"ct_{i}" for i in range(count - n_t)],
+        sides=["T"] * n_t + ["CT"] * (count - n_t),
+        positions=graph.positions[nodes],
+        nodes=nodes,
+        weapons=["AK-47"] * n_t + ["M4A4"] * (count - n_t),
+    )
+
+
+def run_agents(
+    physics: PhysicsWorld,
+    graph: WaypointGraph,
+    count: int,
+    decisions: int,
+    model: DamageModel,
+    mover: str = "physics",
+    seed: int = 0,
+) -> SpeedRow:
+    """Play restarted rounds of `count` agents until `decisions` agent decisions (module doc)."""
+    if mover not in MOVERS:
+        raise ValueError(f"mover must be one of {MOVERS}, not {mover!r}")
+    if count < 2:
+        raise ValueError(f"a round needs at least 2 agents, not {count}")
+    rng = np.random.default_rng(seed)
+    zones = SiteZones.from_graph(graph)
+    ticks = rounds = made = kills = 0
+    los = LineOfSight(physics, count)
+    try:
+        started = time.perf_counter()
+        cpu_started = time.process_time()
+        while made < decisions:
+            agents = _spawn_agents(graph, count, rng)
+            moving = PhysicsMover(physics) if mover == "physics" else KinematicMover()
+            sim = Simulator(
+                graph,
+                agents,
+                moving,
+                RandomPolicy(rng),
+                BombRules(zones, RulesConfig()),
+                bomb_carrier=0,
+                combat=CombatStep(los, model, "de_dust2"),
+                config=SimConfig(combat=True),
+                seed=int(rng.integers(1 << 31)),
+            )
+            start_tick = sim.tick
+            left = decisions - made
+            sim.run(until=lambda s, left=left: int(s.decisions.sum()) >= left)
+            made += int(sim.decisions.sum())
+            ticks += sim.tick - start_tick
+            kills += int((~agents.alive).sum())
+            rounds += 1
+            if isinstance(moving, PhysicsMover):
+                moving.close()
+        wall = time.perf_counter() - started
+        cpu = time.process_time() - cpu_started
+    finally:
+        los.close()
+    game = ticks / TICK_RATE
+    paper = PAPER_TICKS_PER_S.get(count)
+    return SpeedRow(
+        agents=count,
+        mover=mover,
+        rounds=rounds,
+        ticks=ticks,
+        decisions=made,
+        kills=kills,
+        wall_s=wall,
+        cpu_s=cpu,
+        game_s=game,
+        ticks_per_s=ticks / wall,
+        time_scale=game / wall,
+        paper_ticks_per_s=paper,
+        ratio_to_paper=ticks / wall / paper if paper else None,
+    )
+
+
+def speed_table(
+    counts: tuple[int, ...] = AGENT_COUNTS,
+    decisions: int = PAPER_DECISIONS,
+    model: DamageModel | None = None,
+    mover: str = "physics",
+    seed: int = 0,
+    warmup_decisions: int = 200,
+) -> list[SpeedRow]:
+    """Table 1 rows for each agent count, after an untimed warm-up (compilation, caches).
+
+    `model` None runs the combat step with `NeverHits` (line of sight, no inference).
+    """
+    graph = builtin_graph()
+    model = NeverHits() if model is None else model
+    with PhysicsWorld(nav_world()) as physics:
+        if warmup_decisions:
+            run_agents(physics, graph, 2, warmup_decisions, model, mover, seed)
+        return [run_agents(physics, graph, n, decisions, model, mover, seed) for n in counts]

@@ -1,0 +1,290 @@
+"""`decoy bench`: the paper's Table 1 and the throughput of replay, metrics and reader."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from decoy_cli.bench import (
+    SECTIONS,
+    BenchConfig,
+    check_damage_model,
+    failed_sections,
+    find_data,
+    machine_info,
+    report,
+    run_isolated,
+)
+from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.errors import OutputError
+from decoy_cli.files import write_atomic
+
+DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
+
+TITLES = {
+    "table1": "Table 1: simulator speed",
+    "combat_step": "one 5v5 combat step",
+    "replay": "replay throughput",
+    "metrics": "metric throughput",
+    "reader": "reader throughput",
+}
+
+
+def bench(
+    quick: bool = typer.Option(
+        False,
+        "--quick",
+        help="A smoke run of a few seconds per section: 1,000 decisions at 2 and 10 agents, "
+        "3 rounds, 100 metric pairs, 2 files.",
+    ),
+    models: str = typer.Option(
+        "shipped",
+        "--models",
+        help=f"Damage models of the combat step: {CHOICES_HELP}. If they cannot be loaded, the "
+        "benchmark says so and runs line of sight without inference.",
+    ),
+    data: Path | None = typer.Option(
+        None,
+        "--data",
+        help="Folder of ESTA match files for the replay and reader sections (default: "
+        "../shared/data/esta_dust2_tside when present, else the sample in examples/sample/).",
+    ),
+    mover: str = typer.Option(
+        "physics",
+        "--mover",
+        help="Mover of Table 1: physics (capsules, as the paper) or kinematic.",
+    ),
+    out: Path = typer.Option(DEFAULT_OUT, "--out", help="The JSON report."),
+    seed: int = typer.Option(0, "--seed", help="Seed of agent placements and actions."),
+) -> None:
+    """Measure the simulator's speed (the paper's Table 1) and the throughput of the pipeline.
+
+    Sections: Table 1, a 5v5 combat step, replay, metrics and reader throughput, each in its
+    own process; prints tables and writes a JSON report with the machine. Exits non-zero when a
+    section failed."""
+    console = Console()
+    if out.is_dir():
+        raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
+    config = BenchConfig.create(quick, models, mover, seed)
+    bench_data = find_data(data)
+    machine = machine_info()
+    console.print(_machine_line(machine), highlight=False)
+    status = check_damage_model(models)
+    if status.error:
+        console.print(
+            f"[yellow]damage model {escape(models)!r} could not be loaded: {escape(status.error)}"
+            "\nfalling back to line of sight without inference (labelled in the tables)[/yellow]"
+        )
+    console.print(f"damage model: {escape(status.label)}", highlight=False)
+    console.print(
+        "data: "
+        + (
+            f"{bench_data.kind}, {len(bench_data.files)} files in {escape(str(bench_data.folder))}"
+            if bench_data
+            else "none found (replay and reader sections skipped)"
+        ),
+        highlight=False,
+    )
+    sections: dict[str, dict[str, Any]] = {}
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    ) as progress:
+        task = progress.add_task("bench", total=len(SECTIONS))
+        for name in SECTIONS:
+            progress.update(task, description=TITLES[name])
+            sections[name] = run_isolated(name, config, status, bench_data)
+            progress.console.print(_render(name, sections[name]))
+            progress.advance(task)
+    document = report(config, status, bench_data, sections, machine)
+    write_atomic(out, (json.dumps(document, indent=2, allow_nan=False) + "\n").encode())
+    console.print(
+        f"peak memory of this process {document['peak_rss_mb_main']:.0f} MB; load average at "
+        f"the end {_load(document['load_average_end'])}; "
+        f"report written to {escape(str(out))}",
+        highlight=False,
+    )
+    failed = failed_sections(sections)
+    if failed:
+        Console(stderr=True).print(
+            f"error: {len(failed)} section(s) failed: {', '.join(failed)}", highlight=False
+        )
+        raise typer.Exit(1)
+
+
+def _machine_line(machine: dict[str, Any]) -> str:
+    packages = machine["packages"]
+    versions = ", ".join(
+        f"{name} {packages[name]}" for name in ("numpy", "torch", "pybullet") if packages[name]
+    )
+    memory = f", {machine['memory_gb']:.0f} GB" if machine["memory_gb"] else ""
+    return (
+        f"machine: {machine['cores']} cores ({machine['usable_cores']} usable), "
+        f"{machine['cpu']}{memory}; python {machine['python']}, {versions}; "
+        f"load average {_load(machine['load_average'])}"
+    )
+
+
+def _load(load: list[float] | None) -> str:
+    return f"{load[0]:.2f} (1 min)" if load else "unknown"
+
+
+def _render(name: str, result: dict[str, Any]) -> Table | str:
+    """The section's table, or one line when it was skipped or failed."""
+    title = TITLES[name]
+    if "skipped" in result:
+        return f"[yellow]{title}: skipped ({escape(result['skipped'])})[/yellow]"
+    if "error" in result:
+        return f"[red]{title}: failed: {escape(result['error'])}[/red]"
+    return {
+        "table1": _table1,
+        "combat_step": _combat_table,
+        "replay": _replay_table,
+        "metrics": _metrics_table,
+        "reader": _reader_table,
+    }[name](result)
+
+
+def _table(title: str, columns: list[str], caption: str | None = None) -> Table:
+    table = Table(title=title, caption=caption)
+    for k, column in enumerate(columns):
+        table.add_column(column, justify="left" if k == 0 else "right")
+    return table
+
+
+def _table1(result: dict[str, Any]) -> Table:
+    table = _table(
+        f"Table 1: simulator speed, {result['decisions_per_row']:,} agent decisions per row",
+        [
+            "agents",
+            "physics ticks",
+            "decisions",
+            "rounds",
+            "kills",
+            "wall s",
+            "CPU s",
+            "game s",
+            "ticks/s",
+            "time scale",
+            "paper ticks/s",
+            "ours / paper",
+        ],
+        caption=(
+            f"{result['mover']} mover, bomb rules on, combat step every 0.5 s with damage model: "
+            f"{result['damage_model']}; peak memory {result['peak_rss_mb']:.0f} MB"
+        ),
+    )
+    for row in result["rows"]:
+        paper = row["paper_ticks_per_s"]
+        table.add_row(
+            str(row["agents"]),
+            f"{row['ticks']:,}",
+            f"{row['decisions']:,}",
+            str(row["rounds"]),
+            str(row["kills"]),
+            f"{row['wall_s']:.2f}",
+            f"{row['cpu_s']:.2f}",
+            f"{row['game_s']:.1f}",
+            f"{row['ticks_per_s']:,.0f}",
+            f"{row['time_scale']:.1f}x",
+            f"{paper:,g}" if paper else "–",
+            f"{row['ratio_to_paper']:.2f}x" if row["ratio_to_paper"] else "–",
+        )
+    return table
+
+
+def _combat_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        "one 5v5 combat step, median ms",
+        ["layout", "steps", "line of sight", "batch", "model", "damage", "step", "visible pairs"],
+        caption=f"damage model: {result['damage_model']}; peak memory "
+        f"{result['peak_rss_mb']:.0f} MB",
+    )
+    for row in result["rows"]:
+        parts = row["parts"]
+        table.add_row(
+            row["layout"],
+            str(row["steps"]),
+            *(
+                f"{parts[part]['median_ms']:.3f}"
+                for part in ("visible_pairs", "make_batch", "model", "apply_damage", "step")
+            ),
+            f"{row['visible_pairs_median']:g} (max {row['visible_pairs_max']})",
+        )
+    return table
+
+
+def _replay_table(result: dict[str, Any]) -> Table:
+    options = result["options"]
+    table = _table(
+        f"replay throughput ({result['data']['kind']} data), one process",
+        ["rounds", "failed", "frames", "wall s", "rounds/s", "rounds per CPU s", "s per round"],
+        caption=f"snap + plan + replay + metrics; {options['mover']} mover, bomb "
+        f"{'on' if options['bomb'] else 'off'}, combat "
+        f"{'on (' + result['damage_model'] + ')' if options['combat'] else 'off'}; "
+        f"peak memory {result['peak_rss_mb']:.0f} MB",
+    )
+    if not result["rounds"]:
+        table.add_row("0", str(result["failed"]), "–", "–", "–", "–", "–")
+        return table
+    per_cpu = result["rounds_per_cpu_s"]
+    table.add_row(
+        str(result["rounds"]),
+        str(result["failed"]),
+        f"{result['frames']:,}",
+        f"{result['wall_s']:.2f}",
+        f"{result['rounds_per_s']:.2f}",
+        f"{per_cpu:.2f}" if per_cpu else "–",
+        f"{result['s_per_round_median']:.3f}",
+    )
+    return table
+
+
+def _metrics_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        "metric throughput (ten metrics, both protocols, one thread)",
+        ["player-round pairs", "mean frames", "wall s", "pairs/s", "ms per pair"],
+        caption=f"synthetic trajectories; peak memory {result['peak_rss_mb']:.0f} MB",
+    )
+    table.add_row(
+        f"{result['pairs']:,}",
+        f"{result['mean_frames']:.0f}",
+        f"{result['wall_s']:.2f}",
+        f"{result['pairs_per_s']:,.0f}",
+        f"{result['ms_per_pair']:.3f}",
+    )
+    return table
+
+
+def _reader_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        f"reader throughput ({result['data']['kind']} data, read_match)",
+        ["files", "failed", "rounds", "MB xz", "MB JSON", "s per file", "MB/s JSON", "MB/s xz"],
+        caption=f"peak memory {result['peak_rss_mb']:.0f} MB",
+    )
+    if not result["files"]:
+        table.add_row("0", str(result["failed"]), *("–" * 6))
+        return table
+    table.add_row(
+        str(result["files"]),
+        str(result["failed"]),
+        str(result["rounds"]),
+        f"{result['compressed_mb']:.1f}",
+        f"{result['decompressed_mb']:.1f}",
+        f"{result['s_per_file_median']:.3f} ({result['s_per_file_min']:.3f}-"
+        f"{result['s_per_file_max']:.3f})",
+        f"{result['mb_per_s_decompressed']:.1f}",
+        f"{result['mb_per_s_compressed']:.2f}",
+    )
+    return table

@@ -1,0 +1,209 @@
+"""`decoy bench --quick` end to end, and the parts of the benchmark that can go wrong alone.
+
+The end-to-end run measures on a generated fixture match (`--data`), with a model folder that
+does not exist, so the fallback to line of sight without inference is exercised and must be
+labelled. The learned model path runs one combat-step section in-process on a model folder of
+freshly initialised networks. Nothing here asserts a speed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from esta_fixtures import write_match
+from typer.testing import CliRunner
+
+from decoy_cli.bench import (
+    SECTIONS,
+    BenchConfig,
+    ModelStatus,
+    check_damage_model,
+    find_data,
+    run_isolated,
+    run_section,
+)
+from decoy_cli.bench.machine import cpu_model, memory_gb, peak_rss_mb, ru_maxrss_mb
+from decoy_cli.bench.simspeed import PAPER_TICKS_PER_S, NeverHits
+from decoy_cli.cli import app
+from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.sim.combat import VisiblePairs, make_batch
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "220"}
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, dict[str, Any]]:
+    """One `decoy bench --quick` on a fixture match with an unloadable model folder."""
+    folder = tmp_path_factory.mktemp("bench")
+    data = folder / "data"
+    data.mkdir()
+    write_match(data / "fixture.json.xz")
+    out = folder / "out" / "bench.json"
+    result = runner.invoke(
+        app,
+        [
+            "bench",
+            "--quick",
+            "--data",
+            str(data),
+            "--models",
+            str(folder / "no-such-models"),
+            "--out",
+            str(out),
+        ],
+        env=WIDE,
+    )
+    assert result.exit_code == 0, result.output
+    return result, json.loads(out.read_text())
+
+
+def test_quick_bench_writes_every_section_and_the_machine(quick_run) -> None:
+    result, report = quick_run
+    assert set(report["sections"]) == set(SECTIONS)
+    for name, section in report["sections"].items():
+        assert "error" not in section and "skipped" not in section, name
+        assert section["peak_rss_mb"] > 0 and section["ru_maxrss_mb"] > 0
+    machine = report["machine"]
+    assert machine["cores"] >= 1 and machine["cpu"]
+    assert machine["python"] and machine["packages"]["numpy"] == np.__version__
+    assert "torch" in machine["packages"]
+    assert report["quick"] is True and report["data"]["kind"] == "given"
+    assert "machine:" in result.stdout and machine["cpu"] in result.stdout
+    for title in ("Table 1", "combat step", "replay throughput", "metric", "reader"):
+        assert title in result.stdout
+
+
+def test_the_model_fallback_is_said_and_labelled(quick_run) -> None:
+    result, report = quick_run
+    model = report["damage_model"]
+    assert model["loaded"] is False and "no-such-models" in model["error"]
+    assert "could not be loaded" in result.stdout
+    assert "line of sight only, no inference" in report["sections"]["table1"]["damage_model"]
+    assert "line of sight only, no inference" in report["sections"]["combat_step"]["damage_model"]
+    assert report["sections"]["replay"]["options"]["combat"] is False
+
+
+def test_table1_rows_are_consistent(quick_run) -> None:
+    _, report = quick_run
+    table = report["sections"]["table1"]
+    assert [row["agents"] for row in table["rows"]] == [2, 10]
+    for row in table["rows"]:
+        assert row["decisions"] >= table["decisions_per_row"] == 1000
+        assert row["ticks"] > 0 and row["rounds"] >= 1
+        assert math.isclose(row["game_s"], row["ticks"] / 60)
+        assert math.isclose(row["ticks_per_s"], row["ticks"] / row["wall_s"])
+        assert math.isclose(row["time_scale"], row["game_s"] / row["wall_s"])
+        paper = PAPER_TICKS_PER_S[row["agents"]]
+        assert row["paper_ticks_per_s"] == paper
+        assert math.isclose(row["ratio_to_paper"], row["ticks_per_s"] / paper)
+
+
+def test_throughput_sections_count_what_they_measured(quick_run) -> None:
+    _, report = quick_run
+    sections = report["sections"]
+    replay = sections["replay"]
+    # the fixture has rounds 1 and 2 with frames (one replayed untimed to warm up), 3 without
+    assert replay["rounds"] == 1 and replay["failed"] == 1
+    assert "no frames" in replay["failures"][0]
+    assert replay["rounds_per_s"] == pytest.approx(1 / replay["wall_s"])
+    reader = sections["reader"]
+    assert reader["files"] == 1 and reader["rounds"] == 3
+    assert reader["mb_per_s_decompressed"] > reader["mb_per_s_compressed"] > 0
+    metrics = sections["metrics"]
+    assert metrics["pairs"] == 100 and metrics["evaluated"] == 100
+    assert [row["layout"] for row in sections["combat_step"]["rows"]] == ["spread", "clustered"]
+    for row in sections["combat_step"]["rows"]:
+        parts = row["parts"]
+        assert row["steps"] == 20
+        assert parts["step"]["median_ms"] >= parts["visible_pairs"]["median_ms"] > 0
+
+
+def test_find_data_prefers_the_given_folder_then_the_candidates(tmp_path: Path) -> None:
+    empty, real, sample = (tmp_path / name for name in ("empty", "real", "sample"))
+    for folder in (empty, real, sample):
+        folder.mkdir()
+    write_match(sample / "m.json.xz")
+    candidates = (("real", real), ("missing", tmp_path / "nope"), ("synthetic sample", sample))
+    found = find_data(None, candidates)
+    assert found is not None and found.kind == "synthetic sample"
+    assert found.files == [sample / "m.json.xz"]
+    assert find_data(None, candidates[:2]) is None
+    assert find_data(sample, ()).kind == "given"
+    with pytest.raises(EstaError, match=r"no \.json\.xz or \.json match files"):
+        find_data(empty, candidates)
+
+
+def test_without_data_the_data_sections_are_skipped_with_the_reason() -> None:
+    config = BenchConfig.create(quick=True, models="none")
+    status = check_damage_model("none")
+    assert not status.loaded and "--models none" in status.label
+    for name in ("replay", "reader"):
+        skipped = run_isolated(name, config, status, None)
+        assert "examples/sample" in skipped["skipped"]
+
+
+def test_a_failing_section_is_an_error_entry_not_a_crash() -> None:
+    config = BenchConfig.create(quick=True, models="/no/such/folder")
+    status = ModelStatus("/no/such/folder", loaded=True, label="pretend")
+    result = run_isolated("combat_step", config, status, None)
+    assert "no such model folder" in result["error"]
+
+
+def test_bad_options_are_one_line(tmp_path: Path) -> None:
+    mover = runner.invoke(app, ["bench", "--quick", "--mover", "warp"], env=WIDE)
+    assert mover.exit_code == 1
+    assert mover.stderr.strip() == "error: --mover must be one of physics, kinematic, not 'warp'"
+    folder = runner.invoke(app, ["bench", "--quick", "--out", str(tmp_path)], env=WIDE)
+    assert folder.exit_code == 1 and "is a folder" in folder.stderr
+    data = runner.invoke(app, ["bench", "--quick", "--data", str(tmp_path)], env=WIDE)
+    assert data.exit_code == 1 and "no .json.xz or .json match files" in data.stderr
+    with pytest.raises(DecoyError):
+        BenchConfig.create(quick=False, models="none", mover="teleport")
+
+
+def test_a_learned_model_runs_in_the_combat_step(tmp_path: Path) -> None:
+    torch = pytest.importorskip("torch")
+    from decoy_cli.damage.features import PAPER_SPEC
+    from decoy_cli.damage.model_folder import save_dip, save_dog
+    from decoy_cli.damage.networks import DipNet, DogNet
+
+    torch.manual_seed(0)
+    save_dip(tmp_path, DipNet(), PAPER_SPEC, threshold=0.0)  # every visible armed pair hits
+    save_dog(tmp_path, DogNet(), PAPER_SPEC)
+    status = check_damage_model(str(tmp_path))
+    assert status.loaded and status.error is None and str(tmp_path) in status.label
+    config = BenchConfig.create(quick=True, models=str(tmp_path))
+    result = run_section("combat_step", config, status, None)
+    assert result["damage_model"] == status.label
+    clustered = result["rows"][1]
+    assert clustered["visible_pairs_median"] > 0
+    assert clustered["parts"]["model"]["median_ms"] > 0
+
+
+def test_never_hits_and_the_machine_helpers(tmp_path: Path) -> None:
+    from decoy_cli.bench.combat import random_agents
+    from decoy_cli.waypoints.build import builtin_graph
+
+    rng = np.random.default_rng(0)
+    agents = random_agents(builtin_graph(), 2, False, rng)
+    pairs = VisiblePairs(np.array([0, 2]), np.array([2, 0]))
+    hit = NeverHits()(make_batch(agents, pairs, "de_dust2"), rng)
+    assert not hit.hit.any() and (hit.damage == 0).all()
+    cpuinfo = tmp_path / "cpuinfo"
+    cpuinfo.write_text("processor\t: 0\nmodel name\t: Test CPU 9000\n")
+    assert cpu_model(cpuinfo) == "Test CPU 9000"
+    assert cpu_model(tmp_path / "missing")  # falls back to platform
+    meminfo = tmp_path / "meminfo"
+    meminfo.write_text("MemTotal:        2048000 kB\nMemFree: 1 kB\n")
+    assert memory_gb(meminfo) == pytest.approx(2048000 * 1024 / 1e9)
+    assert memory_gb(tmp_path / "missing") is None
+    status = tmp_path / "status"
+    status.write_text("Name: python\nVmPeak: 9 kB\nVmHWM:\t  51200 kB\nVmRSS: 1 kB\n")
+    assert peak_rss_mb(status) == pytest.approx(51200 * 1024 / 1e6)
+    assert peak_rss_mb(tmp_path / "missing") >= ru_maxrss_mb() > 1
