@@ -5,23 +5,23 @@
 
 Prints the clock and paper metrics aggregated by side (mean, std, median, p90), the paper's
 T-side values beside them, lateness and stuck/recovery counts per round, the worst rounds, and
-the wall time. (`decoy evaluate` will do this at scale; this script is the measurement of the
-replay itself.)
+the wall time. It runs the rounds through `decoy evaluate`'s runner (one worker process by
+default, so rounds/s is per core), with a throw-away cache; `decoy evaluate` adds the figures
+and the report.
 """
 
 from __future__ import annotations
 
 import argparse
-import time
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from decoy_cli.esta import iter_match_files
+from decoy_cli.evaluate.backends import LocalBackend
+from decoy_cli.evaluate.runner import make_settings, run_evaluation
 from decoy_cli.metrics import METRIC_NAMES, summarize
-from decoy_cli.replay.batch import replay_files
-from decoy_cli.replay.replayer import ReplayOptions
-from decoy_cli.waypoints.build import builtin_graph
 
 PAPER_T = {
     "paper_euclidean": 0.420,
@@ -36,22 +36,25 @@ def main() -> None:
     parser.add_argument("folder", type=Path)
     parser.add_argument("--mover", default="kinematic", choices=("physics", "kinematic"))
     parser.add_argument("--limit", type=int, default=0, help="only the first N files")
+    parser.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
     parser.add_argument("--csv", type=Path, default=None)
     args = parser.parse_args()
     files = iter_match_files(args.folder)
     if args.limit:
         files = files[: args.limit]
-    options = ReplayOptions(combat=False, bomb=False, mover=args.mover)
-    started = time.perf_counter()
-    result = replay_files(files, builtin_graph(), options)
-    wall = time.perf_counter() - started
-    players = result.players
-    n_rounds = len(result.rounds)
+    settings = make_settings("de_dust2", False, "none", args.mover, 0)
+    with tempfile.TemporaryDirectory() as out, LocalBackend(args.workers) as backend:
+        evaluation = run_evaluation(files, settings, Path(out), backend)
+    wall = evaluation.compute_seconds
+    players = evaluation.accumulator.players()
+    rounds = evaluation.accumulator.round_rows()
+    n_rounds = len(rounds)
     print(
-        f"{n_rounds} rounds, {len(players)} player-rounds, {len(result.failures)} failures, "
-        f"{wall:.1f} s ({n_rounds / wall:.2f} rounds/s, mover {args.mover}, combat and bomb off)"
+        f"{n_rounds} rounds, {len(players)} player-rounds, {len(evaluation.failures)} failures, "
+        f"{wall:.1f} s ({n_rounds / wall:.2f} rounds/s on {args.workers} worker processes, "
+        f"mover {args.mover}, combat and bomb off)"
     )
-    for failure in result.failures:
+    for failure in evaluation.failures:
         print(f"  failed: {failure.file}:{failure.round_num}: {failure.message}")
     summary = summarize(players[["side", *METRIC_NAMES, "reason"]])
     table = summary.table
@@ -76,7 +79,6 @@ def main() -> None:
         f"\nlateness: share of targets late, mean over player-rounds {np.nanmean(late):.1%}; "
         f"p95 lateness median {np.nanmedian(p95):.2f} s, p90 {np.nanpercentile(p95, 90):.2f} s"
     )
-    rounds = result.rounds
     print(
         f"stuck episodes per round: mean {rounds['stuck'].mean():.2f}, "
         f"max {rounds['stuck'].max()}; "

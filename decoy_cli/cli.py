@@ -8,7 +8,18 @@ import typer
 from typer.core import TyperGroup
 
 from decoy_cli import __version__
-from decoy_cli.commands import build_waypoints, info, replay, snap
+from decoy_cli.commands import (
+    bench,
+    build_waypoints,
+    download,
+    evaluate,
+    info,
+    make_sample,
+    models,
+    replay,
+    snap,
+    train,
+)
 from decoy_cli.errors import DecoyError
 
 _debug = False
@@ -54,7 +65,13 @@ def main(
     _debug = debug
 
 
+app.command("bench")(bench.bench)
 app.command("build-waypoints")(build_waypoints.build_waypoints)
+app.command("download")(download.download)
+app.command("evaluate")(evaluate.evaluate)
 app.command("info")(info.info)
+app.command("make-sample")(make_sample.make_sample)
 app.command("replay")(replay.replay)
 app.command("snap")(snap.snap)
+app.add_typer(models.app, name="models")
+app.add_typer(train.app, name="train")

@@ -77,8 +77,10 @@ def snap(
         None, "--frames", help="FILE:ROUND only: plot only data frames FIRST:LAST (inclusive)."
     ),
 ) -> None:
-    """Snap rounds to waypoints and report snap errors, plan feasibility and, with --metrics,
-    the fidelity of the snapped trajectory. Exits non-zero when a file or round failed."""
+    """Snap rounds to waypoints: snap errors, plan feasibility, the snapped trajectory's fidelity.
+
+    With --metrics, the metrics of the snapped trajectory against the original (the bound a
+    replay can reach). Exits non-zero when a file or round failed."""
     console = Console()
     graph = WaypointGraph.load(graph_file) if graph_file is not None else builtin_graph()
     path = Path(target)

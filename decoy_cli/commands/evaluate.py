@@ -1,0 +1,325 @@
+"""`decoy evaluate`: replay many rounds in parallel and report how faithful the replay is."""
+
+from __future__ import annotations
+
+import os
+import platform
+import shlex
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskID,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+import decoy_cli
+from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.errors import DecoyError
+from decoy_cli.evaluate.report import (
+    RunInfo,
+    data_kind,
+    mechanics,
+    num,
+    table_groups,
+    write_outputs,
+)
+from decoy_cli.evaluate.runner import (
+    Evaluation,
+    ProgressEvent,
+    collect_files,
+    make_settings,
+    run_evaluation,
+)
+from decoy_cli.evaluate.tables import Tables, build_tables
+from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+
+DEFAULT_OUT = Path("decoy-out") / "evaluate"
+
+SAMPLE_DIR = Path(decoy_cli.__file__).resolve().parents[1] / "examples" / "sample"
+"""The synthetic sample evaluated when no input is given. It lives in the source tree (a
+checkout or an editable install), next to the README that says how `decoy make-sample`
+regenerates it, rather than inside the package: it is example data, not something the library
+needs, so a wheel stays small and its users pass their own data."""
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return (
+        f"{_cores()} cores ({model}), Python {platform.python_version()}, "
+        f"decoy {decoy_cli.__version__}"
+    )
+
+
+def evaluate(
+    inputs: list[Path] = typer.Argument(
+        None,
+        metavar="FILE|FOLDER",
+        show_default=False,
+        help="ESTA match files (.json.xz, .json) and folders of them. Default: the synthetic "
+        "sample shipped in examples/sample.",
+    ),
+    map_name: str = typer.Option(
+        "dust2", "--map", help="The map to evaluate; files of other maps are skipped."
+    ),
+    sample: int | None = typer.Option(
+        None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
+    ),
+    seed: int = typer.Option(0, "--seed", help="Seed of the sample and of the simulator."),
+    combat: bool = typer.Option(
+        True,
+        "--combat/--no-combat",
+        help="Shooting (with --models) and the bomb. --no-combat turns both off: movement "
+        "only, deaths scripted from the data, as in the paper's Table 2.",
+    ),
+    models: str = typer.Option(
+        "shipped", "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
+    ),
+    mover: str = typer.Option(
+        "kinematic", "--mover", help="kinematic (default) or physics (capsules that collide)."
+    ),
+    out: Path = typer.Option(
+        DEFAULT_OUT,
+        "--out",
+        help="Output folder: tables, figures, report.md, and the cache that lets an "
+        "interrupted run resume.",
+    ),
+    workers: int | None = typer.Option(
+        None,
+        "--workers",
+        min=1,
+        show_default=False,
+        help="Local worker processes (default: the number of cores).",
+    ),
+    scheduler: str | None = typer.Option(
+        None,
+        "--scheduler",
+        help="Run the rounds on a running dask.distributed cluster at this address (e.g. "
+        "tcp://10.0.0.5:8786) instead of local processes; needs the dask extra, and the "
+        "workers must read the input files at the same paths.",
+    ),
+) -> None:
+    """Replay many rounds in parallel and report how faithful the replay is.
+
+    Every round (or a sample) of the ESTA match files runs in worker processes; the results
+    are trajectory metrics (both protocols, next to the paper's Table 2), HP, death times,
+    outcomes, heatmaps and a report. Finished rounds are cached in the output folder, so
+    rerunning an interrupted run resumes it. Exits non-zero when a file or round failed
+    (failures.csv says why).
+    """
+    console = Console()
+    if not inputs:
+        if not SAMPLE_DIR.is_dir() or not any(SAMPLE_DIR.glob("*.json*")):
+            raise DecoyError(
+                f"no input given and no shipped sample in {SAMPLE_DIR}: pass ESTA match files "
+                "or folders (or generate the sample with `decoy make-sample`)"
+            )
+        inputs = [SAMPLE_DIR]
+    collect_files(inputs)  # bad paths fail here, before a damage model is loaded
+    settings = make_settings(map_name, combat, models, mover, seed)
+    command = _command_line(inputs, settings.map_name, sample, seed, combat, models, mover, out)
+    if scheduler:
+        from decoy_cli.evaluate.backends import DaskBackend
+
+        backend = DaskBackend(scheduler)
+        where = f"Dask scheduler {scheduler}"
+    else:
+        from decoy_cli.evaluate.backends import LocalBackend
+
+        count = workers or _cores()
+        backend = LocalBackend(count)
+        where = f"{count} local worker process{'es' if count > 1 else ''}"
+    info = RunInfo(command=command, backend=where, sample=sample, machine=_machine())
+    console.print(f"evaluating with {where}: {mechanics(settings)}", highlight=False)
+    try:
+        with backend, _ProgressDisplay() as on_progress:
+            evaluation = run_evaluation(
+                inputs, settings, out, backend, sample=sample, on_progress=on_progress
+            )
+    except KeyboardInterrupt:
+        console.print(
+            f"[yellow]interrupted: the finished rounds are cached in {out / 'cache'}; run the "
+            "same command again to resume[/yellow]"
+        )
+        raise typer.Exit(130) from None
+    started = time.perf_counter()
+    tables = build_tables(evaluation.accumulator)
+    write_outputs(evaluation, tables, out, info)
+    _show(console, evaluation, tables)
+    console.print(
+        f"outputs written to {out} (report: {out / 'report.md'}) in "
+        f"{time.perf_counter() - started:.1f} s",
+        highlight=False,
+    )
+    if evaluation.failures:
+        raise DecoyError(
+            f"{len(evaluation.failures)} files or rounds failed "
+            f"({evaluation.accumulator.rounds} rounds evaluated); see {out / 'failures.csv'}"
+        )
+
+
+def _command_line(
+    inputs: list[Path],
+    map_name: str,
+    sample: int | None,
+    seed: int,
+    combat: bool,
+    models: str,
+    mover: str,
+    out: Path,
+) -> str:
+    """The command with every effective option (what a reader needs to rerun it)."""
+    words = ["decoy", "evaluate", *map(str, inputs), "--map", map_name]
+    if sample is not None:
+        words += ["--sample", str(sample)]
+    words += ["--seed", str(seed), "--combat" if combat else "--no-combat"]
+    if combat:
+        words += ["--models", models]
+    words += ["--mover", mover, "--out", str(out)]
+    return shlex.join(words)
+
+
+class _ProgressDisplay:
+    """A rich progress display on stderr with one bar per stage (files indexed, rounds)."""
+
+    def __init__(self) -> None:
+        stderr = Console(stderr=True)
+        self.progress = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[failed]} failed"),
+            TextColumn("{task.fields[rate]}"),
+            TimeElapsedColumn(),
+            TextColumn("ETA"),
+            TimeRemainingColumn(),
+            console=stderr,
+            transient=True,
+            disable=not stderr.is_terminal,
+        )
+        self.tasks: dict[str, TaskID] = {}
+        self.started: dict[str, float] = {}
+
+    def __enter__(self) -> Callable[[ProgressEvent], None]:
+        self.progress.start()
+        return self.update
+
+    def __exit__(self, *exc: object) -> None:
+        self.progress.stop()
+
+    def update(self, event: ProgressEvent) -> None:
+        if event.stage not in self.tasks:
+            label = "indexing files" if event.stage == "index" else "evaluating rounds"
+            self.tasks[event.stage] = self.progress.add_task(
+                label, total=event.total, failed=0, rate=""
+            )
+            self.started[event.stage] = time.perf_counter()
+        elapsed = time.perf_counter() - self.started[event.stage]
+        unit = "files" if event.stage == "index" else "rounds"
+        rate = f"{event.done / elapsed:.2f} {unit}/s" if event.done and elapsed > 0 else ""
+        self.progress.update(
+            self.tasks[event.stage], completed=event.done, failed=event.failed, rate=rate
+        )
+
+
+def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
+    """The run's counts, the trajectory tables, HP/deaths/outcomes, places and failures."""
+    kind = data_kind(evaluation)
+    if kind in ("synthetic", "mixed"):
+        console.print(
+            f"[bold yellow]data: {kind}[/bold yellow] (generated by the project, not recorded "
+            "in real matches): these numbers check the pipeline, not reality"
+        )
+    else:
+        console.print(f"data: {kind}")
+    computed = f"{evaluation.computed} computed"
+    if evaluation.computed:
+        rate = evaluation.computed / evaluation.compute_seconds
+        computed += f" in {evaluation.compute_seconds:.1f} s, {rate:.2f} rounds/s"
+    console.print(
+        f"{evaluation.accumulator.rounds} rounds evaluated ({computed}; {evaluation.cached} "
+        f"from the cache), {len(tables.players)} player-rounds, {len(evaluation.failures)} "
+        f"failures; {mechanics(evaluation.settings)}",
+        highlight=False,
+    )
+    groups = table_groups(tables)
+    stats = tables.trajectory.set_index(["metric", "group"])
+    for title, names in (
+        ("protocol clock (m): mean ± std, then median · p90", METRIC_NAMES_CLOCK),
+        ("protocol paper (m): mean ± std, then (the paper's Table 2)", METRIC_NAMES_PAPER),
+    ):
+        console.print(title, style="italic", highlight=False)
+        table = Table()
+        table.add_column("metric", no_wrap=True)
+        for group in groups:
+            table.add_column(group, justify="right", no_wrap=True)
+        for name in names:
+            cells = []
+            for group in groups:
+                row = stats.loc[(name, group)]
+                if name in METRIC_NAMES_PAPER:
+                    detail = f"({num(row['paper_mean'])} ± {num(row['paper_std'])})"
+                else:
+                    detail = f"{num(row['median'])} · {num(row['p90'])}"
+                cells.append(f"{num(row['mean'])} ± {num(row['std'])}\n[dim]{detail}[/dim]")
+            table.add_row(name, *cells)
+        console.print(table)
+    for row in tables.summary.unevaluated.itertuples():
+        console.print(f"  {row.group}: {row.count} not evaluated ({row.reason})", highlight=False)
+    combat = Table(title="HP, deaths and outcomes")
+    for column in ("metric", "value", "n", "paper", "over / why not"):
+        combat.add_column(column, justify="right" if column in ("value", "n", "paper") else "left")
+    for row in tables.combat.itertuples():
+        combat.add_row(row.metric, num(row.value), str(row.n), num(row.paper), str(row.note))
+    console.print(combat)
+    if tables.outcome is not None:
+        matrix = tables.outcome.winner_confusion
+        console.print("winner: data (rows) against replay (columns)")
+        confusion = Table()
+        confusion.add_column("")
+        for column in matrix.columns:
+            confusion.add_column(str(column), justify="right")
+        for label in matrix.index:
+            confusion.add_row(str(label), *map(str, matrix.loc[label]))
+        console.print(confusion)
+    places = Table(title="where the replay is off most (nav places, by the player's place)")
+    for column in ("place", "original", "replay", "diff (pp)", "distance (m)", "off graph"):
+        places.add_column(column, justify="left" if column == "place" else "right")
+    for row in tables.places.head(6).itertuples():
+        places.add_row(
+            str(row.place),
+            f"{100 * row.original_share:.1f}%",
+            f"{100 * row.replay_share:.1f}%",
+            f"{row.difference_pp:+.2f}",
+            num(row.mean_error_m, 2),
+            f"{100 * row.off_graph_share:.1f}%",
+        )
+    console.print(places)
+    for failure in evaluation.failures[:10]:
+        where = failure.file if failure.round_num is None else f"{failure.file}:{failure.round_num}"
+        console.print(f"[red]{failure.kind}[/red] {where}: {failure.message}", highlight=False)
+    if len(evaluation.failures) > 10:
+        console.print(f"… {len(evaluation.failures) - 10} more in failures.csv")

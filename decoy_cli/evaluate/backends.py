@@ -1,0 +1,197 @@
+"""Where the jobs run: a local pool of worker processes, or an existing Dask cluster.
+
+Both backends take a job function and its tasks and yield `(task, outcome)` as tasks finish,
+where the outcome is the job's return value or a `TaskFailure` the backend made because the
+worker died. Use them as context managers: leaving the block (normally, on Ctrl-C or on an
+error) cancels what has not started and waits for what is running.
+
+Local: a `ProcessPoolExecutor` whose workers are started by forkserver (spawn where there is
+none), never by a plain fork: a worker process builds its own pybullet world on first use, so
+no physics client is ever shared across a fork. Workers ignore Ctrl-C (the parent handles
+it). At most one task per worker is in flight, so when a worker dies (the pool then breaks and
+every in-flight task with it) the suspects are those few tasks: each runs again alone in a
+fresh one-worker pool, where a second death is that task's failure and the others complete;
+the rest of the batch goes on in a new pool.
+
+Dask: the same job functions are submitted to a `dask.distributed` scheduler. The input files
+must be readable by the workers at the same paths (a shared file system); results come back to
+this process, which writes the outputs. A task whose workers keep dying (Dask's
+`KilledWorker`) becomes a failure. Run workers with one thread each (`dask worker --nthreads 1`),
+since the replay is CPU-bound Python.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import signal
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.evaluate.job import CRASH_MESSAGE, TaskFailure
+
+Outcomes = Iterator[tuple[Any, Any]]
+
+_BROKEN = object()
+"""The outcome of a task whose pool broke under it."""
+
+
+def _init_worker() -> None:
+    """Worker initializer: Ctrl-C is the parent's to handle; pybullet is imported up front
+    (without its banner, see `load_pybullet`)."""
+    from decoy_cli.world.physics import load_pybullet
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    load_pybullet()
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    """forkserver (preloading the job module, so workers start fast) where available, else
+    spawn; both start workers without a copy of the parent's threads or physics clients."""
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(["decoy_cli.evaluate.job"])
+        return context
+    return multiprocessing.get_context("spawn")
+
+
+def _internal(error: BaseException) -> TaskFailure:
+    return TaskFailure("internal error", f"{type(error).__name__}: {error}")
+
+
+class LocalBackend:
+    """Jobs in `workers` local worker processes (see the module docstring)."""
+
+    def __init__(self, workers: int) -> None:
+        if workers < 1:
+            raise DecoyError(f"--workers must be at least 1, not {workers}")
+        self.workers = workers
+        self._pool: ProcessPoolExecutor | None = None
+
+    def __enter__(self) -> LocalBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Cancel the tasks not started, wait for the running ones, stop the workers."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def run(self, job: Callable[[Any], Any], tasks: Iterable[Any]) -> Outcomes:
+        """Yield (task, outcome) for every task, in the order they finish."""
+        queue = deque(tasks)
+        while queue:
+            suspects = yield from self._run_pooled(job, queue)
+            for task in suspects:
+                yield task, self._run_alone(job, task)
+
+    def _run_pooled(self, job: Callable[[Any], Any], queue: deque) -> Iterator:
+        """Run the queue until it is empty or the pool breaks; returns the suspects."""
+        if self._pool is None:
+            self._pool = ProcessPoolExecutor(
+                max_workers=self.workers, mp_context=_context(), initializer=_init_worker
+            )
+        inflight: dict[Future, Any] = {}
+        suspects: list[Any] = []
+        while (queue or inflight) and not suspects:
+            while queue and len(inflight) < self.workers:
+                task = queue.popleft()
+                try:
+                    inflight[self._pool.submit(job, task)] = task
+                except BrokenProcessPool:
+                    queue.appendleft(task)
+                    break
+            if not inflight:  # broke before anything was in flight
+                break
+            done, _ = wait(inflight, return_when=FIRST_COMPLETED)
+            for future in done:
+                task = inflight.pop(future)
+                outcome = _result(future)
+                if outcome is _BROKEN:
+                    suspects.append(task)
+                else:
+                    yield task, outcome
+        if suspects or (queue and not inflight):
+            suspects.extend(inflight.values())  # their futures broke with the pool
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+        return suspects
+
+    def _run_alone(self, job: Callable[[Any], Any], task: Any) -> Any:
+        """Run one task in a fresh one-worker pool; a dead worker is the task's failure."""
+        pool = ProcessPoolExecutor(max_workers=1, mp_context=_context(), initializer=_init_worker)
+        try:
+            outcome = _result(pool.submit(job, task))
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        return TaskFailure("worker crash", CRASH_MESSAGE) if outcome is _BROKEN else outcome
+
+
+def _result(future: Future) -> Any:
+    try:
+        return future.result()
+    except BrokenProcessPool:
+        return _BROKEN
+    except Exception as error:  # e.g. a result that could not be sent back
+        return _internal(error)
+
+
+class DaskBackend:
+    """Jobs on an existing dask.distributed cluster (see the module docstring)."""
+
+    def __init__(self, address: str, timeout_s: float = 20.0) -> None:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise DecoyError(
+                "--scheduler needs dask.distributed: pip install 'decoy[dask]'"
+            ) from None
+        try:
+            self.client = Client(address, timeout=f"{timeout_s}s", set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as error:
+            raise DecoyError(
+                f"cannot connect to the Dask scheduler at {address}: {error}"
+            ) from None
+        self.address = address
+        self._futures: list[Any] = []
+
+    def __enter__(self) -> DaskBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Cancel what is left of the last run and disconnect (the cluster keeps running)."""
+        if self._futures:
+            self.client.cancel(self._futures)
+            self._futures = []
+        self.client.close()
+
+    def run(self, job: Callable[[Any], Any], tasks: Iterable[Any]) -> Outcomes:
+        """Yield (task, outcome) for every task, in the order they finish."""
+        from distributed import KilledWorker, as_completed
+
+        tasks = list(tasks)
+        if not tasks:
+            return
+        futures = self.client.map(job, tasks, pure=False)
+        self._futures = list(futures)
+        task_of = {future.key: task for future, task in zip(futures, tasks, strict=True)}
+        for future in as_completed(futures, loop=self.client.loop):
+            try:
+                outcome = future.result()
+            except KilledWorker:
+                outcome = TaskFailure("worker crash", CRASH_MESSAGE)
+            except Exception as error:
+                outcome = _internal(error)
+            task = task_of.pop(future.key)
+            future.release()
+            yield task, outcome
+        self._futures = []

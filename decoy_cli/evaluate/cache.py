@@ -1,0 +1,68 @@
+"""The run cache in the output folder: one msgpack file per round result and per file index.
+
+Every file is written atomically (decoy_cli/files.write_atomic) as soon as its result arrives,
+so an interrupted run keeps every finished round, and a rerun loads them instead of computing
+them again. Keys come from decoy_cli/evaluate/settings.py (file content, round, options, code),
+so a changed option or a new version never reuses a stale result. A cache file that cannot be
+decoded (written by another format version, or damaged) counts as missing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import msgspec
+import numpy as np
+
+from decoy_cli.evaluate.job import FileIndex, RoundRecord
+from decoy_cli.files import write_atomic
+
+CACHE_DIR = "cache"
+
+
+def _native(value: Any) -> Any:
+    """numpy scalars as Python values (msgpack knows only the Python types)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    raise NotImplementedError(f"cannot store a {type(value).__name__} in the cache")
+
+
+_ENCODER = msgspec.msgpack.Encoder(enc_hook=_native)
+_ROUND_DECODER = msgspec.msgpack.Decoder(RoundRecord)
+_INDEX_DECODER = msgspec.msgpack.Decoder(FileIndex)
+
+
+class RunCache:
+    """Round records under `<out>/cache/rounds`, file indexes under `<out>/cache/index`."""
+
+    def __init__(self, out: Path) -> None:
+        self.rounds = out / CACHE_DIR / "rounds"
+        self.index = out / CACHE_DIR / "index"
+
+    def round_path(self, key: str) -> Path:
+        return self.rounds / f"{key}.msgpack"
+
+    def index_path(self, key: str) -> Path:
+        return self.index / f"{key}.msgpack"
+
+    def load_round(self, key: str) -> RoundRecord | None:
+        """The cached record, or None when missing or unreadable."""
+        return _load(self.round_path(key), _ROUND_DECODER)
+
+    def store_round(self, record: RoundRecord) -> None:
+        """Write a record atomically; a full disk raises OutputError."""
+        write_atomic(self.round_path(record.key), _ENCODER.encode(record))
+
+    def load_index(self, key: str) -> FileIndex | None:
+        return _load(self.index_path(key), _INDEX_DECODER)
+
+    def store_index(self, key: str, index: FileIndex) -> None:
+        write_atomic(self.index_path(key), _ENCODER.encode(index))
+
+
+def _load(path: Path, decoder: msgspec.msgpack.Decoder) -> Any:
+    try:
+        return decoder.decode(path.read_bytes())
+    except (OSError, msgspec.DecodeError):
+        return None

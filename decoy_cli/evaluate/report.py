@@ -1,0 +1,469 @@
+"""Write an evaluation's outputs: the CSV tables, summary.json, the figures and report.md.
+
+Every file is written atomically; a file that cannot be written (a full disk) is one
+OutputError, and what was written before it stays. Every output is written on every run (empty
+tables keep their header), so a folder never mixes files of two runs.
+
+Layout of the output folder:
+
+* `players.csv` (one row per player-round), `rounds.csv`, `failures.csv`;
+* `tables/`: `trajectory.csv`, `unevaluated.csv`, `combat.csv`, `death_counts.csv`,
+  `outcome_winner_confusion.csv`, `outcome_reason_confusion.csv`, `hp_over_time.csv`,
+  `places.csv`;
+* `summary.json`: what was run and every aggregate table;
+* `figures/`: see decoy_cli/evaluate/figures.py; `report.md` shows them all;
+* `cache/`: the per-round results (decoy_cli/evaluate/cache.py).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.evaluate.figures import draw_figures
+from decoy_cli.evaluate.runner import Evaluation
+from decoy_cli.evaluate.settings import EvalSettings
+from decoy_cli.evaluate.tables import Tables
+from decoy_cli.files import write_atomic
+from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
+
+FAILURE_COLUMNS = ("file", "round", "kind", "message")
+REPORT_FAILURES_SHOWN = 20
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """How the run was started, for the report: the command line, where it ran, the sample."""
+
+    command: str
+    backend: str
+    """e.g. "2 local worker processes" or "Dask scheduler tcp://10.0.0.1:8786"."""
+    sample: int | None
+    machine: str
+
+
+def data_kind(evaluation: Evaluation) -> str:
+    """ "synthetic", "real" or "mixed", from the files' metadata (no file: "none")."""
+    flags = {f.index.synthetic for f in evaluation.files if f.index is not None}
+    if not flags:
+        return "none"
+    if flags == {True}:
+        return "synthetic"
+    return "real" if flags == {False} else "mixed"
+
+
+def mechanics(settings: EvalSettings) -> str:
+    """What the simulation did, in words."""
+    if not settings.combat:
+        return "movement only: combat and bomb off (as in the paper's Table 2); deaths scripted"
+    if settings.models_fingerprint:
+        return f"combat (damage model: {settings.models}) and bomb on"
+    return "bomb on, no shooting (--models none): deaths scripted from the data"
+
+
+def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
+    """Write every output (see the module docstring); returns the paths written."""
+    from decoy_cli.world.navmesh import load_navmesh
+
+    written = [
+        _csv(out / "players.csv", tables.players),
+        _csv(out / "rounds.csv", tables.rounds),
+        _csv(out / "failures.csv", failures_frame(evaluation)),
+    ]
+    folder = out / "tables"
+    frames = {
+        "trajectory": tables.trajectory,
+        "unevaluated": tables.summary.unevaluated,
+        "combat": tables.combat,
+        "death_counts": pd.DataFrame([tables.deaths.counts]),
+        "outcome_winner_confusion": _confusion(tables, "winner_confusion"),
+        "outcome_reason_confusion": _confusion(tables, "end_reason_confusion"),
+        "hp_over_time": tables.hp_curve,
+        "places": tables.places,
+    }
+    written += [_csv(folder / f"{name}.csv", frame) for name, frame in frames.items()]
+    written.append(
+        write_atomic(
+            out / "summary.json",
+            (
+                json.dumps(summary(evaluation, tables, info), indent=2, default=_json) + "\n"
+            ).encode(),
+        )
+    )
+    figures = draw_figures(out / "figures", evaluation.accumulator, tables, load_navmesh())
+    written += list(figures.values())
+    text = report_markdown(
+        evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}
+    )
+    written.append(write_atomic(out / "report.md", text.encode()))
+    return written
+
+
+def failures_frame(evaluation: Evaluation) -> pd.DataFrame:
+    rows = [
+        {"file": f.file, "round": f.round_num, "kind": f.kind, "message": f.message}
+        for f in evaluation.failures
+    ]
+    return pd.DataFrame(rows, columns=list(FAILURE_COLUMNS)).astype({"round": "Int64"})
+
+
+def _confusion(tables: Tables, name: str) -> pd.DataFrame:
+    matrix = getattr(tables.outcome, name, None) if tables.outcome is not None else None
+    if matrix is None:
+        return pd.DataFrame(columns=["original"])
+    return matrix.reset_index()
+
+
+def _csv(path: Path, frame: pd.DataFrame) -> Path:
+    return write_atomic(path, frame.to_csv(index=False).encode())
+
+
+def _json(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def _clean(value: Any) -> Any:
+    """NaN as null, for strict JSON."""
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_clean(v) for v in value]
+    return value
+
+
+def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
+    return _clean(frame.astype(object).where(frame.notna(), None).to_dict("records"))
+
+
+def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, Any]:
+    """What was run and every aggregate, as one JSON-able dict."""
+    settings = evaluation.settings
+    outcome = tables.outcome
+    return _clean(
+        {
+            "data": data_kind(evaluation),
+            "command": info.command,
+            "backend": info.backend,
+            "machine": info.machine,
+            "inputs": [str(p) for p in evaluation.inputs],
+            "options": {
+                "map": settings.map_name,
+                "combat": settings.combat,
+                "bomb": settings.combat,
+                "models": settings.models,
+                "mover": settings.mover,
+                "seed": settings.seed,
+                "sample": info.sample,
+            },
+            "mechanics": mechanics(evaluation.settings),
+            "counts": _counts(evaluation, tables),
+            "wall_seconds": evaluation.wall_seconds,
+            "compute_seconds": evaluation.compute_seconds,
+            "trajectory": _records(tables.trajectory),
+            "unevaluated": _records(tables.summary.unevaluated),
+            "combat": _records(tables.combat),
+            "death_counts": tables.deaths.counts,
+            "outcome_winner_confusion": None
+            if outcome is None
+            else outcome.winner_confusion.to_dict(),
+            "outcome_reason_confusion": None
+            if outcome is None or outcome.end_reason_confusion is None
+            else outcome.end_reason_confusion.to_dict(),
+            "failures_by_kind": dict(Counter(f.kind for f in evaluation.failures)),
+        }
+    )
+
+
+def _counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
+    return {
+        "match_files": len(evaluation.files),
+        "ignored_files": len(evaluation.ignored),
+        "duplicate_files": len(evaluation.duplicates),
+        "rounds_available": evaluation.rounds_available,
+        "rounds_planned": evaluation.rounds_planned,
+        "rounds_evaluated": evaluation.accumulator.rounds,
+        "rounds_from_cache": evaluation.cached,
+        "rounds_computed": evaluation.computed,
+        "rounds_both_teams": tables.rounds_both_teams,
+        "rounds_with_winner": tables.rounds_with_winner,
+        "player_rounds": len(tables.players),
+        "failures": len(evaluation.failures),
+    }
+
+
+# ---- the Markdown report ------------------------------------------------------------------------
+
+
+def num(value: Any, digits: int = 3) -> str:
+    """A number with fixed digits; "–" for NaN or None."""
+    if value is None:
+        return "–"
+    value = float(value)
+    return "–" if math.isnan(value) else f"{value:.{digits}f}"
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def table_groups(tables: Tables) -> list[str]:
+    """The groups a trajectory table shows: each side in the data, and all when both are."""
+    sides = [g for g in SIDES if tables.summary.n_evaluated[g]]
+    return [*sides, "all"] if len(sides) != 1 else sides
+
+
+def trajectory_rows(tables: Tables, names: tuple[str, ...]) -> tuple[list[str], list[list[str]]]:
+    """Header and rows of one protocol's table: mean ± std, median, p90 of each `table_groups`
+    group, and the paper's Table 2 for the same groups."""
+    groups = table_groups(tables)
+    stats = tables.trajectory.set_index(["metric", "group"])
+    header = ["metric"]
+    for group in groups:
+        header += [f"{group} mean ± std", f"{group} median", f"{group} p90"]
+    paper_groups = groups if any(n in METRIC_NAMES_PAPER for n in names) else []
+    header += [f"paper {g}" for g in paper_groups]
+    rows = []
+    for name in names:
+        row = [name]
+        for group in groups:
+            s = stats.loc[(name, group)]
+            row += [f"{num(s['mean'])} ± {num(s['std'])}", num(s["median"]), num(s["p90"])]
+        for group in paper_groups:
+            s = stats.loc[(name, group)]
+            row.append(
+                "–"
+                if math.isnan(s["paper_mean"])
+                else f"{s['paper_mean']:.3f} ± {s['paper_std']:.3f}"
+            )
+        rows.append(row)
+    return header, rows
+
+
+def _provenance_line(evaluation: Evaluation) -> str | None:
+    """What the files say about where they come from (their top-level `provenance`)."""
+    stated = [f.index.provenance for f in evaluation.files if f.index and f.index.provenance]
+    if not stated:
+        return None
+    first = stated[0] if len(stated[0]) <= 400 else stated[0][:400] + " …"
+    return (
+        f"Provenance stated by {len(stated)} of {len(evaluation.files)} match files "
+        f"({len(set(stated))} distinct); the first: `{first}`"
+    )
+
+
+def _count(count: int, noun: str) -> str:
+    return f"{count} {noun}" + ("" if count == 1 else "s")
+
+
+def _data_line(evaluation: Evaluation) -> str:
+    kind = data_kind(evaluation)
+    if kind == "synthetic":
+        return (
+            "**Data: synthetic.** Every match file says it was generated by the project "
+            "(not recorded in a real match): these numbers check the pipeline, not reality."
+        )
+    if kind == "mixed":
+        synthetic = sum(1 for f in evaluation.files if f.index is not None and f.index.synthetic)
+        return (
+            f"**Data: mixed**: {synthetic} of {len(evaluation.files)} match files are synthetic "
+            "(generated by the project); the numbers mix generated and real rounds."
+        )
+    if kind == "real":
+        return "**Data: real** recorded matches (no file says it is synthetic)."
+    return "**Data: none** could be read."
+
+
+def report_markdown(
+    evaluation: Evaluation, tables: Tables, info: RunInfo, figures: dict[str, Path]
+) -> str:
+    """The whole report (see the module docstring)."""
+    settings = evaluation.settings
+    counts = _counts(evaluation, tables)
+    computed = f"{evaluation.computed} computed"
+    if evaluation.computed:
+        rate = evaluation.computed / evaluation.compute_seconds
+        computed += f" in {evaluation.compute_seconds:.1f} s ({rate:.2f} rounds/s)"
+    parts = [f"# DECOY replay fidelity on {settings.map_name}", _data_line(evaluation)]
+    provenance = _provenance_line(evaluation)
+    if provenance:
+        parts.append(provenance)
+    run_rows = [
+        ["command", f"`{info.command}`"],
+        ["inputs", ", ".join(f"`{p}`" for p in evaluation.inputs)],
+        [
+            "match files",
+            f"{counts['match_files']} ({_count(counts['ignored_files'], 'other file')} "
+            f"ignored, {_count(counts['duplicate_files'], 'duplicate')} skipped)",
+        ],
+        [
+            "rounds",
+            f"{counts['rounds_evaluated']} evaluated of {counts['rounds_available']} "
+            f"{settings.map_name} rounds"
+            + (f" (a sample of {info.sample}, seed {settings.seed})" if info.sample else ""),
+        ],
+        ["computed / from cache", f"{computed}, {evaluation.cached} from the cache"],
+        ["failures", f"{counts['failures']} (see below and `failures.csv`)"],
+        ["mechanics", mechanics(evaluation.settings)],
+        ["mover, seed", f"{settings.mover}, {settings.seed}"],
+        ["ran on", f"{info.backend}; {info.machine}"],
+        ["wall time", f"{evaluation.wall_seconds:.1f} s (before writing the outputs)"],
+        [
+            "rounds with both teams",
+            f"{counts['rounds_both_teams']} of {counts['rounds_evaluated']}",
+        ],
+        ["player-rounds", str(counts["player_rounds"])],
+    ]
+    parts.append("## What was run\n\n" + _table(["", ""], run_rows))
+    parts.append(_trajectory_section(tables, settings.combat))
+    parts.append(_combat_section(tables, settings.combat))
+    parts.append(_figures_section(tables, figures))
+    parts.append(_failures_section(evaluation))
+    return "\n\n".join(parts) + "\n"
+
+
+def _trajectory_section(tables: Tables, combat: bool) -> str:
+    text = [
+        "## Trajectory fidelity (the paper's Table 2)",
+        "Metres; definitions in docs/metrics.md. Protocol *clock* compares original and replay "
+        "frame by frame on the common clock; protocol *paper* resamples each alive trajectory "
+        "to 451 points first, as the paper's evaluation did; the paper's values sit beside it"
+        + (
+            " (the paper ran movement only; this run had combat on)."
+            if combat
+            else " (movement only there and here)."
+        ),
+    ]
+    for title, names in (("clock", METRIC_NAMES_CLOCK), ("paper", METRIC_NAMES_PAPER)):
+        header, rows = trajectory_rows(tables, names)
+        rows = [[f"`{row[0]}`", *row[1:]] for row in rows]
+        text.append(f"### Protocol {title}\n\n" + _table(header, rows))
+    summary = tables.summary
+    evaluated = ", ".join(
+        f"{g}: {summary.n_evaluated[g]} of {summary.n_rows[g]}" for g in GROUPS if summary.n_rows[g]
+    )
+    text.append(f"Player-rounds evaluated: {evaluated or 'none'}.")
+    if len(summary.unevaluated):
+        rows = [[r.group, r.reason, str(r.count)] for r in summary.unevaluated.itertuples()]
+        text.append("Not evaluated:\n\n" + _table(["group", "reason", "player-rounds"], rows))
+    return "\n\n".join(text)
+
+
+def _combat_section(tables: Tables, combat: bool) -> str:
+    text = ["## HP, deaths and outcomes"]
+    if not combat:
+        text.append(
+            "Combat was off: HP changes only where a death is scripted from the data, so these "
+            "measure the scripting, not a damage model."
+        )
+    if tables.rounds_both_teams == 0:
+        text.append(
+            "No evaluated round has both teams in its data: the paper's numbers are for full "
+            "rounds and are not comparable here."
+        )
+    rows = [
+        [f"`{r.metric}`", num(r.value), str(r.n), num(r.paper), str(r.note)]
+        for r in tables.combat.itertuples()
+    ]
+    text.append(_table(["metric", "value", "n", "paper", "over / why not"], rows))
+    counts = tables.deaths.counts
+    text.append(
+        "Deaths: "
+        + ", ".join(f"{name.replace('_', ' ')} {value}" for name, value in counts.items())
+        + "."
+    )
+    if tables.outcome is None:
+        text.append("Outcomes: no round has its winner recorded in the data.")
+    else:
+        for title, matrix in (
+            ("winner", tables.outcome.winner_confusion),
+            ("end reason", tables.outcome.end_reason_confusion),
+        ):
+            if matrix is None:
+                continue
+            header = ["original \\ replay", *map(str, matrix.columns)]
+            rows = [[str(i), *map(str, matrix.loc[i])] for i in matrix.index]
+            text.append(f"Confusion of the {title} (rows: data):\n\n" + _table(header, rows))
+    return "\n\n".join(text)
+
+
+def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
+    rows = [
+        [
+            str(r.place),
+            f"{100 * r.original_share:.1f}%",
+            f"{100 * r.replay_share:.1f}%",
+            f"{r.difference_pp:+.2f}",
+            num(r.mean_error_m, 2),
+            f"{100 * r.off_graph_share:.1f}%",
+        ]
+        for r in tables.places.itertuples()
+    ]
+    return "\n\n".join(
+        [
+            "## Figures",
+            "### Where the players and the replay are (the paper's Figure 5)",
+            f"![heatmaps]({figures['heatmaps'].as_posix()})",
+            "Share of alive samples per 0.5 m cell (smoothed), and the signed percentage "
+            "difference replay − original relative to their mean.",
+            "### Where the replay is off",
+            f"![error map]({figures['error_map'].as_posix()})",
+            "The distance between the replayed agent and the player at each data frame (the "
+            "clock protocol's per-frame distance), by where the player was. By nav place "
+            "(the place of the nearest waypoint), largest error first, with the share of the "
+            "player's samples that have no waypoint on their floor (where the replay cannot "
+            "follow):",
+            _table(
+                [
+                    "place",
+                    "original",
+                    "replay",
+                    "difference (pp)",
+                    "mean distance (m)",
+                    "off the graph",
+                ],
+                rows,
+            ),
+            "### HP over time",
+            f"![HP over time]({figures['hp_over_time'].as_posix()})",
+            "### Death times",
+            f"![death times]({figures['death_times'].as_posix()})",
+            "### Final outcomes (the paper's Figure 6)",
+            f"![outcomes]({figures['outcomes'].as_posix()})",
+        ]
+    )
+
+
+def _failures_section(evaluation: Evaluation) -> str:
+    failures = evaluation.failures
+    if not failures:
+        return "## Failures\n\nNone."
+    kinds = Counter(f.kind for f in failures)
+    text = [
+        "## Failures",
+        f"{len(failures)} files or rounds produced no result (all in `failures.csv`): "
+        + ", ".join(f"{kind} {count}" for kind, count in kinds.most_common())
+        + ".",
+    ]
+    rows = [
+        [Path(f.file).name, "" if f.round_num is None else str(f.round_num), f.kind, f.message]
+        for f in failures[:REPORT_FAILURES_SHOWN]
+    ]
+    text.append(_table(["file", "round", "kind", "reason"], rows))
+    if len(failures) > REPORT_FAILURES_SHOWN:
+        text.append(f"… and {len(failures) - REPORT_FAILURES_SHOWN} more in `failures.csv`.")
+    return "\n\n".join(text)

@@ -1,0 +1,317 @@
+"""Run an evaluation: find the match files, index them, run every round, collect the results.
+
+The steps, all resumable:
+
+1. The inputs (files and folders) become match files (decoy_cli.esta.iter_match_files); files
+   in a folder without a match-file suffix are listed as ignored. Each file is hashed (SHA-256
+   of its bytes): the hash keys the cache, and the same content given twice is evaluated once.
+2. Each file's index (match ID, map, provenance, round numbers, rounds the reader rejected) is
+   read from the cache or computed by a worker (`index_file`) and cached.
+3. Files of another map are skipped, with the reason, as a failure of the file; rounds the reader
+   rejected are failures of their round. With `sample`, a seeded random sample of the rounds
+   (ordered by file content and round number, so it does not depend on paths) is kept.
+4. Every round already in the cache is loaded; the others run in the backend's workers
+   (`evaluate_round`). Each result is cached atomically as it arrives, so an interrupt keeps
+   every finished round; a failure is recorded with its reason and the batch goes on.
+
+Nothing here prints: progress is reported through a callback, the result is returned.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.esta import iter_match_files
+from decoy_cli.esta.reader import MATCH_SUFFIXES
+from decoy_cli.evaluate.cache import RunCache
+from decoy_cli.evaluate.job import (
+    FileIndex,
+    IndexTask,
+    RoundRecord,
+    RoundTask,
+    TaskFailure,
+    evaluate_round,
+    index_file,
+    place_names,
+)
+from decoy_cli.evaluate.settings import (
+    EvalSettings,
+    HeatGrid,
+    code_fingerprint,
+    file_sha256,
+    folder_fingerprint,
+    index_key,
+    round_key,
+)
+from decoy_cli.evaluate.tables import Accumulator
+
+
+class Backend(Protocol):
+    """Runs a job over tasks and yields (task, outcome) as they finish (see backends.py)."""
+
+    def run(self, job: Callable[[Any], Any], tasks: Sequence[Any]) -> Any: ...
+
+
+@dataclass(frozen=True)
+class Failure:
+    """A file (round None) or a round that produced no result, and why, in one line."""
+
+    file: str
+    round_num: int | None
+    kind: str
+    message: str
+
+
+@dataclass(frozen=True)
+class ProgressEvent:
+    """Where a run stands: `stage` is "index" (files) or "rounds"."""
+
+    stage: str
+    done: int
+    total: int
+    failed: int
+
+
+@dataclass(frozen=True)
+class MatchFile:
+    """One input file and, once indexed, what it holds."""
+
+    path: Path
+    sha: str
+    index: FileIndex | None = None
+
+
+@dataclass
+class Evaluation:
+    """What a run did and produced: the accumulated results, failures and counts."""
+
+    settings: EvalSettings
+    inputs: list[Path]
+    files: list[MatchFile]
+    ignored: list[Path]
+    """Files in the input folders without a match-file suffix (not read)."""
+    duplicates: list[tuple[Path, Path]]
+    """(file, the earlier file with the same content): evaluated once."""
+    accumulator: Accumulator
+    failures: list[Failure] = field(default_factory=list)
+    rounds_planned: int = 0
+    rounds_available: int = 0
+    """Rounds of the map in the input before sampling (built or broken)."""
+    computed: int = 0
+    cached: int = 0
+    compute_seconds: float = 0.0
+    wall_seconds: float = 0.0
+
+
+def make_settings(map_name: str, combat: bool, models: str, mover: str, seed: int) -> EvalSettings:
+    """Settings for a run; with combat the damage model is loaded once here, so a bad
+    `--models` choice fails at once with one line instead of in every round."""
+    from decoy_cli.waypoints.build import canonical_map
+
+    name = canonical_map(map_name)
+    if mover not in ("kinematic", "physics"):
+        raise DecoyError(f"--mover must be kinematic or physics, not {mover!r}")
+    models_fingerprint = ""
+    if combat:
+        from decoy_cli.damage import SHIPPED_MODELS, load_damage_model
+
+        if models not in ("shipped", "none"):  # a folder: absolute, for workers elsewhere
+            models = str(Path(models).expanduser().resolve())
+        if load_damage_model(models) is not None:
+            folder = SHIPPED_MODELS if models == "shipped" else Path(models)
+            models_fingerprint = folder_fingerprint(folder)
+    return EvalSettings(
+        map_name=name,
+        combat=combat,
+        models=models if combat else "none",
+        mover=mover,
+        seed=seed,
+        grid=HeatGrid.for_map(name),
+        code=code_fingerprint(name),
+        models_fingerprint=models_fingerprint,
+    )
+
+
+def collect_files(inputs: Sequence[Path]) -> tuple[list[Path], list[Path]]:
+    """The match files of the inputs (in input order, each once) and the files ignored."""
+    files: list[Path] = []
+    ignored: list[Path] = []
+    seen: set[Path] = set()
+    for path in inputs:
+        if not path.exists():
+            raise EstaError(f"{path}: no such file or folder")
+        if path.is_dir():
+            ignored.extend(
+                sorted(
+                    p for p in path.iterdir() if p.is_file() and not p.name.endswith(MATCH_SUFFIXES)
+                )
+            )
+        for file in iter_match_files(path):
+            resolved = file.resolve()  # workers may run elsewhere: absolute paths
+            if resolved not in seen:
+                seen.add(resolved)
+                files.append(resolved)
+    return files, ignored
+
+
+def run_evaluation(
+    inputs: Sequence[Path],
+    settings: EvalSettings,
+    out: Path,
+    backend: Backend,
+    *,
+    sample: int | None = None,
+    on_progress: Callable[[ProgressEvent], None] | None = None,
+    job: Callable[[RoundTask], Any] = evaluate_round,
+) -> Evaluation:
+    """Evaluate every round (or a sample) of the inputs; see the module docstring.
+
+    `job` is the per-round function the workers run (a test can wrap it to inject a crash).
+    An OutputError while caching (a full disk) stops the run; what was cached stays.
+    """
+    started = time.perf_counter()
+    from decoy_cli.waypoints.build import builtin_graph
+
+    paths, ignored = collect_files(inputs)
+    cache = RunCache(out)
+    evaluation = Evaluation(
+        settings=settings,
+        inputs=list(inputs),
+        files=[],
+        ignored=ignored,
+        duplicates=[],
+        accumulator=Accumulator(settings, place_names(builtin_graph(settings.map_name))),
+    )
+    failures = evaluation.failures
+    by_sha: dict[str, Path] = {}
+    for path in paths:
+        try:
+            sha = file_sha256(path)
+        except EstaError as error:
+            failures.append(Failure(str(path), None, "unreadable file", str(error)))
+            continue
+        if sha in by_sha:
+            evaluation.duplicates.append((path, by_sha[sha]))
+            continue
+        by_sha[sha] = path
+        evaluation.files.append(MatchFile(path, sha))
+
+    evaluation.files = _index(evaluation.files, settings, cache, backend, failures, on_progress)
+    tasks = _round_tasks(evaluation, sample)
+    evaluation.rounds_planned = len(tasks)
+    pending: list[RoundTask] = []
+    for task in tasks:
+        record = cache.load_round(task.key)
+        if record is None:
+            pending.append(task)
+        else:
+            evaluation.accumulator.add(record, task.file)
+            evaluation.cached += 1
+
+    compute_started = time.perf_counter()
+    failed = 0
+    _report(on_progress, "rounds", 0, len(pending), 0)
+    for done, (task, outcome) in enumerate(backend.run(job, pending), start=1):
+        if isinstance(outcome, RoundRecord):
+            cache.store_round(outcome)
+            evaluation.accumulator.add(outcome, task.file)
+            evaluation.computed += 1
+        else:
+            failed += 1
+            failures.append(_round_failure(task, outcome))
+        _report(on_progress, "rounds", done, len(pending), failed)
+    evaluation.compute_seconds = time.perf_counter() - compute_started
+    evaluation.wall_seconds = time.perf_counter() - started
+    failures.sort(key=lambda f: (f.file, -1 if f.round_num is None else f.round_num))
+    return evaluation
+
+
+def _report(
+    on_progress: Callable[[ProgressEvent], None] | None,
+    stage: str,
+    done: int,
+    total: int,
+    failed: int,
+) -> None:
+    if on_progress is not None:
+        on_progress(ProgressEvent(stage, done, total, failed))
+
+
+def _round_failure(task: RoundTask, outcome: Any) -> Failure:
+    if isinstance(outcome, TaskFailure):
+        return Failure(task.file, task.round_num, outcome.kind, outcome.message)
+    return Failure(task.file, task.round_num, "internal error", f"unexpected result {outcome!r}")
+
+
+def _index(
+    files: list[MatchFile],
+    settings: EvalSettings,
+    cache: RunCache,
+    backend: Backend,
+    failures: list[Failure],
+    on_progress: Callable[[ProgressEvent], None] | None,
+) -> list[MatchFile]:
+    """Every file with its index (cached or computed); unreadable files become failures."""
+    indexes: dict[str, FileIndex] = {}
+    pending: list[IndexTask] = []
+    for file in files:
+        found = cache.load_index(index_key(settings, file.sha))
+        if found is None:
+            pending.append(IndexTask(str(file.path), file.sha, settings))
+        else:
+            indexes[file.sha] = found
+    failed = 0
+    _report(on_progress, "index", 0, len(pending), 0)
+    for done, (task, outcome) in enumerate(backend.run(index_file, pending), start=1):
+        if isinstance(outcome, FileIndex):
+            cache.store_index(index_key(settings, task.file_sha), outcome)
+            indexes[task.file_sha] = outcome
+        else:
+            failed += 1
+            failures.append(Failure(task.file, None, outcome.kind, outcome.message))
+        _report(on_progress, "index", done, len(pending), failed)
+    return [MatchFile(f.path, f.sha, indexes.get(f.sha)) for f in files]
+
+
+def _round_tasks(evaluation: Evaluation, sample: int | None) -> list[RoundTask]:
+    """The rounds to evaluate; other maps and rejected rounds go to the failures."""
+    settings = evaluation.settings
+    population: list[tuple[str, int, MatchFile, str | None]] = []
+    for file, index in ((f, f.index) for f in evaluation.files if f.index is not None):
+        if index.map_name and index.map_name != settings.map_name:
+            count = len(index.rounds) + len(index.round_errors)
+            evaluation.failures.append(
+                Failure(
+                    str(file.path),
+                    None,
+                    "other map",
+                    f"{file.path}: a {index.map_name} match ({count} rounds skipped); "
+                    f"this evaluation is of {settings.map_name}",
+                )
+            )
+            continue
+        population.extend((file.sha, num, file, None) for num in index.rounds)
+        population.extend((file.sha, num, file, msg) for num, msg in index.round_errors.items())
+    population.sort(key=lambda item: (item[0], item[1]))
+    evaluation.rounds_available = len(population)
+    if sample is not None and sample < len(population):
+        rng = np.random.default_rng(settings.seed)
+        chosen = np.sort(rng.choice(len(population), size=sample, replace=False))
+        population = [population[i] for i in chosen]
+    order = {file.sha: i for i, file in enumerate(evaluation.files)}
+    population.sort(key=lambda item: (order[item[0]], item[1]))
+    tasks = []
+    for sha, num, file, error in population:
+        if error is not None:
+            evaluation.failures.append(Failure(str(file.path), num, "broken round", error))
+        else:
+            key = round_key(settings, sha, num)
+            tasks.append(RoundTask(str(file.path), sha, num, key, settings))
+    return tasks

@@ -1,0 +1,167 @@
+"""What decides a round's result, and the fingerprints that key the cache.
+
+`EvalSettings` holds every option that changes a round's result, plus fingerprints of the code,
+the map assets and (with combat) the damage models, so a cached result is reused only for the
+same file content, round, options, code and models. The fixed grids on which per-round data are
+kept compact (`HeatGrid`, the HP time grid) are part of the settings too.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass
+from functools import cache
+from pathlib import Path
+
+from decoy_cli.errors import EstaError
+from decoy_cli.world.navmesh import asset_dir, load_navmesh
+
+RECORD_VERSION = 1
+"""Format of the cached per-round records and file indexes; bump when it changes."""
+
+HEAT_CELL_M = 0.5
+"""Side of a heatmap cell (metres)."""
+
+HP_BIN_S = 1.0
+"""Width of a bin of the HP-over-time curve (seconds since freeze-time end)."""
+
+HP_BINS = 240
+"""Bins of the HP-over-time curve: 0 to 240 s covers a full round with a planted bomb."""
+
+_CODE_PARTS = (
+    "csgo.py",
+    "weapons.py",
+    "esta",
+    "replay",
+    "sim",
+    "metrics",
+    "waypoints",
+    "world",
+    "damage",
+    "evaluate/job.py",
+    "evaluate/settings.py",
+)
+"""The package's modules that decide a round's result (presentation code is left out)."""
+
+
+@dataclass(frozen=True)
+class HeatGrid:
+    """A fixed x-y grid over the map (metres): cell (i, j) spans x0 + i·cell, y0 + j·cell."""
+
+    x0: float
+    y0: float
+    cell: float
+    nx: int
+    ny: int
+
+    @classmethod
+    def for_map(cls, map_name: str, cell: float = HEAT_CELL_M) -> HeatGrid:
+        """The grid covering every nav area of a built-in map, one cell of margin."""
+        from decoy_cli.csgo import HAMMER_TO_M
+
+        nav = load_navmesh(map_name)
+        x_lo = math.floor(float(nav.x_min.min()) * HAMMER_TO_M / cell) - 1
+        y_lo = math.floor(float(nav.y_min.min()) * HAMMER_TO_M / cell) - 1
+        x_hi = math.ceil(float(nav.x_max.max()) * HAMMER_TO_M / cell) + 1
+        y_hi = math.ceil(float(nav.y_max.max()) * HAMMER_TO_M / cell) + 1
+        return cls(x0=x_lo * cell, y0=y_lo * cell, cell=cell, nx=x_hi - x_lo, ny=y_hi - y_lo)
+
+    @property
+    def size(self) -> int:
+        return self.nx * self.ny
+
+    @property
+    def extent(self) -> tuple[float, float, float, float]:
+        """(x_min, x_max, y_min, y_max) of the grid, for imshow."""
+        return (
+            self.x0,
+            self.x0 + self.nx * self.cell,
+            self.y0,
+            self.y0 + self.ny * self.cell,
+        )
+
+
+@dataclass(frozen=True)
+class EvalSettings:
+    """Everything that decides one round's result; its JSON is hashed into the cache key.
+
+    `combat` switches shooting and the bomb together (off: movement only, as in the paper's
+    Table 2); `models` is the damage-model choice a worker loads (only used with combat).
+    """
+
+    map_name: str
+    combat: bool
+    models: str
+    mover: str
+    seed: int
+    grid: HeatGrid
+    code: str
+    """Fingerprint of the result-deciding code and the map's assets (`code_fingerprint`)."""
+    models_fingerprint: str
+    """Fingerprint of the damage model files ("" without combat or with no model)."""
+    hp_bin_s: float = HP_BIN_S
+    hp_bins: int = HP_BINS
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), sort_keys=True)
+
+
+def round_key(settings: EvalSettings, file_sha: str, round_num: int) -> str:
+    """The cache key of one round's result under these settings."""
+    text = f"round|{RECORD_VERSION}|{settings.to_json()}|{file_sha}|{round_num}"
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def index_key(settings: EvalSettings, file_sha: str) -> str:
+    """The cache key of a file's index (its rounds, map and provenance); depends on the code."""
+    text = f"index|{RECORD_VERSION}|{settings.code}|{file_sha}"
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
+    """The simulator seed of one round: fixed by the run's seed, the file and the round."""
+    digest = hashlib.sha256(f"{settings.seed}|{file_sha}|{round_num}".encode()).digest()
+    return int.from_bytes(digest[:8], "little") & (2**63 - 1)
+
+
+def file_sha256(path: Path) -> str:
+    """SHA-256 of a file's bytes; an unreadable file raises EstaError."""
+    digest = hashlib.sha256()
+    try:
+        with path.open("rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+    except OSError as error:
+        raise EstaError(f"{path}: cannot read the file ({error.strerror or error})") from None
+    return digest.hexdigest()
+
+
+@cache
+def code_fingerprint(map_name: str) -> str:
+    """Hash of the result-deciding source files and the map's asset files.
+
+    Computed once per process: the code a process runs does not change while it runs, so two
+    runs in one process (a test's interrupted run and its resume) agree even if files change.
+    """
+    package = Path(__file__).resolve().parents[1]
+    files: list[Path] = []
+    for part in _CODE_PARTS:
+        path = package / part
+        files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
+    files.extend(sorted(p for p in asset_dir(map_name).rglob("*") if p.is_file()))
+    digest = hashlib.sha256()
+    for path in files:
+        digest.update(str(path.relative_to(package)).encode() + b"\0")
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def folder_fingerprint(folder: Path) -> str:
+    """Hash of every file in a folder (names and contents), e.g. a damage-model folder."""
+    digest = hashlib.sha256()
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        digest.update(str(path.relative_to(folder)).encode() + b"\0")
+        digest.update(file_sha256(path).encode())
+    return digest.hexdigest()
