@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 import torch
 from esta_fixtures import make_match, write_match
+from trained_nets import trained_like
 from typer.testing import CliRunner
 
 import decoy_cli.damage
@@ -31,26 +32,14 @@ runner = CliRunner()
 WIDE = {"COLUMNS": "220"}
 
 
-def randomise(net: torch.nn.Module, seed: int) -> torch.nn.Module:
-    """Random weights and BatchNorm statistics, as a trained net would have."""
-    generator = torch.Generator().manual_seed(seed)
-    with torch.no_grad():
-        for name, tensor in net.state_dict().items():
-            if name.endswith("running_var"):
-                tensor.copy_(torch.rand(tensor.shape, generator=generator) + 0.5)
-            elif tensor.is_floating_point():
-                tensor.copy_(torch.randn(tensor.shape, generator=generator) * 0.3)
-    return net.eval()
-
-
 def model_folder(
     folder: Path, fire: bool = False, dog_bias: float | None = None, seed: int = 0
 ) -> Path:
     """A model folder of random nets. DOG's damage is about 30 HP give or take a few tens;
     `fire`: DIP says 'hit' for every pair (logit 20); `dog_bias`: DOG's damage output is this
     constant (HP / 100)."""
-    dip = randomise(DipNet(), seed)
-    dog = randomise(DogNet(), seed + 1)
+    dip = trained_like(DipNet(), seed)
+    dog = trained_like(DogNet(), seed + 1)
     with torch.no_grad():
         dog.vae_decoder.damage_regressor[0].weight.mul_(0.1)
         dog.vae_decoder.damage_regressor[0].bias.fill_(0.3)
@@ -185,7 +174,7 @@ def test_the_folded_networks_equal_the_modules(folder: Path) -> None:
 
 def test_dip_and_dog_may_use_different_features(folder: Path, tmp_path: Path) -> None:
     dip = load_dip(folder)
-    paper_dog = randomise(DogNet(), 3)
+    paper_dog = trained_like(DogNet(), 3)
     save_dog(tmp_path, paper_dog, PAPER_SPEC)
     dog = load_dog(tmp_path)
     pairs = batch(12, seed=5)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import torch
 import torch.nn.functional as F
+from trained_nets import trained_like
 
 from decoy_cli.damage.features import PAPER_SPEC, Features, FeatureSpec
 from decoy_cli.damage.model_folder import (
@@ -29,18 +30,6 @@ def random_features(k: int, seed: int = 0) -> Features:
     weapon = np.eye(34, dtype=np.float32)[rng.integers(0, 34, k)]
     armor = rng.integers(0, 2, (k, 2)).astype(np.float32)
     return Features(onehot, rng.uniform(-1, 1, (k, 11)).astype(np.float32), weapon, armor)
-
-
-def trained_like(net: torch.nn.Module, seed: int) -> torch.nn.Module:
-    """Random weights and BatchNorm statistics, as a trained net would have; eval mode."""
-    generator = torch.Generator().manual_seed(seed)
-    with torch.no_grad():
-        for name, tensor in net.state_dict().items():
-            if name.endswith("running_var"):
-                tensor.copy_(torch.rand(tensor.shape, generator=generator) + 0.5)
-            elif tensor.is_floating_point():
-                tensor.copy_(torch.randn(tensor.shape, generator=generator) * 0.3)
-    return net.eval()
 
 
 def test_layers_are_the_papers() -> None:
