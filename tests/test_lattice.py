@@ -21,12 +21,16 @@ from worlds import (
     LEDGE_X,
     LEDGE_Z,
     alcove_room,
+    box,
+    floor,
     gap_wall_world,
     jump_box_world,
     ledge_world,
+    make_world,
     overpass_world,
     room,
     seeds_of,
+    walls_around,
 )
 
 from decoy_cli.csgo import JUMP_HEIGHT_M
@@ -211,22 +215,64 @@ def test_ledge_drops_one_way_and_never_climbs() -> None:
 
 def test_box_is_jumped_onto_and_dropped_off() -> None:
     result = lattice("jump box")
-    pos, kind = result.positions, result.edge_kind
+    pos, kind, direction = result.positions, result.edge_kind, result.edge_direction
     x0, y0, x1, y1 = BOX
     top = np.abs(pos[:, 2] - BOX_Z) < 0.02
     inside = (pos[:, 0] > x0) & (pos[:, 0] < x1) & (pos[:, 1] > y0) & (pos[:, 1] < y1)
     assert np.array_equal(top, inside)
-    assert top.sum() == 4  # lattice lines 3.3 and 4.0 (seed 0.5 + 0.7 k) cross the box
+    # lattice lines 3.3 and 4.0 (seed 0.5 + 0.7 k) cross the box; the four nodes on line 4.0
+    # also get a wall node 0.35 m toward the edge 0.5 m away (a cliff edge on the box top)
+    lattice_top = top & np.all(np.isclose(pos[:, :2] % 0.7, 0.5), axis=1)
+    assert lattice_top.sum() == 4 and top.sum() == 8
     src, dst = result.edge_source, result.edge_target
     onto = ~top[src] & top[dst]
     off = top[src] & ~top[dst]
-    assert onto.sum() == off.sum() == 20  # each top node has 5 floor neighbours
+    assert onto.sum() == off.sum() == 20  # each top lattice node has 5 floor neighbours
+    assert np.all(lattice_top[dst[onto]])
     assert np.all(kind[onto] == EdgeKind.JUMP)
     assert np.all(kind[off] == EdgeKind.DROP)
     assert np.all(kind[~onto & ~off] == EdgeKind.WALK)
-    jumps = set(zip(src[onto].tolist(), dst[onto].tolist(), strict=True))
-    drops = set(zip(dst[off].tolist(), src[off].tolist(), strict=True))
-    assert jumps == drops
+    # the floor nodes that jump on are the ones the drops land on; a drop the edge wall node
+    # took over from its lattice parent keeps the parent's direction
+    assert set(src[onto].tolist()) == set(dst[off].tolist())
+    from_wall = off & ~lattice_top[src]
+    assert from_wall.sum() > 0
+    for e in np.flatnonzero(from_wall):
+        parent = (dst == src[e]) & lattice_top[src] & (direction == direction[e])
+        assert parent.sum() == 1
+
+
+def test_wall_node_stands_at_a_box_face_and_the_jump_leaves_from_it() -> None:
+    """A floor node 0.7 m from the face of a box it jumps onto gets a wall node against the
+    face (players wait there before jumping); the jump then leaves from the wall node, and the
+    parent walks to it, so no node has two edges in one direction and the box stays reachable."""
+    face_x = 3.2
+    world = make_world(
+        [
+            floor(0.0, 0.0, 8.0, 8.0),
+            walls_around(0.0, 0.0, 8.0, 8.0),
+            box(face_x, 3.2, 4.8, 4.8, 0.0, BOX_Z),
+        ],
+        "box face",
+        (0.5, 0.5, 0.0),
+    )
+    params = LatticeParams(spacing=1.0)
+    with PhysicsWorld(world) as physics:
+        result = build_lattice(physics, seeds_of(world), params)
+    pos, src, dst = result.positions, result.edge_source, result.edge_target
+    kind, direction = result.edge_kind, result.edge_direction
+    on_face = np.isclose(pos[:, 0], face_x - params.agent_radius - 0.03) & (pos[:, 2] < 0.05)
+    face_node = int(np.flatnonzero(on_face & np.isclose(pos[:, 1], 3.5))[0])
+    parent = int(np.flatnonzero(np.all(np.isclose(pos, (2.5, 3.5, 0.0), atol=0.02), axis=1))[0])
+    east = 2
+    from_parent = (src == parent) & (direction == east)
+    assert dst[from_parent].tolist() == [face_node] and kind[from_parent][0] == EdgeKind.WALK
+    from_face = (src == face_node) & (direction == east)
+    assert kind[from_face].tolist() == [EdgeKind.JUMP]
+    assert np.allclose(pos[dst[from_face][0]], (3.5, 3.5, BOX_Z), atol=0.02)
+    pairs = list(zip(src.tolist(), direction.tolist(), strict=True))
+    assert len(pairs) == len(set(pairs))
+    assert result.stats.components_before == 1
 
 
 @cache

@@ -1,5 +1,6 @@
 """`decoy make-sample`: a synthetic match written without damage models (rounds end by the bomb
-or time), byte-identical for the same seed, and one error line for every bad option."""
+or time), byte-identical for the same seed, the shipped sample reproduced, and one error line for
+every bad option."""
 
 from __future__ import annotations
 
@@ -47,6 +48,17 @@ def test_sample_without_models(tmp_path: Path) -> None:
     assert code == 0, stdout + stderr
     again = tmp_path / "b" / "synthetic-dust2-seed1.json.xz"
     assert again.read_bytes() == path.read_bytes()
+
+
+def test_the_shipped_sample_is_what_make_sample_writes(tmp_path: Path) -> None:
+    """The built-in sample is the project's own output, current with its code, graph and models:
+    the command in examples/sample/README.md reproduces it byte for byte (when the simulator,
+    the graph or the shipped models change, regenerate it with that command)."""
+    shipped = Path(__file__).parents[1] / "examples" / "sample" / "synthetic-dust2-seed0.json.xz"
+    args = ["--out", str(tmp_path), "--rounds", "8", "--seed", "0", "--models", "shipped"]
+    result = runner.invoke(app, ["make-sample", *args], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / shipped.name).read_bytes() == shipped.read_bytes()
 
 
 @pytest.mark.parametrize(
