@@ -181,6 +181,8 @@ def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(
     for text in ("protocol clock", "protocol paper", "paper_dtw", "HP, deaths and outcomes"):
         assert text in result.output
     assert "data: real" in result.output
+    # the HP and death numbers say, in the terminal as in the report, what they do not measure
+    assert "Combat was off: HP changes only" in result.output
     # the same numbers as one worker, down to the last digit of the CSV
     assert (out / "players.csv").read_text() == reference[1].players.to_csv(index=False)
     report = (out / "report.md").read_text()
@@ -188,7 +190,7 @@ def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(
         "## What was run",
         "### Protocol clock",
         "### Protocol paper",
-        "## HP, deaths and outcomes",
+        "## HP, deaths and outcomes\n\nCombat was off: HP changes only",
         "Confusion of the winner",
         "Confusion of the end reason",
         "## Failures",

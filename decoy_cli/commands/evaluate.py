@@ -27,6 +27,7 @@ from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.report import (
     RunInfo,
+    combat_caveats,
     data_kind,
     mechanics,
     num,
@@ -289,7 +290,8 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         console.print(table)
     for row in tables.summary.unevaluated.itertuples():
         console.print(f"  {row.group}: {row.count} not evaluated ({row.reason})", highlight=False)
-    combat = Table(title="HP, deaths and outcomes")
+    caveats = combat_caveats(tables, evaluation.settings.combat)
+    combat = Table(title="HP, deaths and outcomes", caption=" ".join(caveats) or None)
     for column in ("metric", "value", "n", "paper", "over / why not"):
         combat.add_column(column, justify="right" if column in ("value", "n", "paper") else "left")
     for row in tables.combat.itertuples():

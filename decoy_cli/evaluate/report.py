@@ -363,18 +363,24 @@ def _trajectory_section(tables: Tables, combat: bool) -> str:
     return "\n\n".join(text)
 
 
-def _combat_section(tables: Tables, combat: bool) -> str:
-    text = ["## HP, deaths and outcomes"]
+def combat_caveats(tables: Tables, combat: bool) -> list[str]:
+    """What the HP, death and outcome numbers do not measure in this run (report and terminal)."""
+    caveats = []
     if not combat:
-        text.append(
+        caveats.append(
             "Combat was off: HP changes only where a death is scripted from the data, so these "
             "measure the scripting, not a damage model."
         )
     if tables.rounds_both_teams == 0:
-        text.append(
+        caveats.append(
             "No evaluated round has both teams in its data: the paper's numbers are for full "
             "rounds and are not comparable here."
         )
+    return caveats
+
+
+def _combat_section(tables: Tables, combat: bool) -> str:
+    text = ["## HP, deaths and outcomes", *combat_caveats(tables, combat)]
     rows = [
         [f"`{r.metric}`", num(r.value), str(r.n), num(r.paper), str(r.note)]
         for r in tables.combat.itertuples()
