@@ -3,6 +3,14 @@
 See decoy_cli/esta/reader.py for what is tolerated and what fails the file or only one round.
 """
 
+from decoy_cli.esta.batch import (
+    RoundFailure,
+    collect_match_files,
+    failure_from,
+    iter_matches,
+    iter_rounds,
+    match_rounds,
+)
 from decoy_cli.esta.frames import MISSING, PlayerInfo
 from decoy_cli.esta.reader import (
     Match,
@@ -18,8 +26,14 @@ __all__ = [
     "Match",
     "PlayerInfo",
     "Round",
+    "RoundFailure",
+    "collect_match_files",
+    "failure_from",
     "iter_match_files",
+    "iter_matches",
+    "iter_rounds",
     "load_round",
+    "match_rounds",
     "parse_round_address",
     "read_match",
 ]

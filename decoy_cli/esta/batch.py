@@ -1,0 +1,126 @@
+"""Every round of a set of match files, or why it could not be had: the one batch loop.
+
+Work over many rounds (evaluate, the snap and replay studies, the benchmark, training) goes
+through this module. A file that cannot be read, a match of another map and a round that fails
+validation each become a `RoundFailure` with its reason, and the batch goes on; work done on a
+round that then fails is recorded with `failure_from` under the same rules: a `DecoyError` is a
+bad input and keeps its own one-line message, anything else is a bug ("internal error") named
+with the place it was raised.
+"""
+
+from __future__ import annotations
+
+import traceback
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.esta.reader import MATCH_SUFFIXES, Match, Round, iter_match_files, read_match
+
+UNREADABLE_FILE = "unreadable file"
+OTHER_MAP = "other map"
+BROKEN_ROUND = "broken round"
+INTERNAL_ERROR = "internal error"
+
+
+@dataclass(frozen=True)
+class RoundFailure:
+    """A file (`round_num` None) or one round that produced no result, and why, in one line.
+
+    `kind` is a short category (`UNREADABLE_FILE`, `OTHER_MAP`, `BROKEN_ROUND`, or what the
+    work on the round calls its own failures, e.g. "replay error"); `message` is one line.
+    """
+
+    file: str
+    round_num: int | None
+    kind: str
+    message: str
+
+
+def failure_from(
+    error: BaseException, file: str | Path, round_num: int | None, kind: str
+) -> RoundFailure:
+    """The failure of work that raised `error`: its own line for a `DecoyError`, else a bug."""
+    if isinstance(error, DecoyError):
+        return RoundFailure(str(file), round_num, kind, str(error))
+    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
+    where = f" (at {Path(frame.filename).name}:{frame.lineno})" if frame else ""
+    text = str(error).splitlines()[0] if str(error) else ""
+    return RoundFailure(
+        str(file), round_num, INTERNAL_ERROR, f"{type(error).__name__}: {text}{where}"
+    )
+
+
+def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[Path]]:
+    """The match files of the inputs (files or folders; absolute, in input order, each once)
+    and the other files found in the folders (not read). A missing input is an EstaError."""
+    files: list[Path] = []
+    ignored: list[Path] = []
+    seen: set[Path] = set()
+    for item in inputs:
+        path = Path(item)
+        if not path.exists():
+            raise EstaError(f"{path}: no such file or folder")
+        if path.is_dir():
+            ignored.extend(
+                sorted(
+                    p for p in path.iterdir() if p.is_file() and not p.name.endswith(MATCH_SUFFIXES)
+                )
+            )
+        for file in iter_match_files(path):
+            resolved = file.resolve()  # workers may run elsewhere: absolute paths
+            if resolved not in seen:
+                seen.add(resolved)
+                files.append(resolved)
+    return files, ignored
+
+
+def map_failure(match: Match, map_name: str | None) -> RoundFailure | None:
+    """The failure of a whole match played on another map than `map_name` (None: any map)."""
+    if map_name is None or not match.map_name or match.map_name == map_name:
+        return None
+    count = len(match.round_numbers)
+    return RoundFailure(
+        str(match.path),
+        None,
+        OTHER_MAP,
+        f"{match.path}: a {match.map_name} match ({count} rounds skipped); "
+        f"this work is on {map_name}",
+    )
+
+
+def match_rounds(match: Match) -> Iterator[Round | RoundFailure]:
+    """The rounds of a match in round-number order, a broken one as its failure."""
+    built = {r.round_num: r for r in match.rounds}
+    for num in match.round_numbers:
+        if num in built:
+            yield built[num]
+        else:
+            error = match.round_errors[num]
+            yield RoundFailure(str(match.path), num, BROKEN_ROUND, str(error))
+
+
+def iter_matches(
+    files: Iterable[str | Path], *, map_name: str | None = None
+) -> Iterator[Match | RoundFailure]:
+    """Each readable match of `files` on `map_name` (None: any), else the file's failure."""
+    for file in files:
+        try:
+            match = read_match(file)
+        except DecoyError as error:
+            yield failure_from(error, file, None, UNREADABLE_FILE)
+            continue
+        other = map_failure(match, map_name)
+        yield match if other is None else other
+
+
+def iter_rounds(
+    files: Iterable[str | Path], *, map_name: str | None = None
+) -> Iterator[Round | RoundFailure]:
+    """Every round of `files` in file then round order, or the failure that stands for it."""
+    for item in iter_matches(files, map_name=map_name):
+        if isinstance(item, RoundFailure):
+            yield item
+        else:
+            yield from match_rounds(item)
