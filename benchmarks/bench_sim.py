@@ -16,8 +16,9 @@ import json
 from pathlib import Path
 
 from decoy_cli.bench.machine import machine_info
-from decoy_cli.bench.simspeed import AGENT_COUNTS, MOVERS, PAPER_DECISIONS, speed_table
+from decoy_cli.bench.simspeed import AGENT_COUNTS, PAPER_DECISIONS, speed_table
 from decoy_cli.damage import load_damage_model
+from decoy_cli.sim.setup import MOVERS
 
 
 def main() -> None:
@@ -33,7 +34,7 @@ def main() -> None:
     print(f"machine: {machine['cores']} cores, {machine['cpu']}, load {machine['load_average']}")
     model = load_damage_model(args.models)
     print(f"damage model: {args.models if model else 'none (line of sight only)'}")
-    rows = speed_table(tuple(args.agents), args.decisions, model, args.mover, args.seed)
+    rows = speed_table(tuple(args.agents), args.decisions, model, mover=args.mover, seed=args.seed)
     print("agents  ticks  decisions  wall s  game s  ticks/s  time scale  paper ticks/s  ratio")
     for row in rows:
         paper = row.paper_ticks_per_s

@@ -42,7 +42,9 @@ def main() -> None:
     files = iter_match_files(args.folder)
     if args.limit:
         files = files[: args.limit]
-    settings = make_settings("de_dust2", False, "none", args.mover, 0)
+    settings = make_settings(
+        map_name="de_dust2", combat=False, bomb=False, models="none", mover=args.mover, seed=0
+    )
     with tempfile.TemporaryDirectory() as out, LocalBackend(args.workers) as backend:
         evaluation = run_evaluation(files, settings, Path(out), backend)
     wall = evaluation.compute_seconds

@@ -6,6 +6,8 @@ Hammer units are converted once where data enters (the ESTA reader, the nav asse
 
 from __future__ import annotations
 
+import math
+
 HAMMER_TO_M = 0.01905
 """One Hammer unit in metres."""
 
@@ -35,3 +37,16 @@ GRAVITY_M_S2 = 800 * HAMMER_TO_M
 
 JUMP_SPEED_M_S = 301.99 * HAMMER_TO_M
 """Upward speed a jump starts with (sqrt(2 * 800 * 57) u/s): a plain jump rises about 57 u."""
+
+
+def seconds_to_ticks(seconds: float, tick_rate: int = TICK_RATE) -> int:
+    """A duration as a whole number of ticks, rounded up so that no rule runs shorter than in the
+    game. The product is first rounded to 1e-6, so float noise adds no tick: 8.3 * 60 is
+    498.00000000000006 and gives 498, not 499."""
+    return math.ceil(round(seconds * tick_rate, 6))
+
+
+def tick_at(seconds: float, tick_rate: int = TICK_RATE) -> int:
+    """The tick nearest a moment in time (seconds on the round's clock): where data frames,
+    deadlines and recorded events fall."""
+    return round(float(seconds) * tick_rate)

@@ -1,4 +1,5 @@
-"""Writing output files safely: to a temporary file beside the target, then a rename.
+"""Writing output files safely: to a temporary file beside the target, then a rename; and the
+one JSON writer (strict JSON: no bare NaN).
 
 A crash, a full disk or an interrupt never leaves a half-written graph, mesh, table or picture
 under the real name; every failure is one OutputError line.
@@ -6,10 +7,15 @@ under the real name; every failure is one OutputError line.
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from decoy_cli.errors import OutputError
 
@@ -42,3 +48,31 @@ def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> P
         tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def json_ready(value: Any) -> Any:
+    """`value` as strict JSON data: NaN and infinities as null (strict JSON has neither), numpy
+    scalars and arrays as Python numbers and lists, paths as strings, tuples as lists."""
+    if isinstance(value, np.ndarray):
+        return json_ready(value.tolist())
+    if isinstance(value, np.generic):
+        return json_ready(value.item())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def json_text(data: Any, *, sort_keys: bool = True) -> str:
+    """Pretty strict JSON of `data` (see `json_ready`), ending in a newline."""
+    return json.dumps(json_ready(data), indent=2, sort_keys=sort_keys, allow_nan=False) + "\n"
+
+
+def write_json(path: str | Path, data: Any, *, sort_keys: bool = True) -> Path:
+    """Write `data` as pretty strict JSON, atomically: the one JSON writer of every output."""
+    return write_atomic(path, json_text(data, sort_keys=sort_keys).encode())

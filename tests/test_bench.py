@@ -158,7 +158,7 @@ def test_a_failing_section_is_an_error_entry_not_a_crash() -> None:
 def test_bad_options_are_one_line(tmp_path: Path) -> None:
     mover = runner.invoke(app, ["bench", "--quick", "--mover", "warp"], env=WIDE)
     assert mover.exit_code == 1
-    assert mover.stderr.strip() == "error: --mover must be one of physics, kinematic, not 'warp'"
+    assert mover.stderr.strip() == "error: unknown mover 'warp' (use kinematic or physics)"
     folder = runner.invoke(app, ["bench", "--quick", "--out", str(tmp_path)], env=WIDE)
     assert folder.exit_code == 1 and "is a folder" in folder.stderr
     data = runner.invoke(app, ["bench", "--quick", "--data", str(tmp_path)], env=WIDE)

@@ -351,12 +351,15 @@ def test_replay_bad_models_are_one_error_line(
 # ---- the environment --------------------------------------------------------------------------
 
 
-def test_environment_takes_a_model_choice(tmp_path: Path) -> None:
+def test_environment_takes_a_model_loader(tmp_path: Path) -> None:
     lethal = model_folder(tmp_path / "lethal", fire=True, dog_bias=5.0)
-    assert DecoyParallelEnv(n_t=1, n_ct=1, damage_model="none").damage_model is None
+    none = DecoyParallelEnv(n_t=1, n_ct=1, damage_model=lambda: load_damage_model("none"))
+    assert none.damage_model is None and not none.setup.shooting
     with pytest.raises(ModelError, match="no such model folder"):
-        DecoyParallelEnv(damage_model=str(tmp_path / "nowhere"))
-    env = DecoyParallelEnv(n_t=1, n_ct=1, damage_model=str(lethal), bomb=False)
+        DecoyParallelEnv(damage_model=lambda: load_damage_model(str(tmp_path / "nowhere")))
+    env = DecoyParallelEnv(
+        n_t=1, n_ct=1, damage_model=lambda: load_damage_model(str(lethal)), bomb=False
+    )
     assert isinstance(env.damage_model, LearnedDamage)
     try:
         env.reset(seed=0)

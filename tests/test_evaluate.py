@@ -96,7 +96,9 @@ def clean(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def settings() -> EvalSettings:
-    return make_settings("dust2", combat=False, models="shipped", mover="kinematic", seed=0)
+    return make_settings(
+        map_name="dust2", combat=False, bomb=False, models="shipped", mover="kinematic", seed=0
+    )
 
 
 @pytest.fixture(scope="module")
@@ -176,7 +178,7 @@ def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(
     clean: Path, reference: tuple[Evaluation, Tables], tmp_path: Path
 ) -> None:
     out = tmp_path / "out"
-    result = _invoke(str(clean), "--no-combat", "--workers", "2", "--out", str(out))
+    result = _invoke(str(clean), "--no-combat", "--no-bomb", "--workers", "2", "--out", str(out))
     assert result.exit_code == 0, result.output
     for text in ("protocol clock", "protocol paper", "paper_dtw", "HP, deaths and outcomes"):
         assert text in result.output
@@ -261,7 +263,9 @@ def test_an_interrupted_run_resumes_with_only_the_rest(
     assert_same_results(again, reference)
 
     # another option is another result: nothing is reused
-    other = make_settings("dust2", combat=False, models="shipped", mover="kinematic", seed=1)
+    other = make_settings(
+        map_name="dust2", combat=False, bomb=False, models="shipped", mover="kinematic", seed=1
+    )
     assert run_evaluation([clean], other, tmp_path, pool).computed == CLEAN_ROUNDS
 
 
@@ -384,7 +388,7 @@ def test_a_full_disk_stops_with_one_line_and_keeps_what_was_cached(
 
     monkeypatch.setattr(RunCache, "store_round", store)
     out = tmp_path / "out"
-    result = _invoke(str(clean), "--no-combat", "--workers", "1", "--out", str(out))
+    result = _invoke(str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
     assert result.exit_code == 1
     assert result.output.strip().splitlines()[-1].startswith("error: cannot write")
     assert "No space left" in result.output and "Traceback" not in result.output
@@ -396,7 +400,7 @@ def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path
         ([str(tmp_path / "nowhere")], "no such file or folder"),
         ([str(tmp_path), "--combat"], "no .json.xz or .json match files"),
         ([str(clean), "--map", "nuke"], "unknown map 'nuke'"),
-        ([str(clean), "--no-combat", "--mover", "teleport"], "--mover must be"),
+        ([str(clean), "--no-combat", "--no-bomb", "--mover", "teleport"], "unknown mover"),
         ([str(clean), "--combat", "--models", str(tmp_path / "no-models")], "no such model"),
     ):
         result = _invoke(*args, "--out", str(tmp_path / "out"))
@@ -411,10 +415,10 @@ def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path
 def test_without_input_the_shipped_sample_is_evaluated_and_called_synthetic(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from decoy_cli.commands import evaluate as command
+    from decoy_cli.synth import sample as shipped
 
-    monkeypatch.setattr(command, "SAMPLE_DIR", tmp_path / "missing")
-    result = _invoke("--no-combat", "--out", str(tmp_path / "out"))
+    monkeypatch.setattr(shipped, "SAMPLE_DIR", tmp_path / "missing")
+    result = _invoke("--no-combat", "--no-bomb", "--out", str(tmp_path / "out"))
     assert result.exit_code == 1 and "no shipped sample" in result.output
 
     sample = tmp_path / "sample"
@@ -422,9 +426,9 @@ def test_without_input_the_shipped_sample_is_evaluated_and_called_synthetic(
     document = walking_match("synthetic-dust2-seed0", 2)
     document["provenance"] = {"generator": "decoy make-sample", "seed": 0}
     write_match(sample / "synthetic-dust2-seed0.json.xz", document)
-    monkeypatch.setattr(command, "SAMPLE_DIR", sample)
+    monkeypatch.setattr(shipped, "SAMPLE_DIR", sample)
     out = tmp_path / "out"
-    result = _invoke("--no-combat", "--workers", "1", "--out", str(out))
+    result = _invoke("--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
     assert result.exit_code == 0, result.output
     assert "data: synthetic" in result.output
     assert "**Data: synthetic.**" in (out / "report.md").read_text()
@@ -526,7 +530,9 @@ def test_a_dask_cluster_gives_the_local_numbers(
         dashboard_address=None,
     ) as cluster:
         address = cluster.scheduler_address
-        result = _invoke(str(clean), "--no-combat", "--scheduler", address, "--out", str(tmp_path))
+        result = _invoke(
+            str(clean), "--no-combat", "--no-bomb", "--scheduler", address, "--out", str(tmp_path)
+        )
     assert result.exit_code == 0, result.output
     assert f"Dask scheduler {address}" in result.output
     tables = reference[1]

@@ -11,21 +11,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import pandas as pd
 import pytest
 
-import decoy_cli.replay.replayer as replayer
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import EstaError
-from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK
-from decoy_cli.replay.output import player_metrics
+from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK, player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
 from decoy_cli.replay.snapping import SnapStatus
+from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import BOMB_TARGET_BOXES, RulesConfig, SiteZones
+from decoy_cli.sim.setup import open_round
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind
 from decoy_cli.weapons import max_speed_u_s
@@ -171,7 +173,7 @@ def replay(
 ) -> ReplayResult:
     """Replay with combat off (deaths in the data are scripted)."""
     options = ReplayOptions(combat=False, bomb=bomb, mover=mover)
-    return replay_round(round_, builtin_graph(), physics, options)
+    return replay_round(round_, builtin_graph(), options, physics=physics)
 
 
 # ---- timing: standing, walking, running late --------------------------------------------------
@@ -312,7 +314,7 @@ def test_data_deaths_are_scripted_and_absent_players_dead_from_the_start(
     assert death_tick - 1 <= deaths[0].tick <= death_tick
     assert result.outcome is None
 
-    table = player_metrics(round_, result)
+    table = player_metrics(round_, result.trace())
     assert table["died_original"].tolist() == [False, True, False, False, False]
     assert table["died_replay"].tolist() == [False, True, False, False, False]
     assert table["death"].tolist() == ["", "scripted", "", "", ""]
@@ -370,24 +372,23 @@ def expected_detour_lateness(weapon: str) -> float:
 
 
 @pytest.mark.parametrize("mover", MOVERS)
-def test_the_weapon_in_hand_follows_the_data(
-    physics: PhysicsWorld, mover: str, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_the_weapon_in_hand_follows_the_data(physics: PhysicsWorld, mover: str) -> None:
     """The detour with an AWP in hand (3.8 m/s), then back with the knife out (4.8 m/s)."""
-    simulators: list[replayer.Simulator] = []
+    simulators: list[Simulator] = []
     initial_weapons: list[list[str]] = []
 
-    class Spy(replayer.Simulator):
-        def __init__(self, *args, **kwargs) -> None:
-            super().__init__(*args, **kwargs)
-            simulators.append(self)
-            initial_weapons.append(list(self.agents.weapon))
+    @contextmanager
+    def watched_round(*args: Any, **kwargs: Any) -> Iterator[Simulator]:
+        with open_round(*args, **kwargs) as sim:
+            simulators.append(sim)
+            initial_weapons.append(list(sim.agents.weapon))
+            yield sim
 
-    monkeypatch.setattr(replayer, "Simulator", Spy)
     a, b = node_at(DETOUR[0]), node_at(DETOUR[1])
     weapons = ["AWP"] * 4 + ["Knife"] * 6
     round_ = make_round([Track("switcher", "T", [a] + [b] * 5 + [a] * 4, weapons=weapons)])
-    result = replay(round_, physics, mover)
+    options = ReplayOptions(combat=False, mover=mover)
+    result = replay_round(round_, builtin_graph(), options, physics=physics, open_sim=watched_round)
 
     speeds = result.plan.plans[0].interval_max_speed_m_s
     assert speeds.tolist() == pytest.approx([3.81] * 4 + [4.7625] * 5)
@@ -486,7 +487,7 @@ def test_a_perfect_replay_of_a_standing_player_measures_the_snap_error(
     result = replay(round_, physics, mover)
     snap = result.plan.snaps[0]
     assert snap.error_m == pytest.approx(np.full(frames, SNAP_OFFSET_M))
-    table = player_metrics(round_, result)
+    table = player_metrics(round_, result.trace())
     assert tuple(table.columns) == PLAYER_COLUMNS
     for name in METRIC_NAMES_CLOCK:
         assert table.loc[0, name] == pytest.approx(SNAP_OFFSET_M, abs=1e-9), name
@@ -526,7 +527,7 @@ def test_an_undecided_round_is_played_out(physics: PhysicsWorld, play_out: bool)
         ]
     )
     options = ReplayOptions(combat=True, damage_model=Misses(), play_out=play_out)
-    result = replay_round(round_, builtin_graph(), physics, options)
+    result = replay_round(round_, builtin_graph(), options, physics=physics)
     assert result.recording.alive.all()  # the recording stays at the data's frames
     if play_out:
         assert (result.outcome.winner, result.outcome.reason) == ("CT", "TargetSaved")

@@ -139,7 +139,7 @@ def test_physics_mover_without_the_bomb(match_file: Path, tmp_path: Path) -> Non
         ("{file}:9", [], "error: {file}: no round 9 (rounds 1-3)"),
         ("{file}:3", [], "error: round 3 has no frames (events only): nothing to replay"),
         ("{file}", [], "error: {file}: not a round address (expected FILE:ROUND"),
-        ("{file}:1", ["--mover", "nonsense"], "error: --mover must be physics or kinematic"),
+        ("{file}:1", ["--mover", "nonsense"], "error: unknown mover 'nonsense'"),
         ("{file}:1", ["--out", "{blocker}"], "error: cannot create {blocker}: "),
     ],
     ids=["missing-file", "missing-round", "no-frames", "no-round", "bad-mover", "bad-out"],

@@ -13,14 +13,14 @@ import pytest
 
 from decoy_cli.esta import Match, read_match
 from decoy_cli.esta.writer import AWPY_HIT_GROUPS, encode_match, write_match
-from decoy_cli.replay.output import player_metrics
+from decoy_cli.metrics import player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import HIT_GROUPS, NO_HIT, CombatBatch, DamageResult
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.synth import SampleMatch, play_match, sample_file_name
 from decoy_cli.synth.loadouts import BUY_KINDS, buy_kind, side_loadouts
-from decoy_cli.synth.player import make_simulator
+from decoy_cli.synth.player import RoundScript, open_scripted_round, scripted_setup
 from decoy_cli.synth.routes import (
     CT_ROLES,
     CT_SETUPS,
@@ -192,9 +192,10 @@ def test_dropped_bomb_is_picked_up_and_planted(graph) -> None:
     rng = np.random.default_rng(11)
     plan = plan_round(places, zones, rng)
     loadouts = side_loadouts("T", "full", 5, rng) + side_loadouts("CT", "full", 5, rng)
-    sim = make_simulator(graph, places, zones, plan, loadouts, TEAM, seed=0)
-    sim.kill(plan.carrier, "test")
-    sim.run()
+    script = RoundScript(places=places, plan=plan, loadouts=loadouts, team=TEAM)
+    with open_scripted_round(scripted_setup(graph, None), script, seed=0) as sim:
+        sim.kill(plan.carrier, "test")
+        sim.run()
     kinds = [(e.kind, e.agent) for e in sim.events]
     assert ("bomb_drop", plan.carrier) in kinds
     picker = next(agent for kind, agent in kinds if kind == "bomb_pickup")
@@ -281,7 +282,8 @@ def test_the_sample_replays(graph, quiet: tuple[SampleMatch, Match]) -> None:
     _, match = quiet
     r = match.rounds[0]
     with PhysicsWorld(nav_world()) as physics:
-        result = replay_round(r, graph, physics, ReplayOptions(combat=False, bomb=True))
-    players = player_metrics(r, result)
+        options = ReplayOptions(combat=False, bomb=True)
+        result = replay_round(r, graph, options, physics=physics)
+    players = player_metrics(r, result.trace())
     assert len(players) == 10 and set(players["side"]) == {"T", "CT"}
     assert players["mean_dist"].median() < 0.3

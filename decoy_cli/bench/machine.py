@@ -81,6 +81,14 @@ def load_average() -> list[float] | None:
         return None
 
 
+def machine_line() -> str:
+    """The machine in one line, for a report: cores, CPU, Python and decoy versions."""
+    return (
+        f"{usable_cores()} cores ({cpu_model()}), Python {platform.python_version()}, "
+        f"decoy {package_version('decoy')}"
+    )
+
+
 def machine_info() -> dict[str, Any]:
     """Cores, CPU, memory, load, OS and the versions of Python and the packages that matter."""
     return {

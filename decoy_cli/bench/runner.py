@@ -25,13 +25,13 @@ from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
 from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
 from decoy_cli.bench.simspeed import (
     AGENT_COUNTS,
-    MOVERS,
     PAPER_DECISIONS,
     PAPER_TICKS_PER_S,
     NeverHits,
     speed_table,
 )
 from decoy_cli.errors import DecoyError
+from decoy_cli.sim.setup import check_mover
 
 REPORT_FORMAT = 1
 
@@ -48,13 +48,18 @@ MODEL_SECTIONS = ("table1", "combat_step", "replay")
 PAPER = "DECOY paper (Wang, Ustun, McGroarty, WSC 2025), Table 1"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class BenchConfig:
-    """What to run and how much of it: the full benchmark, or a quick smoke run."""
+    """What to run and how much of it: the full benchmark, or a quick smoke run.
+
+    `combat` and `bomb` switch the mechanics of Table 1 and of the replay section (the paper's
+    Table 1 has every mechanic on)."""
 
     quick: bool
     models: str
     mover: str = "physics"
+    combat: bool = True
+    bomb: bool = True
     seed: int = 0
     agent_counts: tuple[int, ...] = AGENT_COUNTS
     decisions: int = PAPER_DECISIONS
@@ -64,18 +69,26 @@ class BenchConfig:
     reader_files: int | None = None
 
     @classmethod
-    def create(cls, quick: bool, models: str, mover: str = "physics", seed: int = 0):
+    def create(
+        cls,
+        *,
+        quick: bool,
+        models: str,
+        mover: str = "physics",
+        combat: bool = True,
+        bomb: bool = True,
+        seed: int = 0,
+    ) -> BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
         round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
-        if mover not in MOVERS:
-            raise DecoyError(f"--mover must be one of {', '.join(MOVERS)}, not {mover!r}")
+        check_mover(mover)
+        switches = {"mover": mover, "combat": combat, "bomb": bomb, "seed": seed}
         if not quick:
-            return cls(quick=False, models=models, mover=mover, seed=seed)
+            return cls(quick=False, models=models, **switches)
         return cls(
             quick=True,
             models=models,
-            mover=mover,
-            seed=seed,
+            **switches,
             agent_counts=(2, 10),
             decisions=1_000,
             combat_repeats=20,
@@ -128,9 +141,19 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
     started = time.perf_counter()
     result: dict[str, Any]
     if name == "table1":
-        rows = speed_table(config.agent_counts, config.decisions, model, config.mover, config.seed)
+        rows = speed_table(
+            config.agent_counts,
+            config.decisions,
+            model,
+            mover=config.mover,
+            combat=config.combat,
+            bomb=config.bomb,
+            seed=config.seed,
+        )
         result = {
             "mover": config.mover,
+            "combat": config.combat,
+            "bomb": config.bomb,
             "decisions_per_row": config.decisions,
             "damage_model": status.label,
             "paper": {"source": PAPER, "ticks_per_s": PAPER_TICKS_PER_S},
@@ -141,7 +164,14 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
         result = {"damage_model": status.label, "rows": rows}
     elif name == "replay":
         data = _needed(data, name)
-        result = replay_throughput(data.files, config.replay_rounds, model, config.seed)
+        result = replay_throughput(
+            data.files,
+            config.replay_rounds,
+            model,
+            combat=config.combat,
+            bomb=config.bomb,
+            seed=config.seed,
+        )
         result |= {"data": data.describe(), "damage_model": status.label if model else None}
     elif name == "metrics":
         result = metric_throughput(config.metric_pairs, config.seed)

@@ -19,10 +19,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
-from decoy_cli.sim.combat import CombatBatch, CombatStep, DamageModel, DamageResult, LineOfSight
-from decoy_cli.sim.engine import Decision, SimConfig, Simulator
-from decoy_cli.sim.movement import KinematicMover, PhysicsMover
-from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
+from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
@@ -37,8 +36,6 @@ PAPER_DECISIONS = 10_000
 
 PAPER_TICKS_PER_S: dict[int, float | None] = {2: 4322.0, 6: None, 10: 966.0, 20: 487.0, 100: 99.6}
 """The paper's physics ticks per second by agent count (None: no value recorded here)."""
-
-MOVERS = ("physics", "kinematic")
 
 
 class NeverHits:
@@ -104,48 +101,39 @@ def run_agents(
     count: int,
     decisions: int,
     model: DamageModel,
+    *,
     mover: str = "physics",
+    combat: bool = True,
+    bomb: bool = True,
     seed: int = 0,
 ) -> SpeedRow:
     """Play restarted rounds of `count` agents until `decisions` agent decisions (module doc)."""
-    if mover not in MOVERS:
-        raise ValueError(f"mover must be one of {MOVERS}, not {mover!r}")
     if count < 2:
         raise ValueError(f"a round needs at least 2 agents, not {count}")
+    setup = RoundSetup(graph=graph, mover=mover, combat=combat, bomb=bomb, damage_model=model)
     rng = np.random.default_rng(seed)
-    zones = SiteZones.from_graph(graph)
     ticks = rounds = made = kills = 0
-    los = LineOfSight(physics, count)
-    try:
-        started = time.perf_counter()
-        cpu_started = time.process_time()
-        while made < decisions:
-            agents = _spawn_agents(graph, count, rng)
-            moving = PhysicsMover(physics) if mover == "physics" else KinematicMover()
-            sim = Simulator(
-                graph,
-                agents,
-                moving,
-                RandomPolicy(rng),
-                BombRules(zones, RulesConfig()),
-                bomb_carrier=0,
-                combat=CombatStep(los, model, "de_dust2"),
-                config=SimConfig(combat=True),
-                seed=int(rng.integers(1 << 31)),
-            )
+    started = time.perf_counter()
+    cpu_started = time.process_time()
+    while made < decisions:
+        agents = _spawn_agents(graph, count, rng)
+        with open_round(
+            setup,
+            agents,
+            RandomPolicy(rng),
+            physics=physics,
+            bomb_carrier=0,
+            seed=int(rng.integers(1 << 31)),
+        ) as sim:
             start_tick = sim.tick
             left = decisions - made
             sim.run(until=lambda s, left=left: int(s.decisions.sum()) >= left)
-            made += int(sim.decisions.sum())
-            ticks += sim.tick - start_tick
-            kills += int((~agents.alive).sum())
-            rounds += 1
-            if isinstance(moving, PhysicsMover):
-                moving.close()
-        wall = time.perf_counter() - started
-        cpu = time.process_time() - cpu_started
-    finally:
-        los.close()
+        made += int(sim.decisions.sum())
+        ticks += sim.tick - start_tick
+        kills += int((~agents.alive).sum())
+        rounds += 1
+    wall = time.perf_counter() - started
+    cpu = time.process_time() - cpu_started
     game = ticks / TICK_RATE
     paper = PAPER_TICKS_PER_S.get(count)
     return SpeedRow(
@@ -169,17 +157,22 @@ def speed_table(
     counts: tuple[int, ...] = AGENT_COUNTS,
     decisions: int = PAPER_DECISIONS,
     model: DamageModel | None = None,
+    *,
     mover: str = "physics",
+    combat: bool = True,
+    bomb: bool = True,
     seed: int = 0,
     warmup_decisions: int = 200,
 ) -> list[SpeedRow]:
     """Table 1 rows for each agent count, after an untimed warm-up (compilation, caches).
 
-    `model` None runs the combat step with `NeverHits` (line of sight, no inference).
+    `model` None runs the combat step with `NeverHits` (line of sight, no inference); `combat`
+    False runs no combat step at all.
     """
     graph = builtin_graph()
     model = NeverHits() if model is None else model
+    options = {"mover": mover, "combat": combat, "bomb": bomb, "seed": seed}
     with PhysicsWorld(nav_world()) as physics:
         if warmup_decisions:
-            run_agents(physics, graph, 2, warmup_decisions, model, mover, seed)
-        return [run_agents(physics, graph, n, decisions, model, mover, seed) for n in counts]
+            run_agents(physics, graph, 2, warmup_decisions, model, **options)
+        return [run_agents(physics, graph, n, decisions, model, **options) for n in counts]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +23,7 @@ from decoy_cli.bench import (
 )
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import OutputError
-from decoy_cli.files import write_atomic
+from decoy_cli.files import write_json
 
 DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
 
@@ -61,6 +60,15 @@ def bench(
         "--mover",
         help="Mover of Table 1: physics (capsules, as the paper) or kinematic.",
     ),
+    combat: bool = typer.Option(
+        True,
+        "--combat/--no-combat",
+        help="The combat step in Table 1 and shooting in the replay section (the paper's "
+        "Table 1 has it on).",
+    ),
+    bomb: bool = typer.Option(
+        True, "--bomb/--no-bomb", help="Bomb rules in Table 1 and in the replay section."
+    ),
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="The JSON report."),
     seed: int = typer.Option(0, "--seed", help="Seed of agent placements and actions."),
 ) -> None:
@@ -72,7 +80,9 @@ def bench(
     console = Console()
     if out.is_dir():
         raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
-    config = BenchConfig.create(quick, models, mover, seed)
+    config = BenchConfig.create(
+        quick=quick, models=models, mover=mover, combat=combat, bomb=bomb, seed=seed
+    )
     bench_data = find_data(data)
     machine = machine_info()
     console.print(_machine_line(machine), highlight=False)
@@ -108,7 +118,7 @@ def bench(
             progress.console.print(_render(name, sections[name]))
             progress.advance(task)
     document = report(config, status, bench_data, sections, machine)
-    write_atomic(out, (json.dumps(document, indent=2, allow_nan=False) + "\n").encode())
+    write_json(out, document, sort_keys=False)
     console.print(
         f"peak memory of this process {document['peak_rss_mb_main']:.0f} MB; load average at "
         f"the end {_load(document['load_average_end'])}; "
@@ -181,8 +191,13 @@ def _table1(result: dict[str, Any]) -> Table:
             "ours / paper",
         ],
         caption=(
-            f"{result['mover']} mover, bomb rules on, combat step every 0.5 s with damage model: "
-            f"{result['damage_model']}; peak memory {result['peak_rss_mb']:.0f} MB"
+            f"{result['mover']} mover, bomb rules {'on' if result['bomb'] else 'off'}, "
+            + (
+                f"combat step every 0.5 s with damage model: {result['damage_model']}"
+                if result["combat"]
+                else "no combat step"
+            )
+            + f"; peak memory {result['peak_rss_mb']:.0f} MB"
         ),
     )
     for row in result["rows"]:

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import platform
-import shlex
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -22,12 +19,14 @@ from rich.progress import (
 )
 from rich.table import Table
 
-import decoy_cli
+from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
+from decoy_cli.esta import collect_match_files
 from decoy_cli.evaluate.report import (
     RunInfo,
     combat_caveats,
+    command_line,
     data_kind,
     mechanics,
     num,
@@ -37,7 +36,7 @@ from decoy_cli.evaluate.report import (
 from decoy_cli.evaluate.runner import (
     Evaluation,
     ProgressEvent,
-    collect_files,
+    default_inputs,
     make_settings,
     run_evaluation,
 )
@@ -45,34 +44,6 @@ from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 
 DEFAULT_OUT = Path("decoy-out") / "evaluate"
-
-SAMPLE_DIR = Path(decoy_cli.__file__).resolve().parents[1] / "examples" / "sample"
-"""The synthetic sample evaluated when no input is given. It lives in the source tree (a
-checkout or an editable install), next to the README that says how `decoy make-sample`
-regenerates it, rather than inside the package: it is example data, not something the library
-needs, so a wheel stays small and its users pass their own data."""
-
-
-def _cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
-def _machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return (
-        f"{_cores()} cores ({model}), Python {platform.python_version()}, "
-        f"decoy {decoy_cli.__version__}"
-    )
 
 
 def evaluate(
@@ -93,8 +64,11 @@ def evaluate(
     combat: bool = typer.Option(
         True,
         "--combat/--no-combat",
-        help="Shooting (with --models) and the bomb. --no-combat turns both off: movement "
-        "only, deaths scripted from the data, as in the paper's Table 2.",
+        help="Shooting, with the damage model of --models; without it deaths are scripted "
+        "from the data. The paper's movement-only Table 2 is --no-combat --no-bomb.",
+    ),
+    bomb: bool = typer.Option(
+        True, "--bomb/--no-bomb", help="Bomb rules: carrier, plant, defuse, detonation."
     ),
     models: str = typer.Option(
         "shipped", "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
@@ -132,16 +106,12 @@ def evaluate(
     (failures.csv says why).
     """
     console = Console()
-    if not inputs:
-        if not SAMPLE_DIR.is_dir() or not any(SAMPLE_DIR.glob("*.json*")):
-            raise DecoyError(
-                f"no input given and no shipped sample in {SAMPLE_DIR}: pass ESTA match files "
-                "or folders (or generate the sample with `decoy make-sample`)"
-            )
-        inputs = [SAMPLE_DIR]
-    collect_files(inputs)  # bad paths fail here, before a damage model is loaded
-    settings = make_settings(map_name, combat, models, mover, seed)
-    command = _command_line(inputs, settings.map_name, sample, seed, combat, models, mover, out)
+    inputs = inputs or default_inputs()
+    collect_match_files(inputs)  # bad paths fail here, before a damage model is loaded
+    settings = make_settings(
+        map_name=map_name, combat=combat, bomb=bomb, models=models, mover=mover, seed=seed
+    )
+    command = command_line(inputs, settings, sample, out)
     if scheduler:
         from decoy_cli.evaluate.backends import DaskBackend
 
@@ -150,10 +120,10 @@ def evaluate(
     else:
         from decoy_cli.evaluate.backends import LocalBackend
 
-        count = workers or _cores()
+        count = workers or usable_cores()
         backend = LocalBackend(count)
         where = f"{count} local worker process{'es' if count > 1 else ''}"
-    info = RunInfo(command=command, backend=where, sample=sample, machine=_machine())
+    info = RunInfo(command=command, backend=where, sample=sample, machine=machine_line())
     console.print(f"evaluating with {where}: {mechanics(settings)}", highlight=False)
     try:
         with backend, _ProgressDisplay() as on_progress:
@@ -180,27 +150,6 @@ def evaluate(
             f"{len(evaluation.failures)} files or rounds failed "
             f"({evaluation.accumulator.rounds} rounds evaluated); see {out / 'failures.csv'}"
         )
-
-
-def _command_line(
-    inputs: list[Path],
-    map_name: str,
-    sample: int | None,
-    seed: int,
-    combat: bool,
-    models: str,
-    mover: str,
-    out: Path,
-) -> str:
-    """The command with every effective option (what a reader needs to rerun it)."""
-    words = ["decoy", "evaluate", *map(str, inputs), "--map", map_name]
-    if sample is not None:
-        words += ["--sample", str(sample)]
-    words += ["--seed", str(seed), "--combat" if combat else "--no-combat"]
-    if combat:
-        words += ["--models", models]
-    words += ["--mover", mover, "--out", str(out)]
-    return shlex.join(words)
 
 
 class _ProgressDisplay:

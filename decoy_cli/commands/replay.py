@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -11,17 +10,10 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.damage import load_damage_model
-from decoy_cli.errors import DecoyError
-from decoy_cli.esta import load_round
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
-from decoy_cli.replay.output import animate, player_metrics, plot_paths, write_replay
-from decoy_cli.replay.replayer import ReplayOptions, replay_round
-from decoy_cli.waypoints.build import builtin_graph
-from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh, nav_world
-from decoy_cli.world.physics import PhysicsWorld
-
-DEFAULT_OUT = Path("decoy-out") / "replay"
+from decoy_cli.replay.replayer import ReplayOptions
+from decoy_cli.replay.single import replay_address
+from decoy_cli.sim.setup import check_mover
 
 
 def replay(
@@ -53,64 +45,27 @@ def replay(
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
     console = Console()
-    if mover not in ("physics", "kinematic"):
-        raise DecoyError(f"--mover must be physics or kinematic, not {mover!r}")
-    round_ = load_round(address)
-    if round_.map_name and round_.map_name != BUILTIN_MAP:
-        raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
-    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
+    check_mover(mover)
     damage_model = load_damage_model(models) if combat else None
-    options = ReplayOptions(
-        combat=combat and damage_model is not None,
-        bomb=bomb,
-        mover=mover,
-        damage_model=damage_model,
-        seed=seed,
-    )
     if combat and damage_model is None:
         console.print(
             "[yellow]--models none: replaying without shooting (deaths in the data are "
             "scripted)[/yellow]"
         )
-    started = time.perf_counter()
-    with PhysicsWorld(nav_world()) as physics:
-        result = replay_round(round_, graph, physics, options)
-    seconds = time.perf_counter() - started
-    players = player_metrics(round_, result)
-
+    options = ReplayOptions(
+        combat=damage_model is not None,
+        bomb=bomb,
+        mover=mover,
+        damage_model=damage_model,
+        seed=seed,
+    )
+    run = replay_address(address, options, models=models, graph_file=graph_file, out=out, gif=gif)
+    round_, result, players = run.round_, run.result, run.players
     real = (round_.winning_side, round_.end_reason)
     simulated = (result.outcome.winner, result.outcome.reason) if result.outcome else (None, None)
-    summary = {
-        "round": address,
-        "match_id": round_.match_id,
-        "round_num": round_.round_num,
-        "options": {"combat": options.combat, "bomb": bomb, "mover": mover, "seed": seed},
-        "damage_models": models if options.combat else None,
-        "played_out_s": round(result.played_out_s, 3),
-        "outcome_original": {"winner": real[0], "reason": real[1]},
-        "outcome_replay": {"winner": simulated[0], "reason": simulated[1]},
-        "frames": int(round_.num_frames),
-        "wall_seconds": round(seconds, 3),
-        "stuck_episodes": int(players["stuck"].sum()),
-        "recoveries": int(players["recoveries"].sum()),
-        "relocations": int(players["relocations"].sum()),
-    }
-    folder = out or DEFAULT_OUT / f"{round_.match_id[:8]}_r{round_.round_num}"
-    write_replay(folder, round_, result, players, summary)
-    nav = load_navmesh()
-    plot_paths(
-        folder / "paths.png",
-        round_,
-        result,
-        nav,
-        title=f"{round_.match_id[:8]} round {round_.round_num}: original (dashed) vs replay",
-    )
-    if gif:
-        animate(folder / "round.gif", round_, result, nav)
-
     console.print(
         f"round {round_.round_num} of {round_.match_id}: {round_.num_frames} frames replayed in "
-        f"{seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
+        f"{run.seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
         f"bomb {'on' if bomb else 'off'})"
     )
     outcome = Table(title="outcome")
@@ -156,4 +111,4 @@ def replay(
             row["death"] or "–",
         )
     console.print(timing)
-    console.print(f"replay written to {folder}")
+    console.print(f"replay written to {run.folder}")

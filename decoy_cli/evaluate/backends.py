@@ -1,9 +1,10 @@
 """Where the jobs run: a local pool of worker processes, or an existing Dask cluster.
 
 Both backends take a job function and its tasks and yield `(task, outcome)` as tasks finish,
-where the outcome is the job's return value or a `TaskFailure` the backend made because the
-worker died. Use them as context managers: leaving the block (normally, on Ctrl-C or on an
-error) cancels what has not started and waits for what is running.
+where the outcome is the job's return value or a `RoundFailure` the backend made because the
+worker died (its file and round are the runner's to fill in from the task). Use them as
+context managers: leaving the block (normally, on Ctrl-C or on an error) cancels what has not
+started and waits for what is running.
 
 Local: a `ProcessPoolExecutor` whose workers are started by forkserver (spawn where there is
 none), never by a plain fork: a worker process builds its own pybullet world on first use, so
@@ -31,7 +32,9 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.evaluate.job import CRASH_MESSAGE, TaskFailure
+from decoy_cli.esta import RoundFailure
+from decoy_cli.esta.batch import INTERNAL_ERROR
+from decoy_cli.evaluate.job import CRASH_MESSAGE, WORKER_CRASH
 
 Outcomes = Iterator[tuple[Any, Any]]
 
@@ -58,8 +61,12 @@ def _context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("spawn")
 
 
-def _internal(error: BaseException) -> TaskFailure:
-    return TaskFailure("internal error", f"{type(error).__name__}: {error}")
+def _internal(error: BaseException) -> RoundFailure:
+    return RoundFailure("", None, INTERNAL_ERROR, f"{type(error).__name__}: {error}")
+
+
+def _crash() -> RoundFailure:
+    return RoundFailure("", None, WORKER_CRASH, CRASH_MESSAGE)
 
 
 class LocalBackend:
@@ -130,7 +137,7 @@ class LocalBackend:
             outcome = _result(pool.submit(job, task))
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
-        return TaskFailure("worker crash", CRASH_MESSAGE) if outcome is _BROKEN else outcome
+        return _crash() if outcome is _BROKEN else outcome
 
 
 def _result(future: Future) -> Any:
@@ -188,7 +195,7 @@ class DaskBackend:
             try:
                 outcome = future.result()
             except KilledWorker:
-                outcome = TaskFailure("worker crash", CRASH_MESSAGE)
+                outcome = _crash()
             except Exception as error:
                 outcome = _internal(error)
             task = task_of.pop(future.key)

@@ -4,8 +4,8 @@ A job is a plain function of a small picklable task, so the same job runs in a l
 pool and on a Dask cluster. Each worker process (each thread, on a multi-threaded Dask worker)
 builds its waypoint graph, pybullet world and damage model once, on first use, and keeps the
 last match files it read, so the rounds of one file read it once per worker. A job never raises:
-a bad file, a broken round or a bug becomes a `TaskFailure` with a one-line reason, so the batch
-goes on.
+a bad file, a broken round or a bug becomes a `RoundFailure` with a one-line reason
+(`decoy_cli.esta.failure_from`), so the batch goes on.
 
 A `RoundRecord` is everything the aggregate tables and figures need from one round, in compact
 form: the per-player and per-round table rows, 2-D histogram counts of original and replayed
@@ -21,7 +21,6 @@ import hashlib
 import json
 import threading
 import time
-import traceback
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,13 +30,18 @@ import msgspec
 import numpy as np
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Match, read_match
+from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
+from decoy_cli.esta.batch import UNREADABLE_FILE
 from decoy_cli.evaluate.settings import EvalSettings, HeatGrid, round_seed
-from decoy_cli.metrics import METRIC_NAMES
+from decoy_cli.metrics import METRIC_NAMES, player_metrics
 
 if TYPE_CHECKING:
     from decoy_cli.replay.replayer import ReplayResult
+    from decoy_cli.sim.combat import DamageModel
+    from decoy_cli.waypoints.graph import WaypointGraph
 
+WORKER_CRASH = "worker crash"
+REPLAY_ERROR = "replay error"
 CRASH_MESSAGE = (
     "the worker process died while evaluating this (a crash, a kill or running out of memory)"
 )
@@ -64,14 +68,6 @@ class RoundTask:
     round_num: int
     key: str
     settings: EvalSettings
-
-
-@dataclass(frozen=True)
-class TaskFailure:
-    """Why a task produced no result: `kind` is a short category, `message` one line."""
-
-    kind: str
-    message: str
 
 
 class FileIndex(msgspec.Struct, frozen=True):
@@ -137,7 +133,8 @@ class RoundRecord(msgspec.Struct, frozen=True):
 
 
 _REPLAY_COLUMNS = ("late_share", "late_p95_s", "stuck", "recoveries", "relocations")
-"""Player columns taken as they are from `player_metrics`: timing and the mover's troubles."""
+"""Player columns taken as they are from `metrics.player_metrics`: timing and the mover's
+troubles."""
 
 PLAYER_COLUMNS = (
     "match",
@@ -192,10 +189,10 @@ class _WorkerState:
         self.graph = builtin_graph(map_name)
         self.places = PlaceFinder(self.graph)
         self.physics = PhysicsWorld(nav_world(map_name))
-        self.models: dict[str, Any] = {}
+        self.models: dict[str, DamageModel | None] = {}
         self.matches: OrderedDict[tuple[str, str], Match] = OrderedDict()
 
-    def damage_model(self, choice: str) -> Any:
+    def damage_model(self, choice: str) -> DamageModel | None:
         """The damage model of a `--models` choice, loaded once (torch on one thread)."""
         if choice not in self.models:
             from decoy_cli.damage import load_damage_model
@@ -240,28 +237,18 @@ def worker_state(map_name: str) -> _WorkerState:
     return state
 
 
-def _failure(error: BaseException, kind: str) -> TaskFailure:
-    """A DecoyError as its own line; anything else as a bug, with where it was raised."""
-    if isinstance(error, DecoyError):
-        return TaskFailure(kind, str(error))
-    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
-    where = f" (at {Path(frame.filename).name}:{frame.lineno})" if frame else ""
-    text = str(error).splitlines()[0] if str(error) else ""
-    return TaskFailure("internal error", f"{type(error).__name__}: {text}{where}")
-
-
 def is_synthetic(match_id: str, provenance: Any) -> bool:
     """Whether a match says it was generated, not recorded (matchID or provenance)."""
     text = f"{match_id} {json.dumps(provenance, default=str)}".lower()
     return "synthetic" in text
 
 
-def index_file(task: IndexTask) -> FileIndex | TaskFailure:
+def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     """Read a match file and list its rounds; the worker keeps the match for its rounds."""
     try:
         match = worker_state(task.settings.map_name).match(task.file, task.file_sha)
     except Exception as error:
-        return _failure(error, "unreadable file")
+        return failure_from(error, task.file, None, UNREADABLE_FILE)
     provenance = match.meta.get("provenance")
     return FileIndex(
         file_sha=task.file_sha,
@@ -274,7 +261,7 @@ def index_file(task: IndexTask) -> FileIndex | TaskFailure:
     )
 
 
-def evaluate_round(task: RoundTask) -> RoundRecord | TaskFailure:
+def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
     """Replay one round with the task's settings and measure it (never raises)."""
     try:
         state = worker_state(task.settings.map_name)
@@ -285,34 +272,35 @@ def evaluate_round(task: RoundTask) -> RoundRecord | TaskFailure:
         result = _replay(state, round_, settings, model, task)
         return build_record(task, round_, result, state.places, time.perf_counter() - started)
     except Exception as error:
-        return _failure(error, "replay error")
+        return failure_from(error, task.file, task.round_num, REPLAY_ERROR)
 
 
 def _replay(
-    state: _WorkerState, round_: Any, settings: EvalSettings, model: Any, task: RoundTask
+    state: _WorkerState,
+    round_: Round,
+    settings: EvalSettings,
+    model: DamageModel | None,
+    task: RoundTask,
 ) -> ReplayResult:
     from decoy_cli.replay.replayer import ReplayOptions, replay_round
 
     options = ReplayOptions(
         combat=model is not None,
-        bomb=settings.combat,
+        bomb=settings.bomb,
         mover=settings.mover,
         damage_model=model,
         seed=round_seed(settings, task.file_sha, task.round_num),
-        map_name=settings.map_name,
     )
-    return replay_round(round_, state.graph, state.physics, options)
+    return replay_round(round_, state.graph, options, physics=state.physics)
 
 
 def build_record(
-    task: RoundTask, round_: Any, result: ReplayResult, places: PlaceFinder, seconds: float
+    task: RoundTask, round_: Round, result: ReplayResult, places: PlaceFinder, seconds: float
 ) -> RoundRecord:
     """The `RoundRecord` of a replayed round (see the module docstring)."""
-    from decoy_cli.replay.output import player_metrics
-
     settings = task.settings
     rec = result.recording
-    metrics = player_metrics(round_, result)
+    metrics = player_metrics(round_, result.trace())
     frame_seconds = np.asarray(round_.frame_seconds, dtype=np.float64)
     original = np.asarray(round_.position, dtype=np.float64)  # (P, F, 3)
     present = np.asarray(round_.present, dtype=bool)
@@ -434,7 +422,7 @@ def read_grid_sums(data: bytes, columns: int = 2) -> list[np.ndarray]:
 NO_PLACE = "(no place)"
 
 
-def place_names(graph: Any) -> list[str]:
+def place_names(graph: WaypointGraph) -> list[str]:
     """The place labels of the per-place counts: the graph's places, then `NO_PLACE`."""
     return [*graph.place_names, NO_PLACE]
 
@@ -443,7 +431,7 @@ class PlaceFinder:
     """The nav place of positions: the place of the nearest waypoint on the position's floor,
     or, for a position with no waypoint on its floor, of the nearest waypoint in x-y."""
 
-    def __init__(self, graph: Any) -> None:
+    def __init__(self, graph: WaypointGraph) -> None:
         from scipy.spatial import cKDTree
 
         self.graph = graph

@@ -17,21 +17,21 @@ Layout of the output folder:
 
 from __future__ import annotations
 
-import json
 import math
+import shlex
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from decoy_cli.evaluate.figures import draw_figures
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
-from decoy_cli.files import write_atomic
+from decoy_cli.files import json_ready, write_atomic, write_json
 from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
 
 FAILURE_COLUMNS = ("file", "round", "kind", "message")
@@ -61,11 +61,29 @@ def data_kind(evaluation: Evaluation) -> str:
 
 def mechanics(settings: EvalSettings) -> str:
     """What the simulation did, in words."""
-    if not settings.combat:
+    if not settings.combat and not settings.bomb:
         return "movement only: combat and bomb off (as in the paper's Table 2); deaths scripted"
+    bomb = "bomb on" if settings.bomb else "bomb off"
+    if not settings.combat:
+        return f"combat off, {bomb}: deaths scripted from the data"
     if settings.models_fingerprint:
-        return f"combat (damage model: {settings.models}) and bomb on"
-    return "bomb on, no shooting (--models none): deaths scripted from the data"
+        return f"combat (damage model: {settings.models}), {bomb}"
+    return f"{bomb}, no shooting (--models none): deaths scripted from the data"
+
+
+def command_line(
+    inputs: Sequence[Path], settings: EvalSettings, sample: int | None, out: Path
+) -> str:
+    """The command with every effective option (what a reader needs to rerun it)."""
+    words = ["decoy", "evaluate", *map(str, inputs), "--map", settings.map_name]
+    if sample is not None:
+        words += ["--sample", str(sample)]
+    words += ["--seed", str(settings.seed), "--combat" if settings.combat else "--no-combat"]
+    words += ["--bomb" if settings.bomb else "--no-bomb"]
+    if settings.combat:
+        words += ["--models", settings.models]
+    words += ["--mover", settings.mover, "--out", str(out)]
+    return shlex.join(words)
 
 
 def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
@@ -90,12 +108,7 @@ def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunIn
     }
     written += [_csv(folder / f"{name}.csv", frame) for name, frame in frames.items()]
     written.append(
-        write_atomic(
-            out / "summary.json",
-            (
-                json.dumps(summary(evaluation, tables, info), indent=2, default=_json) + "\n"
-            ).encode(),
-        )
+        write_json(out / "summary.json", summary(evaluation, tables, info), sort_keys=False)
     )
     figures = draw_figures(out / "figures", evaluation.accumulator, tables, load_navmesh())
     written += list(figures.values())
@@ -125,34 +138,15 @@ def _csv(path: Path, frame: pd.DataFrame) -> Path:
     return write_atomic(path, frame.to_csv(index=False).encode())
 
 
-def _json(value: Any) -> Any:
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
-
-def _clean(value: Any) -> Any:
-    """NaN as null, for strict JSON."""
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_clean(v) for v in value]
-    return value
-
-
 def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
-    return _clean(frame.astype(object).where(frame.notna(), None).to_dict("records"))
+    return json_ready(frame.astype(object).where(frame.notna(), None).to_dict("records"))
 
 
 def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, Any]:
     """What was run and every aggregate, as one JSON-able dict."""
     settings = evaluation.settings
     outcome = tables.outcome
-    return _clean(
+    return json_ready(
         {
             "data": data_kind(evaluation),
             "command": info.command,
@@ -162,7 +156,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
             "options": {
                 "map": settings.map_name,
                 "combat": settings.combat,
-                "bomb": settings.combat,
+                "bomb": settings.bomb,
                 "models": settings.models,
                 "mover": settings.mover,
                 "seed": settings.seed,
@@ -329,22 +323,23 @@ def report_markdown(
         ["player-rounds", str(counts["player_rounds"])],
     ]
     parts.append("## What was run\n\n" + _table(["", ""], run_rows))
-    parts.append(_trajectory_section(tables, settings.combat))
+    parts.append(_trajectory_section(tables, settings))
     parts.append(_combat_section(tables, settings.combat))
     parts.append(_figures_section(tables, figures))
     parts.append(_failures_section(evaluation))
     return "\n\n".join(parts) + "\n"
 
 
-def _trajectory_section(tables: Tables, combat: bool) -> str:
+def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
+    on = [name for name, flag in (("combat", settings.combat), ("bomb", settings.bomb)) if flag]
     text = [
         "## Trajectory fidelity (the paper's Table 2)",
         "Metres; definitions in docs/metrics.md. Protocol *clock* compares original and replay "
         "frame by frame on the common clock; protocol *paper* resamples each alive trajectory "
         "to 451 points first, as the paper's evaluation did; the paper's values sit beside it"
         + (
-            " (the paper ran movement only; this run had combat on)."
-            if combat
+            f" (the paper ran movement only; this run had {' and '.join(on)} on)."
+            if on
             else " (movement only there and here)."
         ),
     ]

@@ -2,7 +2,7 @@
 
 The steps, all resumable:
 
-1. The inputs (files and folders) become match files (decoy_cli.esta.iter_match_files); files
+1. The inputs (files and folders) become match files (`decoy_cli.esta.collect_match_files`); files
    in a folder without a match-file suffix are listed as ignored. Each file is hashed (SHA-256
    of its bytes): the hash keys the cache, and the same content given twice is evaluated once.
 2. Each file's index (match ID, map, provenance, round numbers, rounds the reader rejected) is
@@ -21,22 +21,21 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
 
 from decoy_cli.errors import DecoyError, EstaError
-from decoy_cli.esta import iter_match_files
-from decoy_cli.esta.reader import MATCH_SUFFIXES
+from decoy_cli.esta import RoundFailure, collect_match_files
+from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, OTHER_MAP, UNREADABLE_FILE
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.job import (
     FileIndex,
     IndexTask,
     RoundRecord,
     RoundTask,
-    TaskFailure,
     evaluate_round,
     index_file,
     place_names,
@@ -57,16 +56,6 @@ class Backend(Protocol):
     """Runs a job over tasks and yields (task, outcome) as they finish (see backends.py)."""
 
     def run(self, job: Callable[[Any], Any], tasks: Sequence[Any]) -> Any: ...
-
-
-@dataclass(frozen=True)
-class Failure:
-    """A file (round None) or a round that produced no result, and why, in one line."""
-
-    file: str
-    round_num: int | None
-    kind: str
-    message: str
 
 
 @dataclass(frozen=True)
@@ -100,7 +89,7 @@ class Evaluation:
     duplicates: list[tuple[Path, Path]]
     """(file, the earlier file with the same content): evaluated once."""
     accumulator: Accumulator
-    failures: list[Failure] = field(default_factory=list)
+    failures: list[RoundFailure] = field(default_factory=list)
     rounds_planned: int = 0
     rounds_available: int = 0
     """Rounds of the map in the input before sampling (built or broken)."""
@@ -110,14 +99,16 @@ class Evaluation:
     wall_seconds: float = 0.0
 
 
-def make_settings(map_name: str, combat: bool, models: str, mover: str, seed: int) -> EvalSettings:
+def make_settings(
+    *, map_name: str, combat: bool, bomb: bool, models: str, mover: str, seed: int
+) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round."""
+    from decoy_cli.sim.setup import check_mover
     from decoy_cli.waypoints.build import canonical_map
 
     name = canonical_map(map_name)
-    if mover not in ("kinematic", "physics"):
-        raise DecoyError(f"--mover must be kinematic or physics, not {mover!r}")
+    check_mover(mover)
     models_fingerprint = ""
     if combat:
         from decoy_cli.damage import SHIPPED_MODELS, load_damage_model
@@ -130,6 +121,7 @@ def make_settings(map_name: str, combat: bool, models: str, mover: str, seed: in
     return EvalSettings(
         map_name=name,
         combat=combat,
+        bomb=bomb,
         models=models if combat else "none",
         mover=mover,
         seed=seed,
@@ -139,26 +131,16 @@ def make_settings(map_name: str, combat: bool, models: str, mover: str, seed: in
     )
 
 
-def collect_files(inputs: Sequence[Path]) -> tuple[list[Path], list[Path]]:
-    """The match files of the inputs (in input order, each once) and the files ignored."""
-    files: list[Path] = []
-    ignored: list[Path] = []
-    seen: set[Path] = set()
-    for path in inputs:
-        if not path.exists():
-            raise EstaError(f"{path}: no such file or folder")
-        if path.is_dir():
-            ignored.extend(
-                sorted(
-                    p for p in path.iterdir() if p.is_file() and not p.name.endswith(MATCH_SUFFIXES)
-                )
-            )
-        for file in iter_match_files(path):
-            resolved = file.resolve()  # workers may run elsewhere: absolute paths
-            if resolved not in seen:
-                seen.add(resolved)
-                files.append(resolved)
-    return files, ignored
+def default_inputs() -> list[Path]:
+    """The inputs of a run given none: the shipped synthetic sample (an error without it)."""
+    from decoy_cli.synth.sample import SAMPLE_DIR
+
+    if not SAMPLE_DIR.is_dir() or not any(SAMPLE_DIR.glob("*.json*")):
+        raise DecoyError(
+            f"no input given and no shipped sample in {SAMPLE_DIR}: pass ESTA match files "
+            "or folders (or generate the sample with `decoy make-sample`)"
+        )
+    return [SAMPLE_DIR]
 
 
 def run_evaluation(
@@ -179,7 +161,7 @@ def run_evaluation(
     started = time.perf_counter()
     from decoy_cli.waypoints.build import builtin_graph
 
-    paths, ignored = collect_files(inputs)
+    paths, ignored = collect_match_files(inputs)
     cache = RunCache(out)
     evaluation = Evaluation(
         settings=settings,
@@ -195,7 +177,7 @@ def run_evaluation(
         try:
             sha = file_sha256(path)
         except EstaError as error:
-            failures.append(Failure(str(path), None, "unreadable file", str(error)))
+            failures.append(RoundFailure(str(path), None, UNREADABLE_FILE, str(error)))
             continue
         if sha in by_sha:
             evaluation.duplicates.append((path, by_sha[sha]))
@@ -244,10 +226,12 @@ def _report(
         on_progress(ProgressEvent(stage, done, total, failed))
 
 
-def _round_failure(task: RoundTask, outcome: Any) -> Failure:
-    if isinstance(outcome, TaskFailure):
-        return Failure(task.file, task.round_num, outcome.kind, outcome.message)
-    return Failure(task.file, task.round_num, "internal error", f"unexpected result {outcome!r}")
+def _round_failure(task: RoundTask, outcome: Any) -> RoundFailure:
+    """The failure of a round task, with the task's file and round (a backend's crash report
+    does not know them)."""
+    if isinstance(outcome, RoundFailure):
+        return replace(outcome, file=task.file, round_num=task.round_num)
+    return RoundFailure(task.file, task.round_num, INTERNAL_ERROR, f"unexpected result {outcome!r}")
 
 
 def _index(
@@ -255,7 +239,7 @@ def _index(
     settings: EvalSettings,
     cache: RunCache,
     backend: Backend,
-    failures: list[Failure],
+    failures: list[RoundFailure],
     on_progress: Callable[[ProgressEvent], None] | None,
 ) -> list[MatchFile]:
     """Every file with its index (cached or computed); unreadable files become failures."""
@@ -275,7 +259,7 @@ def _index(
             indexes[task.file_sha] = outcome
         else:
             failed += 1
-            failures.append(Failure(task.file, None, outcome.kind, outcome.message))
+            failures.append(RoundFailure(task.file, None, outcome.kind, outcome.message))
         _report(on_progress, "index", done, len(pending), failed)
     return [MatchFile(f.path, f.sha, indexes.get(f.sha)) for f in files]
 
@@ -288,10 +272,10 @@ def _round_tasks(evaluation: Evaluation, sample: int | None) -> list[RoundTask]:
         if index.map_name and index.map_name != settings.map_name:
             count = len(index.rounds) + len(index.round_errors)
             evaluation.failures.append(
-                Failure(
+                RoundFailure(
                     str(file.path),
                     None,
-                    "other map",
+                    OTHER_MAP,
                     f"{file.path}: a {index.map_name} match ({count} rounds skipped); "
                     f"this evaluation is of {settings.map_name}",
                 )
@@ -310,7 +294,7 @@ def _round_tasks(evaluation: Evaluation, sample: int | None) -> list[RoundTask]:
     tasks = []
     for sha, num, file, error in population:
         if error is not None:
-            evaluation.failures.append(Failure(str(file.path), num, "broken round", error))
+            evaluation.failures.append(RoundFailure(str(file.path), num, BROKEN_ROUND, error))
         else:
             key = round_key(settings, sha, num)
             tasks.append(RoundTask(str(file.path), sha, num, key, settings))

@@ -83,16 +83,18 @@ class HeatGrid:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class EvalSettings:
     """Everything that decides one round's result; its JSON is hashed into the cache key.
 
-    `combat` switches shooting and the bomb together (off: movement only, as in the paper's
-    Table 2); `models` is the damage-model choice a worker loads (only used with combat).
+    `combat` switches shooting and `bomb` the bomb rules, independently (both off: movement
+    only, as in the paper's Table 2); `models` is the damage-model choice a worker loads (only
+    used with combat).
     """
 
     map_name: str
     combat: bool
+    bomb: bool
     models: str
     mover: str
     seed: int

@@ -4,6 +4,7 @@
 * `trajectory`: the ten trajectory metrics of a player-round, protocols "clock" and "paper".
 * `combat`: HP, death-time and round-outcome metrics of full rounds.
 * `aggregate`: mean, std, median and p90 by side and overall, with unevaluated rows accounted for.
+* `players`: the per-player fidelity table of a replayed round (`player_metrics`).
 """
 
 from decoy_cli.metrics.aggregate import GROUPS, SIDES, MetricSummary, summarize
@@ -22,6 +23,7 @@ from decoy_cli.metrics.combat import (
     pearson,
 )
 from decoy_cli.metrics.distances import TIE_RTOL, dtw, dtw_mean, frechet
+from decoy_cli.metrics.players import PLAYER_METRIC_COLUMNS, ReplayTrace, player_metrics
 from decoy_cli.metrics.trajectory import (
     METRIC_NAMES,
     METRIC_NAMES_CLOCK,
@@ -44,6 +46,7 @@ __all__ = [
     "METRIC_NAMES_PAPER",
     "OUTCOME_METRIC_NAMES",
     "PAPER_LENGTH",
+    "PLAYER_METRIC_COLUMNS",
     "SIDES",
     "TIE_RTOL",
     "DeathTimeMetrics",
@@ -51,6 +54,7 @@ __all__ = [
     "MetricSummary",
     "OutcomeMetrics",
     "PlayerRound",
+    "ReplayTrace",
     "TrajectoryMetrics",
     "confusion_matrix",
     "death_time_metrics",
@@ -60,6 +64,7 @@ __all__ = [
     "hp_metrics",
     "outcome_metrics",
     "pearson",
+    "player_metrics",
     "resample",
     "summarize",
     "trajectory_metrics",

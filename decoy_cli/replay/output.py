@@ -1,7 +1,5 @@
 """What a replay produces for people and for other tools: metrics, files and pictures.
 
-* `player_metrics`: the clock and paper metrics (docs' metrics.md) of every player, original
-  versus replay, plus lateness, stuck episodes, relocations and how the player's round ended.
 * `write_replay`: the replay as open files in a folder: `replay.csv` (one row per data frame
   and player: time, position, yaw, HP, alive, and the original position beside it),
   `events.csv` (every simulator event), `players.csv` (the per-player table) and
@@ -20,62 +18,16 @@ import pandas as pd
 
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import OutputError
+from decoy_cli.esta import Round
 from decoy_cli.figures import draw_nav_areas, save_figure
-from decoy_cli.files import write_atomic
-from decoy_cli.metrics import trajectory_metrics
+from decoy_cli.files import json_text, write_atomic
 from decoy_cli.replay.replayer import ReplayResult
-
-
-def player_metrics(round_: Any, result: ReplayResult) -> pd.DataFrame:
-    """One row per player: identity, fate in both worlds, timing, and all ten metrics.
-
-    Columns: player, side, died_original, died_replay, death ("scripted", "simulated" or ""),
-    late_share, late_p95_s, stuck, recoveries, relocations, the ten `METRIC_NAMES`, and reason
-    (why the metrics are NaN, else None).
-
-    Frames where the data lost the player (absent from the frame's player list; some rounds
-    miss a player for many seconds) are left out of both trajectories: the original has no
-    position there, and the replay's path across the gap is a shortest path, not something the
-    player did.
-    """
-    rec = result.recording
-    lateness = result.lateness_table()
-    present = np.asarray(getattr(round_, "present", np.isfinite(round_.position).all(axis=2)))
-    rows = []
-    for p, player in enumerate(result.plan.players):
-        metrics = trajectory_metrics(
-            np.asarray(round_.position[p]),
-            np.asarray(round_.alive[p]),
-            rec.position[:, p],
-            rec.alive[:, p] & present[p],
-        )
-        died_original = bool(result.plan.plans[p].death_frame >= 0)
-        # a player never alive on the graph (absent) never lived in the replay: not a death
-        died_replay = bool(rec.alive[:, p].any() and not rec.alive[-1, p])
-        rows.append(
-            {
-                "player": player.name,
-                "side": player.side,
-                "died_original": died_original,
-                "died_replay": died_replay,
-                "death": "scripted"
-                if result.scripted_death[p]
-                else ("simulated" if died_replay else ""),
-                "late_share": lateness.loc[p, "late_share"],
-                "late_p95_s": lateness.loc[p, "late_p95_s"],
-                "stuck": int(result.stuck[p]) if result.stuck is not None else 0,
-                "recoveries": int(result.recoveries[p]) if result.recoveries is not None else 0,
-                "relocations": int(lateness.loc[p, "relocations"]),
-                **metrics.values,
-                "reason": metrics.reason,
-            }
-        )
-    return pd.DataFrame(rows)
+from decoy_cli.world.navmesh import NavMesh
 
 
 def write_replay(
     folder: str | Path,
-    round_: Any,
+    round_: Round,
     result: ReplayResult,
     players: pd.DataFrame,
     summary: dict[str, Any],
@@ -129,13 +81,15 @@ def write_replay(
         ("replay.csv", table.to_csv(index=False)),
         ("events.csv", events.to_csv(index=False)),
         ("players.csv", players.to_csv(index=False)),
-        ("summary.json", json.dumps(summary, indent=2, sort_keys=True, default=str) + "\n"),
+        ("summary.json", json_text(summary)),
     ):
         written.append(write_atomic(folder / name, content.encode()))
     return written
 
 
-def plot_paths(path: str | Path, round_: Any, result: ReplayResult, nav, title: str = "") -> None:
+def plot_paths(
+    path: str | Path, round_: Round, result: ReplayResult, nav: NavMesh, title: str = ""
+) -> None:
     """Original (dashed) versus replayed (solid) path of every player over the map."""
     import matplotlib
 
@@ -166,7 +120,9 @@ def plot_paths(path: str | Path, round_: Any, result: ReplayResult, nav, title: 
     save_figure(fig, path)
 
 
-def animate(path: str | Path, round_: Any, result: ReplayResult, nav, fps: int = 8) -> None:
+def animate(
+    path: str | Path, round_: Round, result: ReplayResult, nav: NavMesh, fps: int = 8
+) -> None:
     """An animated GIF of the round: replayed agents (filled) and originals (rings) per frame."""
     import matplotlib
 

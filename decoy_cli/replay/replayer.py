@@ -15,21 +15,23 @@ S_t on the same clock.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from decoy_cli.csgo import TICK_RATE
+from decoy_cli.csgo import TICK_RATE, tick_at
 from decoy_cli.errors import EstaError
+from decoy_cli.esta import PlayerInfo, Round
+from decoy_cli.metrics.players import ReplayTrace
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.replay.rounds import RoundPlan, snap_round
-from decoy_cli.sim.combat import CombatStep, LineOfSight
-from decoy_cli.sim.engine import Decision, Recording, SimConfig, Simulator
-from decoy_cli.sim.movement import KinematicMover, PhysicsMover
-from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
-from decoy_cli.sim.state import Agents, SimEvent
+from decoy_cli.sim.combat import DamageModel
+from decoy_cli.sim.engine import Decision, Recording, Simulator
+from decoy_cli.sim.rules import RulesConfig
+from decoy_cli.sim.setup import OpenRound, RoundSetup, check_mover, open_round
+from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 from decoy_cli.world.physics import PhysicsWorld
@@ -50,7 +52,7 @@ class AgentLog:
         """(T,) seconds late at each reached target (0 when on time or early), NaN if unreached."""
         late = np.where(
             self.arrival_tick >= 0,
-            np.maximum(0, self.arrival_tick - self.deadline_tick) / 60.0,
+            np.maximum(0, self.arrival_tick - self.deadline_tick) / TICK_RATE,
             np.nan,
         )
         return late
@@ -62,7 +64,7 @@ class PlanPolicy:
     def __init__(
         self,
         plans: list[PlayerPlan],
-        tick_of: Any,
+        tick_of: Callable[[float], int],
         graph_edge_length: np.ndarray,
         plant_from_tick: int | None = None,
         defuse_from_tick: dict[int, int] | None = None,
@@ -137,7 +139,7 @@ class PlanPolicy:
                         STOP_ACTION, hold_ticks=deadline - now, plant=plant, defuse=defuse
                     )
                 continue
-            seconds_left = (deadline - now) / 60.0
+            seconds_left = (deadline - now) / TICK_RATE
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
@@ -160,11 +162,29 @@ class ReplayResult:
     frame_ticks: np.ndarray  # (F,) simulator tick of each data frame
     scripted_death: np.ndarray  # (P,) bool: removed at its data death time, not by combat
     logs: list[AgentLog]
-    outcome: Any
+    outcome: RoundOutcome | None
     events: list[SimEvent] = field(default_factory=list)
     stuck: np.ndarray | None = None  # (P,) stuck episodes
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
     played_out_s: float = 0.0  # game seconds simulated after the data's last frame (play_out)
+
+    def trace(self) -> ReplayTrace:
+        """What the fidelity metrics need from this replay (`decoy_cli.metrics.player_metrics`)."""
+        lateness = self.lateness_table()
+        count = len(self.logs)
+        return ReplayTrace(
+            position=self.recording.position,
+            alive=self.recording.alive,
+            died_original=np.array([plan.death_frame >= 0 for plan in self.plan.plans], bool),
+            scripted_death=self.scripted_death,
+            late_share=lateness["late_share"].to_numpy(dtype=float),
+            late_p95_s=lateness["late_p95_s"].to_numpy(dtype=float),
+            stuck=self.stuck if self.stuck is not None else np.zeros(count, np.int64),
+            recoveries=self.recoveries
+            if self.recoveries is not None
+            else np.zeros(count, np.int64),
+            relocations=lateness["relocations"].to_numpy(dtype=np.int64),
+        )
 
     def lateness_table(self) -> pd.DataFrame:
         """Per player: share of targets reached late, p95 and max lateness (s), relocations."""
@@ -177,7 +197,7 @@ class ReplayResult:
                     "player": self.plan.players[p].name,
                     "targets": len(late),
                     "reached": len(reached),
-                    "late_share": float(np.mean(reached > 1 / 60 + 1e-9))
+                    "late_share": float(np.mean(reached > 1 / TICK_RATE + 1e-9))
                     if len(reached)
                     else np.nan,
                     "late_p95_s": float(np.percentile(reached, 95)) if len(reached) else np.nan,
@@ -188,20 +208,20 @@ class ReplayResult:
         return pd.DataFrame(rows)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ReplayOptions:
-    """How to replay: mechanics on or off, the mover, the damage model, the seed."""
+    """How to replay: shooting, the bomb, the mover, the damage model, the seed.
+
+    `combat` and `bomb` are independent switches (shooting needs `damage_model` too); both off
+    is the paper's movement-only replay. The default mover is the one measured more faithful
+    on real rounds (the README gives the numbers).
+    """
 
     combat: bool = True
     bomb: bool = True
-    # "kinematic" (compiled straight-line motion, agents pass through each other) or "physics"
-    # (pybullet capsules that block each other). Measured on the 385 real T rounds with combat
-    # and bomb off (benchmarks/replay_study.py): kinematic mean_dist 0.974 m (median 0.675),
-    # physics 1.014 m (median 0.694; teammates block each other, 0.5 stuck episodes a round),
-    # so the default is kinematic.
     mover: str = "kinematic"
-    damage_model: Any = None  # a decoy_cli.sim.combat.DamageModel; None: no shooting
-    # With combat on, a round still undecided when the data ends (the replay's fights went
+    damage_model: DamageModel | None = None
+    # With shooting, a round still undecided when the data ends (the replay's fights went
     # otherwise than the real ones) is played on, every agent holding its last waypoint and
     # planting or defusing where the data did, until the rules end it (elimination, the bomb,
     # the clock). Real frames end at the round's end, so without this most replays of a
@@ -209,25 +229,57 @@ class ReplayOptions:
     # which outcomes were decided after the data (`ReplayResult.played_out_s`).
     play_out: bool = True
     seed: int = 0
-    map_name: str = "de_dust2"
+
+    def __post_init__(self) -> None:
+        check_mover(self.mover)
+
+    def setup(self, graph: WaypointGraph, round_: Round) -> RoundSetup:
+        """The simulator setup of a replay of `round_` on `graph`."""
+        rules = RulesConfig()
+        if not self.bomb and len(round_.frame_seconds):
+            # Without the bomb, a round whose data ran past the round time (after a plant,
+            # which stops the clock) would time out while the players still move: replay it
+            # to the end of its data.
+            rules = RulesConfig(
+                round_time_s=max(rules.round_time_s, float(round_.frame_seconds[-1]) + 1.0)
+            )
+        return RoundSetup(
+            graph=graph,
+            mover=self.mover,
+            combat=self.combat,
+            bomb=self.bomb,
+            damage_model=self.damage_model,
+            rules=rules,
+        )
 
 
-def _tick_of(seconds: float) -> int:
-    return round(float(seconds) * TICK_RATE)
+PLANT_TOLERANCE_S = 1.0
+"""How early, before the data's plant start, the carrier may begin planting: the replay's
+timing tolerance."""
 
 
 def replay_round(
-    round_: Any, graph: WaypointGraph, physics: PhysicsWorld, options: ReplayOptions
+    round_: Round,
+    graph: WaypointGraph,
+    options: ReplayOptions | None = None,
+    *,
+    physics: PhysicsWorld | None = None,
+    open_sim: OpenRound = open_round,
 ) -> ReplayResult:
     """Snap, plan and replay one round; see the module docstring.
 
-    A round without frames (an events-only round) raises EstaError: there is nothing to replay.
+    `physics` lends a pybullet client of the map's world (a batch keeps one per worker); without
+    it the replay opens its own for the round. `open_sim` builds the simulator (default
+    `open_round`; a test may inject its own). A round without frames (an events-only round)
+    raises EstaError: there is nothing to replay.
     """
+    options = options if options is not None else ReplayOptions()
     if len(round_.frame_seconds) == 0:
-        raise EstaError(
-            f"round {getattr(round_, 'round_num', '?')} has no frames (events only): "
-            "nothing to replay"
-        )
+        raise EstaError(f"round {round_.round_num} has no frames (events only): nothing to replay")
+    setup = options.setup(graph, round_)
+    if physics is None:  # snapping finds frames in the air with the world's rays
+        with setup.open_physics() as own:
+            return replay_round(round_, graph, options, physics=own, open_sim=open_sim)
     plan = snap_round(round_, graph, physics=physics)
     players = plan.players
     n = len(players)
@@ -236,7 +288,7 @@ def replay_round(
         [int(p.target_node[0]) if len(p.target_node) else 0 for p in plan.plans], dtype=np.int64
     )
 
-    def at_first(array: np.ndarray, default):
+    def at_first(array: np.ndarray, default: object) -> list:
         return [array[i, first[i]] if len(plan.plans[i].target_node) else default for i in range(n)]
 
     weapons = [w or "Knife" for w in at_first(np.asarray(round_.weapon), "Knife")]
@@ -256,6 +308,7 @@ def replay_round(
     agents.alive[never] = False
     agents.hp[never] = 0
 
+    rules_config = setup.rules_config()
     carrier = -1
     has_bomb = np.asarray(round_.has_bomb)
     if options.bomb and has_bomb.size:
@@ -264,54 +317,32 @@ def replay_round(
     plant_from = None
     if options.bomb and round_.bomb_plant_tick is not None and len(round_.frame_ticks):
         plant_s = float(np.interp(round_.bomb_plant_tick, round_.frame_ticks, round_.frame_seconds))
-        plant_from = _tick_of(plant_s - 3.2 - 1.0)  # allow for the replay's timing tolerance
+        plant_from = tick_at(plant_s - rules_config.plant_s - PLANT_TOLERANCE_S)
     defuse_from = _defuse_starts(round_, players)
 
-    frame_ticks = np.array([_tick_of(s) for s in round_.frame_seconds], dtype=np.int64)
+    frame_ticks = np.array([tick_at(s) for s in round_.frame_seconds], dtype=np.int64)
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
-    policy = PlanPolicy(plan.plans, _tick_of, graph.edge_length, plant_from, defuse_from, caps)
-    if options.mover == "physics":
-        mover = PhysicsMover(physics)
-    elif options.mover == "kinematic":
-        mover = KinematicMover()
-    else:
-        raise ValueError(f"unknown mover {options.mover!r} (physics or kinematic)")
-    round_time = RulesConfig().round_time_s
-    if not options.bomb and len(round_.frame_seconds):
-        # Without the bomb, a round whose data ran past 115 s (after a plant, which stops the
-        # clock) would time out while the players still move: replay it to the end of its data.
-        round_time = max(round_time, float(round_.frame_seconds[-1]) + 1.0)
-    rules = BombRules(
-        SiteZones.from_graph(graph),
-        RulesConfig(bomb_enabled=options.bomb, round_time_s=round_time),
-    )
-    combat = None
-    if options.combat and options.damage_model is not None:
-        combat = CombatStep(LineOfSight(physics, n), options.damage_model, options.map_name)
-    start_tick = int(frame_ticks[0]) if len(frame_ticks) else 0
-    sim = Simulator(
-        graph,
+    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant_from, defuse_from, caps)
+    start_tick = int(frame_ticks[0])
+    scripted = np.zeros(n, dtype=bool)
+    weapon_frames = np.asarray(round_.weapon)
+    frame_of_tick = {int(t): f for f, t in enumerate(frame_ticks)}
+    end_tick = int(frame_ticks[-1])
+    with open_sim(
+        setup,
         agents,
-        mover,
         policy,
-        rules,
+        physics=physics,
         bomb_carrier=carrier,
-        combat=combat,
-        config=SimConfig(combat=combat is not None),
         start_tick=start_tick,
         record_ticks=frame_ticks,
         seed=options.seed,
-    )
-    scripted = np.zeros(n, dtype=bool)
-    deaths = {}
-    if combat is None:  # movement only: the data's deaths are scripted
-        deaths = {
-            i: _tick_of(p.death_seconds) for i, p in enumerate(plan.plans) if p.death_frame >= 0
-        }
-    weapon_frames = np.asarray(round_.weapon)
-    frame_of_tick = {int(t): f for f, t in enumerate(frame_ticks)}
-    end_tick = int(frame_ticks[-1]) if len(frame_ticks) else start_tick
-    try:
+    ) as sim:
+        deaths = {}
+        if sim.combat is None:  # movement only: the data's deaths are scripted
+            deaths = {
+                i: tick_at(p.death_seconds) for i, p in enumerate(plan.plans) if p.death_frame >= 0
+            }
         while not sim.done and sim.tick < end_tick:
             # Scripted deaths come before the step of the death frame's tick, which records the
             # frame: the frame that shows the player dead in the data shows it dead here too.
@@ -325,18 +356,15 @@ def replay_round(
                 for i in np.nonzero(agents.alive)[0]:
                     if weapon_frames[i, f]:
                         agents.weapon[i] = weapon_frames[i, f]
-                        mover.set_max_speed(int(i), max_speed_m_s(str(weapon_frames[i, f])))
+                        sim.mover.set_max_speed(int(i), max_speed_m_s(str(weapon_frames[i, f])))
         played_from = sim.tick
-        if options.play_out and combat is not None and not sim.done:
+        if options.play_out and sim.combat is not None and not sim.done:
             # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later
-            limit = max(sim.tick, rules.config.round_ticks) + rules.config.bomb_ticks + 1
+            limit = max(sim.tick, rules_config.round_ticks) + rules_config.bomb_ticks + 1
             while not sim.done and sim.tick < limit:
                 sim.step()
-    finally:
-        if combat is not None:
-            combat.los.close()
-        if hasattr(mover, "close"):
-            mover.close()
+        stuck = np.asarray(sim.mover.stuck_events).copy()
+        recoveries = np.asarray(sim.mover.recoveries).copy()
     return ReplayResult(
         plan=plan,
         recording=sim.recording,
@@ -345,8 +373,8 @@ def replay_round(
         logs=policy.logs,
         outcome=sim.outcome,
         events=sim.events,
-        stuck=np.asarray(mover.stuck_events).copy(),
-        recoveries=np.asarray(mover.recoveries).copy(),
+        stuck=stuck,
+        recoveries=recoveries,
         played_out_s=(sim.tick - played_from) / TICK_RATE,
     )
 
@@ -383,20 +411,20 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     return np.maximum(plan.interval_max_speed_m_s, ran) * zigzag
 
 
-def _defuse_starts(round_: Any, players: list) -> dict[int, int]:
+def _defuse_starts(round_: Round, players: list[PlayerInfo]) -> dict[int, int]:
     """Agent -> tick from which it wants to defuse: its `defuse_start` events in the data."""
-    events = getattr(round_, "bomb_events", None)
-    if events is None or len(events) == 0 or "bombAction" not in events:
+    events = round_.bomb_events
+    if len(events) == 0 or "bombAction" not in events:
         return {}
     starts = events[events["bombAction"] == "defuse_start"]
     out: dict[int, int] = {}
     for i, player in enumerate(players):
         mine = starts[
             (starts.get("playerName") == player.name)
-            | (starts.get("playerSteamID") == getattr(player, "steam_id", None))
+            | (starts.get("playerSteamID") == player.steam_id)
         ]
         if len(mine):
             seconds = float(np.nanmin(mine["seconds"])) if "seconds" in mine else np.nan
             if np.isfinite(seconds):
-                out[i] = _tick_of(seconds) - TICK_RATE
+                out[i] = tick_at(seconds) - TICK_RATE
     return out

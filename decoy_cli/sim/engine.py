@@ -27,6 +27,7 @@ import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.sim.movement import Mover
+from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.state import Agents, Bomb, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -56,14 +57,8 @@ class Policy(Protocol):
     def decide(self, sim: Simulator, agent: int) -> Decision: ...
 
 
-@dataclass
-class SimConfig:
-    """Switches and rates of a simulated round."""
-
-    combat: bool = True  # the bomb's switch is the rules' own (RulesConfig.bomb_enabled)
-    combat_every_ticks: int = 30
-    tick_rate: int = TICK_RATE
-    max_ticks: int | None = None  # hard bound on the run (default: round time + bomb timer)
+COMBAT_EVERY_TICKS = TICK_RATE // 2
+"""Ticks between combat steps: the paper's 0.5 s."""
 
 
 @dataclass
@@ -78,8 +73,19 @@ class Recording:
     events: list[SimEvent] = field(default_factory=list)
 
 
+class CombatRunner(Protocol):
+    """A combat step: changes the agents in place and returns the events (see sim/combat.py)."""
+
+    def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]: ...
+
+
 class Simulator:
-    """One round; build it, then `run()` (or `step()` yourself, as the environment does)."""
+    """One round; build it, then `run()` (or `step()` yourself, as the environment does).
+
+    Rounds are normally opened with `decoy_cli.sim.setup.open_round`, which builds the mover,
+    the rules and the combat step from one `RoundSetup`; constructing it directly is for tests
+    and for callers that bring their own parts. `combat` None: nobody shoots.
+    """
 
     def __init__(
         self,
@@ -87,21 +93,24 @@ class Simulator:
         agents: Agents,
         mover: Mover,
         policy: Policy,
-        rules,
+        rules: BombRules,
+        *,
         bomb_carrier: int = -1,
-        combat=None,
-        config: SimConfig | None = None,
+        combat: CombatRunner | None = None,
+        combat_every_ticks: int = COMBAT_EVERY_TICKS,
         start_tick: int = 0,
         record_ticks: Sequence[int] = (),
         seed: int | None = None,
     ) -> None:
+        if combat_every_ticks < 1:
+            raise ValueError(f"combat_every_ticks must be >= 1, got {combat_every_ticks}")
         self.graph = graph
         self.agents = agents
         self.mover = mover
         self.policy = policy
         self.rules = rules
         self.combat = combat
-        self.config = config or SimConfig()
+        self.combat_every_ticks = int(combat_every_ticks)
         self.rng = np.random.default_rng(seed)
         self.tick = start_tick
         self.events: list[SimEvent] = []
@@ -130,11 +139,8 @@ class Simulator:
             events=self.events,
         )
         self._next_record = 0
-        self._max_tick = start_tick + (
-            self.config.max_ticks
-            if self.config.max_ticks is not None
-            else rules.config.round_ticks + rules.config.bomb_ticks + 1
-        )
+        # every loop is bounded: the round's time limit plus the bomb timer after a plant
+        self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
         self._record()
 
     # ---- the tick -----------------------------------------------------------------------------
@@ -168,11 +174,7 @@ class Simulator:
         self.events += self.rules.step(
             self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
         )
-        if (
-            self.config.combat
-            and self.combat is not None
-            and self.tick % self.config.combat_every_ticks == 0
-        ):
+        if self.combat is not None and self.tick % self.combat_every_ticks == 0:
             alive_before = agents.alive.copy()
             self.events += self.combat.run(agents, self.tick, self.rng)
             for agent in np.nonzero(alive_before & ~agents.alive)[0]:

@@ -11,7 +11,8 @@ mask then allows only STOP when it will not.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from contextlib import ExitStack
 from numbers import Integral
 from typing import Any, ClassVar
 
@@ -20,17 +21,16 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from decoy_cli.csgo import TICK_RATE
-from decoy_cli.damage import load_damage_model
-from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
-from decoy_cli.sim.engine import Decision, SimConfig, Simulator
-from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
-from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones, seconds_to_ticks
+from decoy_cli.csgo import seconds_to_ticks
+from decoy_cli.sim.combat import DamageModel
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.rules import RulesConfig
+from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents, Bomb, BombStatus
+from decoy_cli.sim.view import TopDownView
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import is_known
-from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
@@ -112,10 +112,10 @@ class DecoyParallelEnv(ParallelEnv):
     direction N, NE, E, SE, S, SW, W, NW (N = +y, E = +x) at the weapon's full speed; the agent
     decides again when it reaches the next waypoint. 8 is STOP: stand still for `stop_seconds`
     (whole ticks, rounded up; 0.5 s = 30 ticks), then decide again. STOP is also the objective
-    action: a T carrying the bomb inside a bomb-site zone plants while it stands (3.2 s, so
-    several STOPs in a row), a CT in range of the planted bomb defuses. A move with no edge in
-    its direction (masked out) stands still like a STOP, without planting or defusing, and the
-    engine records an "invalid_action" event.
+    action: a T carrying the bomb inside a bomb-site zone plants while it stands (the rules'
+    plant time, so several STOPs in a row), a CT in range of the planted bomb defuses. A move
+    with no edge in its direction (masked out) stands still like a STOP, without planting or
+    defusing, and the engine records an "invalid_action" event.
 
     Asynchronous decisions: only agents with `needs_decision` (observation entry and info) have
     their action applied; the action of any other agent is ignored (it is walking an edge or
@@ -162,14 +162,16 @@ class DecoyParallelEnv(ParallelEnv):
     and the simulator's seed (combat randomness); `reset()` without a seed continues it. The
     same seed and actions give the same round with either mover.
 
-    Combat: `damage_model` is a `DamageModel` (decoy_cli/sim/combat.py) or a model choice for
-    `decoy_cli.damage.load_damage_model`: "shipped", "none" or the path of a model folder (DIP
-    and DOG, e.g. written by `decoy models import-decoy`). None or "none": no combat, and agents
-    never die.
+    Combat: `damage_model` is a `DamageModel` (decoy_cli/sim/combat.py), or a function that
+    loads one (called once, here), e.g. `lambda: load_damage_model("shipped")` with
+    `decoy_cli.damage.load_damage_model` ("shipped", "none" or the path of a model folder such
+    as `decoy models import-decoy` writes). None: no combat, and agents never die. `combat`
+    False keeps the model but turns shooting off; `bomb` False takes the bomb out of the round.
 
     pybullet: the physics mover and combat (`damage_model`) need a pybullet client with the
     world (`world`, default the built-in nav world); it is created at each reset and the
-    previous round's client is disconnected, and `close()` disconnects it.
+    previous round's client is disconnected, and `close()` disconnects it. Rounds are set up
+    by `decoy_cli.sim.setup.open_round`, as every other user of the simulator does.
 
     Rendering: `render_mode="rgb_array"` gives a top-down matplotlib picture (waypoints grey,
     T orange, CT blue, dead agents light grey, the bomb a red star).
@@ -184,7 +186,8 @@ class DecoyParallelEnv(ParallelEnv):
         graph: WaypointGraph | None = None,
         world: World | None = None,
         mover: str = "kinematic",
-        damage_model: DamageModel | str | None = None,
+        damage_model: DamageModel | Callable[[], DamageModel | None] | None = None,
+        combat: bool = True,
         bomb: bool = True,
         stop_seconds: float = 0.5,
         weapons: Mapping[str, str] | None = None,
@@ -195,8 +198,6 @@ class DecoyParallelEnv(ParallelEnv):
                 raise ValueError(f"{name} must be an int >= 0, got {count!r}")
         if n_t + n_ct == 0:
             raise ValueError("a round needs at least one agent")
-        if mover not in ("kinematic", "physics"):
-            raise ValueError(f"unknown mover {mover!r} (kinematic or physics)")
         if not stop_seconds > 0:
             raise ValueError(f"stop_seconds must be > 0, got {stop_seconds!r}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -204,13 +205,22 @@ class DecoyParallelEnv(ParallelEnv):
         self.graph = builtin_graph() if graph is None else graph
         self.world = world
         self.mover_kind = mover
-        self.damage_model = (
-            load_damage_model(damage_model) if isinstance(damage_model, str) else damage_model
+        self.damage_model: DamageModel | None = (
+            damage_model() if _is_loader(damage_model) else damage_model  # type: ignore[assignment,operator]
         )
         self.bomb = bool(bomb)
+        self.setup = RoundSetup(
+            graph=self.graph,
+            mover=mover,
+            combat=combat,
+            bomb=self.bomb,
+            damage_model=self.damage_model,
+            world=world,
+        )
+        """How every round of this environment is simulated."""
         self.render_mode = render_mode
         self.n_t, self.n_ct = int(n_t), int(n_ct)
-        self.stop_ticks = seconds_to_ticks(stop_seconds, TICK_RATE)
+        self.stop_ticks = seconds_to_ticks(stop_seconds)
 
         self._t_spawn = self.graph.region_of("t_spawn")
         self._ct_spawn = self.graph.region_of("ct_spawn")
@@ -224,8 +234,7 @@ class DecoyParallelEnv(ParallelEnv):
         self._index = {name: k for k, name in enumerate(self.possible_agents)}
         self._sides = ["T"] * n_t + ["CT"] * n_ct
         self._weapons = self._weapon_list(weapons or {})
-        self._rules = BombRules(SiteZones.from_graph(self.graph), RulesConfig(bomb_enabled=bomb))
-        self._map_name = str(self.graph.meta.get("map", ""))
+        self._rules_config: RulesConfig = self.setup.rules_config()
 
         slots = max(n_t, n_ct)
         self.layout = observation_layout(slots - 1, slots)
@@ -259,8 +268,8 @@ class DecoyParallelEnv(ParallelEnv):
         self.physics: PhysicsWorld | None = None
         """The pybullet client of the current round (None with the kinematic mover and no
         combat, or after `close()`)."""
-        self._los: LineOfSight | None = None
-        self._view: _TopDownView | None = None
+        self._round = ExitStack()
+        self._view: TopDownView | None = None
 
     # ---- PettingZoo API -----------------------------------------------------------------------
 
@@ -296,18 +305,19 @@ class DecoyParallelEnv(ParallelEnv):
             weapons=self._weapons,
         )
         carrier = int(rng.integers(self.n_t)) if self.bomb and self.n_t else -1
-        mover, combat = self._new_round_bodies()
+        self._end_round()
         self._policy = _ChosenActions()
-        self._sim = Simulator(
-            self.graph,
-            agents,
-            mover,
-            self._policy,
-            self._rules,
-            bomb_carrier=carrier,
-            combat=combat,
-            config=SimConfig(combat=combat is not None),
-            seed=int(rng.integers(2**63)),
+        if self.setup.needs_physics:
+            self.physics = self._round.enter_context(self.setup.open_physics())
+        self._sim = self._round.enter_context(
+            open_round(
+                self.setup,
+                agents,
+                self._policy,
+                physics=self.physics,
+                bomb_carrier=carrier,
+                seed=int(rng.integers(2**63)),
+            )
         )
         self.agents = list(self.possible_agents)
         return self._observe(self.agents), self._infos(self.agents)
@@ -368,13 +378,12 @@ class DecoyParallelEnv(ParallelEnv):
             return None
         sim = self._require_sim()
         if self._view is None:
-            self._view = _TopDownView(self.graph, self._sides)
+            self._view = TopDownView(self.graph, self._sides)
         return self._view.draw(sim.agents, sim.bomb if self.bomb else None)
 
     def close(self) -> None:
         """Disconnect the pybullet client and drop the round; safe to call more than once."""
-        self._release_physics()
-        self._sim = None
+        self._end_round()
         self.agents = []
         self._view = None
 
@@ -413,29 +422,12 @@ class DecoyParallelEnv(ParallelEnv):
             enemies[agent, : len(other)] = other
         return mates, enemies
 
-    def _new_round_bodies(self) -> tuple[Mover, CombatStep | None]:
-        """The round's mover and combat step, in a fresh pybullet client when they need one
-        (the previous round's client is disconnected first)."""
-        self._release_physics()
-        if self.mover_kind == "kinematic" and self.damage_model is None:
-            return KinematicMover(), None
-        self.physics = PhysicsWorld(self.world if self.world is not None else nav_world())
-        mover: Mover = (
-            PhysicsMover(self.physics) if self.mover_kind == "physics" else KinematicMover()
-        )
-        combat = None
-        if self.damage_model is not None:
-            self._los = LineOfSight(self.physics, len(self.possible_agents))
-            combat = CombatStep(self._los, self.damage_model, self._map_name)
-        return mover, combat
-
-    def _release_physics(self) -> None:
-        if self._los is not None:
-            self._los.close()
-            self._los = None
-        if self.physics is not None:
-            self.physics.close()
-            self.physics = None
+    def _end_round(self) -> None:
+        """Release the current round's bodies and pybullet client (if any)."""
+        self._round.close()
+        self._round = ExitStack()
+        self._sim = None
+        self.physics = None
 
     def _due(self) -> np.ndarray:
         """(N,) which agents the engine will ask for a decision at the next tick."""
@@ -457,7 +449,7 @@ class DecoyParallelEnv(ParallelEnv):
 
     def _observe(self, names: list[str]) -> dict[str, dict[str, np.ndarray]]:
         sim = self._require_sim()
-        agents, bomb, cfg, layout = sim.agents, sim.bomb, self._rules.config, self.layout
+        agents, bomb, cfg, layout = sim.agents, sim.bomb, self._rules_config, self.layout
         n = agents.count
         pos = agents.position
         due = self._due()
@@ -537,45 +529,20 @@ class DecoyParallelEnv(ParallelEnv):
         }
 
 
-class _TopDownView:
-    """A matplotlib figure of the map drawn once; each render moves the agents and the bomb."""
+def _is_loader(value: object) -> bool:
+    """Whether `value` is a function that loads a damage model rather than a model itself
+    (a model is called with a batch and a generator, a loader with nothing)."""
+    import inspect
 
-    SIZE_PX = 512
-    COLOURS: ClassVar[dict[str, tuple[float, float, float, float]]] = {
-        "T": (0.93, 0.55, 0.13, 1.0),
-        "CT": (0.16, 0.38, 0.85, 1.0),
-        "dead": (0.8, 0.8, 0.8, 1.0),
-    }
-
-    def __init__(self, graph: WaypointGraph, sides: list[str]) -> None:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
-
-        figure = Figure(figsize=(self.SIZE_PX / 100, self.SIZE_PX / 100), dpi=100)
-        self.canvas = FigureCanvasAgg(figure)
-        axes = figure.add_axes((0.0, 0.0, 1.0, 1.0))
-        axes.set_axis_off()
-        axes.set_aspect("equal")
-        xy = graph.positions[:, :2]
-        axes.scatter(xy[:, 0], xy[:, 1], s=0.5, c="0.7", linewidths=0)
-        lo, hi = xy.min(axis=0) - 1.0, xy.max(axis=0) + 1.0
-        axes.set_xlim(lo[0], hi[0])
-        axes.set_ylim(lo[1], hi[1])
-        self.sides = np.asarray(sides)
-        count = len(sides)
-        self.agents = axes.scatter(
-            np.zeros(count), np.zeros(count), s=60, edgecolors="black", linewidths=0.8, zorder=3
-        )
-        self.bomb = axes.scatter([], [], marker="*", s=180, c="red", edgecolors="black", zorder=4)
-
-    def draw(self, agents: Agents, bomb: Bomb | None) -> np.ndarray:
-        colours = np.array([self.COLOURS[str(side)] for side in self.sides])
-        colours[~agents.alive] = self.COLOURS["dead"]
-        self.agents.set_offsets(agents.position[:, :2])
-        self.agents.set_facecolors(colours)
-        show_bomb = bomb is not None and not (
-            bomb.status == BombStatus.CARRIED and bomb.carrier < 0
-        )
-        self.bomb.set_offsets(bomb.position[None, :2] if show_bomb else np.empty((0, 2)))
-        self.canvas.draw()
-        return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()
+    if value is None or not callable(value):
+        return False
+    try:
+        signature = inspect.signature(value)
+    except (TypeError, ValueError):
+        return False
+    required = [
+        p
+        for p in signature.parameters.values()
+        if p.default is p.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+    ]
+    return not required

@@ -51,7 +51,7 @@ from itertools import chain
 import numpy as np
 from scipy.spatial import cKDTree
 
-from decoy_cli.csgo import TICK_RATE
+from decoy_cli.csgo import TICK_RATE, seconds_to_ticks
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 
@@ -191,13 +191,6 @@ class SiteZones:
             near = np.abs(self._node_z[cols] - pts[rows, 2]) <= self.vertical_m
             np.minimum.at(best, rows[near], self._node_site[cols[near]])
         return self._labels[best]
-
-
-def seconds_to_ticks(seconds: float, tick_rate: int) -> int:
-    """A duration as a whole number of ticks, rounded up so that no rule runs shorter than in the
-    game. The product is first rounded to 1e-6, so float noise adds no tick: 8.3 * 60 is
-    498.00000000000006 and gives 498, not 499."""
-    return math.ceil(round(seconds * tick_rate, 6))
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,9 @@ become demo ticks (128 Hz) by rounding; a frame tick is exact.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from typing import cast
 
 import numpy as np
@@ -44,10 +46,10 @@ from decoy_cli.esta.writer import (
     PlayerRecord,
     RoundRecord,
 )
-from decoy_cli.sim.combat import HIT_GROUPS, CombatStep, DamageModel, LineOfSight
-from decoy_cli.sim.engine import Decision, SimConfig, Simulator
-from decoy_cli.sim.movement import KinematicMover
-from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
+from decoy_cli.sim.combat import HIT_GROUPS, DamageModel
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.rules import SiteZones
+from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents, BombStatus, SimEvent
 from decoy_cli.synth.loadouts import START_VALUE, Loadout
 from decoy_cli.synth.routes import SITE_PLACES, Leg, Places, RoundPlan
@@ -107,13 +109,10 @@ class PlayedRound:
 class ScriptedPolicy:
     """The engine policy of a scripted round (see the module docstring)."""
 
-    def __init__(
-        self, graph: WaypointGraph, places: Places, plan: RoundPlan, rules: BombRules
-    ) -> None:
+    def __init__(self, graph: WaypointGraph, places: Places, plan: RoundPlan) -> None:
         self.graph = graph
         self.places = places
         self.plan = plan
-        self.rules = rules
         n = len(plan.routes)
         self.legs: list[list[Leg]] = [list(route) for route in plan.routes]
         self.leg = np.zeros(n, dtype=np.int64)
@@ -162,7 +161,7 @@ class ScriptedPolicy:
         node = int(sim.agents.node[agent])
         target = self._node_at(bomb.position)
         agents = sim.agents
-        cfg = self.rules.config
+        cfg = sim.rules.config
         offset = agents.position[agent] - bomb.position
         in_range = (
             np.hypot(offset[0], offset[1]) <= cfg.defuse_range_m
@@ -244,18 +243,34 @@ class ScriptedPolicy:
         return self._bomb_node[1]
 
 
-def make_simulator(
-    graph: WaypointGraph,
-    places: Places,
-    zones: SiteZones,
-    plan: RoundPlan,
-    loadouts: list[Loadout],
-    team: Team,
-    seed: int,
-    combat: CombatStep | None = None,
-) -> Simulator:
-    """The simulator of a scripted round before its first tick: agents on their spawn
-    waypoints facing their first leg, with their loadouts; the policy is a `ScriptedPolicy`."""
+@dataclass(frozen=True, kw_only=True)
+class RoundScript:
+    """What a scripted round is played from: the routes, the loadouts and the team."""
+
+    places: Places
+    plan: RoundPlan
+    loadouts: list[Loadout]
+    team: Team
+    buys: dict[str, str] = field(default_factory=dict)
+
+
+def scripted_setup(graph: WaypointGraph, damage_model: DamageModel | None) -> RoundSetup:
+    """How scripted rounds are simulated: kinematic mover, bomb on, combat (with a damage
+    model) once per recorded frame."""
+    return RoundSetup(
+        graph=graph,
+        mover="kinematic",
+        combat=damage_model is not None,
+        bomb=True,
+        damage_model=damage_model,
+        combat_every_ticks=FRAME_EVERY_TICKS,
+    )
+
+
+def scripted_agents(graph: WaypointGraph, script: RoundScript) -> Agents:
+    """The agents of a scripted round before its first tick: on their spawn waypoints, facing
+    their first leg, with their loadouts."""
+    plan, loadouts, team = script.plan, script.loadouts, script.team
     start_nodes = np.array([route[0].node for route in plan.routes], dtype=np.int64)
     positions = graph.positions[start_nodes]
     first_moves = [route[1].node if len(route) > 1 else route[0].node for route in plan.routes]
@@ -265,7 +280,7 @@ def make_simulator(
             graph.positions[first_moves, 0] - positions[:, 0],
         )
     )
-    agents = Agents.create(
+    return Agents.create(
         names=list(team.names),
         sides=list(team.sides),
         positions=positions,
@@ -276,51 +291,43 @@ def make_simulator(
         has_defuser=np.array([lo.defuse_kit for lo in loadouts]),
         yaw=yaw,
     )
-    rules = BombRules(zones, RulesConfig())
-    return Simulator(
-        graph,
-        agents,
-        KinematicMover(),
-        ScriptedPolicy(graph, places, plan, rules),
-        rules,
-        bomb_carrier=plan.carrier,
-        combat=combat,
-        config=SimConfig(combat=combat is not None, combat_every_ticks=FRAME_EVERY_TICKS),
-        seed=seed,
-    )
+
+
+@contextmanager
+def open_scripted_round(
+    setup: RoundSetup, script: RoundScript, *, seed: int, physics: PhysicsWorld | None = None
+) -> Iterator[Simulator]:
+    """The simulator of a scripted round before its first tick (policy `ScriptedPolicy`)."""
+    policy = ScriptedPolicy(setup.graph, script.places, script.plan)
+    agents = scripted_agents(setup.graph, script)
+    with open_round(
+        setup, agents, policy, physics=physics, bomb_carrier=script.plan.carrier, seed=seed
+    ) as sim:
+        yield sim
 
 
 def play_round(
-    graph: WaypointGraph,
-    places: Places,
-    zones: SiteZones,
-    plan: RoundPlan,
-    loadouts: list[Loadout],
-    team: Team,
+    setup: RoundSetup,
+    script: RoundScript,
+    *,
     round_num: int,
     start_tick: int,
     seed: int,
-    damage_model: DamageModel | None = None,
     physics: PhysicsWorld | None = None,
-    buys: dict[str, str] | None = None,
 ) -> PlayedRound:
-    """Play one round of `plan` and record it (demo ticks from `start_tick`).
+    """Play one round of `script` and record it (demo ticks from `start_tick`).
 
-    Combat runs when `damage_model` is given; it needs `physics` (a pybullet world of the map)
-    for line of sight.
+    `physics` lends a pybullet world of the map for line of sight (without it, one is opened
+    for the round when combat needs it).
     """
-    if damage_model is not None and physics is None:
-        raise ValueError("combat needs a physics world for line of sight")
+    graph, plan, loadouts, team = setup.graph, script.plan, script.loadouts, script.team
     n = len(plan.routes)
-    combat = None
-    if damage_model is not None and physics is not None:
-        combat = CombatStep(LineOfSight(physics, n), damage_model, str(graph.meta.get("map", "")))
-    sim = make_simulator(graph, places, zones, plan, loadouts, team, seed, combat)
-    agents = sim.agents
-    recorder = _Recorder(graph, zones, agents)
+    zones = SiteZones.from_graph(graph)
     freeze_end = start_tick + FREEZE_TIME_TICKS
-    events = _EventLog(freeze_end, agents)
-    try:
+    with open_scripted_round(setup, script, seed=seed, physics=physics) as sim:
+        agents = sim.agents
+        recorder = _Recorder(graph, zones, agents)
+        events = _EventLog(freeze_end, agents)
         recorder.snapshot(sim)
         while not sim.done:
             hp_before = agents.hp.copy()
@@ -328,9 +335,6 @@ def play_round(
             events.add(sim, new, hp_before)
             if sim.tick % FRAME_EVERY_TICKS == 0:
                 recorder.snapshot(sim)
-    finally:
-        if combat is not None:
-            combat.los.close()
     if sim.outcome is None:
         raise RuntimeError(f"round {round_num} did not end within the simulator's bound")
 
@@ -365,7 +369,7 @@ def play_round(
         **frames,
     )
     invalid = sum(1 for e in sim.events if e.kind == "invalid_action")
-    return PlayedRound(record, plan, dict(buys or {}), invalid)
+    return PlayedRound(record, plan, dict(script.buys), invalid)
 
 
 class _Recorder:

@@ -24,12 +24,24 @@ from decoy_cli.esta.writer import MatchRecord, write_match
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.synth.loadouts import buy_kind, side_loadouts
-from decoy_cli.synth.player import DEMO_TICK_RATE, PlayedRound, Team, play_round
+from decoy_cli.synth.player import (
+    DEMO_TICK_RATE,
+    PlayedRound,
+    RoundScript,
+    Team,
+    play_round,
+    scripted_setup,
+)
 from decoy_cli.synth.routes import TEAM_SIZE, Places, plan_round
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.world.navmesh import BUILTIN_MAP, nav_world
-from decoy_cli.world.physics import PhysicsWorld
+from decoy_cli.world.navmesh import BUILTIN_MAP
+
+SAMPLE_DIR = Path(__file__).resolve().parents[2] / "examples" / "sample"
+"""The shipped synthetic sample, evaluated when no input is given. It lives in the source tree
+(a checkout or an editable install), next to the README that says how `decoy make-sample`
+regenerates it, rather than inside the package: it is example data, not something the library
+needs, so a wheel stays small and its users pass their own data."""
 
 MAX_ROUNDS = 30
 HALF_ROUNDS = 15
@@ -79,7 +91,8 @@ def play_match(
     graph = builtin_graph() if graph is None else graph
     places = Places(graph)
     zones = SiteZones.from_graph(graph)
-    physics = PhysicsWorld(nav_world()) if damage_model is not None else None
+    setup = scripted_setup(graph, damage_model)
+    physics = setup.open_physics() if setup.needs_physics else None
     played: list[PlayedRound] = []
     cursor = 0
     previous_winner: str | None = None
@@ -93,19 +106,14 @@ def play_match(
             loadouts = side_loadouts("T", buys["T"], TEAM_SIZE, rng) + side_loadouts(
                 "CT", buys["CT"], TEAM_SIZE, rng
             )
+            script = RoundScript(places=places, plan=plan, loadouts=loadouts, team=TEAM, buys=buys)
             result = play_round(
-                graph,
-                places,
-                zones,
-                plan,
-                loadouts,
-                TEAM,
+                setup,
+                script,
                 round_num=k + 1,
                 start_tick=cursor,
                 seed=int(rng.integers(2**63)),
-                damage_model=damage_model,
                 physics=physics,
-                buys=buys,
             )
             played.append(result)
             cursor = result.record.end_official_tick

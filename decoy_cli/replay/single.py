@@ -1,0 +1,107 @@
+"""One round replayed for a person: from a round address to the files `decoy replay` writes.
+
+`replay_address` reads the round, checks its map, replays it, measures every player and
+writes `replay.csv`, `events.csv`, `players.csv`, `summary.json`, `paths.png` (and `round.gif`)
+into the output folder; the command only parses options and prints what this returns.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.esta import Round, load_round
+from decoy_cli.metrics.players import player_metrics
+from decoy_cli.replay.output import animate, plot_paths, write_replay
+from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
+
+DEFAULT_REPLAY_OUT = Path("decoy-out") / "replay"
+
+
+@dataclass(frozen=True)
+class SingleReplay:
+    """A replayed round with its per-player table, its summary and where it was written."""
+
+    round_: Round
+    options: ReplayOptions
+    result: ReplayResult
+    players: pd.DataFrame
+    summary: dict[str, Any]
+    folder: Path
+    seconds: float
+
+
+def replay_address(
+    address: str,
+    options: ReplayOptions,
+    *,
+    models: str | None,
+    graph_file: Path | None = None,
+    out: Path | None = None,
+    gif: bool = False,
+) -> SingleReplay:
+    """Replay the round at "FILE:ROUND" and write its files (see the module docstring).
+
+    `models` names the damage models in the summary (None: no shooting).
+    """
+    round_ = load_round(address)
+    if round_.map_name and round_.map_name != BUILTIN_MAP:
+        raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
+    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
+    started = time.perf_counter()
+    result = replay_round(round_, graph, options)
+    seconds = time.perf_counter() - started
+    players = player_metrics(round_, result.trace())
+    summary = replay_summary(address, round_, options, models, result, players, seconds)
+    folder = out or DEFAULT_REPLAY_OUT / f"{round_.match_id[:8]}_r{round_.round_num}"
+    write_replay(folder, round_, result, players, summary)
+    nav = load_navmesh()
+    title = f"{round_.match_id[:8]} round {round_.round_num}: original (dashed) vs replay"
+    plot_paths(folder / "paths.png", round_, result, nav, title=title)
+    if gif:
+        animate(folder / "round.gif", round_, result, nav)
+    return SingleReplay(round_, options, result, players, summary, folder, seconds)
+
+
+def replay_summary(
+    address: str,
+    round_: Round,
+    options: ReplayOptions,
+    models: str | None,
+    result: ReplayResult,
+    players: pd.DataFrame,
+    seconds: float,
+) -> dict[str, Any]:
+    """The contents of `summary.json`: the round, the options, both outcomes, counts."""
+    outcome = result.outcome
+    return {
+        "round": address,
+        "match_id": round_.match_id,
+        "round_num": round_.round_num,
+        "options": {
+            "combat": options.combat,
+            "bomb": options.bomb,
+            "mover": options.mover,
+            "seed": options.seed,
+        },
+        "damage_models": models if options.combat else None,
+        "played_out_s": round(result.played_out_s, 3),
+        "outcome_original": {"winner": round_.winning_side, "reason": round_.end_reason},
+        "outcome_replay": {
+            "winner": outcome.winner if outcome else None,
+            "reason": outcome.reason if outcome else None,
+        },
+        "frames": int(round_.num_frames),
+        "wall_seconds": round(seconds, 3),
+        "stuck_episodes": int(players["stuck"].sum()),
+        "recoveries": int(players["recoveries"].sum()),
+        "relocations": int(players["relocations"].sum()),
+    }

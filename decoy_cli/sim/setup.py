@@ -1,0 +1,160 @@
+"""One way to set up a simulated round: what it is played with, and the bodies it needs.
+
+`RoundSetup` (keyword-only) names everything that decides how a round is simulated: the
+waypoint graph, the mover, shooting (`combat` and the damage model), the bomb rules, the combat
+cadence. `open_round` is the one place that turns it into a ready `Simulator`: it opens a
+pybullet client only when the round needs one (the physics mover, or line of sight for
+shooting) unless the caller lends one, builds the mover, the rules, line of sight and the combat
+step, and on exit releases exactly what it built. The PettingZoo environment, the replay of a
+real round, the synthetic sample and the speed benchmark all start their rounds here, so a
+switch means the same in each.
+
+`combat` and `bomb` are independent: shooting happens when `combat` is on and there is a damage
+model; the bomb (carrier, plant, defuse, detonation) acts when `bomb` is on. The paper's
+movement-only evaluation is both off.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import AbstractContextManager, ExitStack, contextmanager
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
+from decoy_cli.sim.engine import COMBAT_EVERY_TICKS, Policy, Simulator
+from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
+from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
+from decoy_cli.sim.state import Agents
+from decoy_cli.waypoints.graph import WaypointGraph
+
+if TYPE_CHECKING:
+    from decoy_cli.world.physics import PhysicsWorld
+    from decoy_cli.world.world import World
+
+MOVERS = ("kinematic", "physics")
+"""The movers: "kinematic" (compiled motion along the edges, agents pass through each other)
+and "physics" (pybullet capsules that block each other)."""
+
+
+class SetupError(DecoyError, ValueError):
+    """A round setup that cannot be played (an unknown mover, combat without a world)."""
+
+
+def check_mover(mover: str) -> str:
+    """The mover's name if it is one of `MOVERS`, else a SetupError naming them."""
+    if mover not in MOVERS:
+        raise SetupError(f"unknown mover {mover!r} (use {' or '.join(MOVERS)})")
+    return mover
+
+
+@dataclass(frozen=True, kw_only=True)
+class RoundSetup:
+    """How rounds are simulated (see the module docstring).
+
+    `world` is the geometry for pybullet (None: the nav world of the graph's map); it is used
+    only when a client is opened here, not when the caller lends one. `rules` overrides the
+    rules' durations and ranges (its `bomb_enabled` is replaced by `bomb`).
+    """
+
+    graph: WaypointGraph
+    mover: str = "kinematic"
+    combat: bool = True
+    bomb: bool = True
+    damage_model: DamageModel | None = None
+    combat_every_ticks: int = COMBAT_EVERY_TICKS
+    world: World | None = None
+    rules: RulesConfig | None = None
+
+    def __post_init__(self) -> None:
+        check_mover(self.mover)
+        if self.combat_every_ticks < 1:
+            raise SetupError(f"combat_every_ticks must be >= 1, got {self.combat_every_ticks}")
+
+    @property
+    def map_name(self) -> str:
+        """The map of the graph ("" when the graph does not say)."""
+        return str(self.graph.meta.get("map", ""))
+
+    @property
+    def shooting(self) -> bool:
+        """Whether agents shoot: combat on and a damage model to decide the hits."""
+        return self.combat and self.damage_model is not None
+
+    @property
+    def needs_physics(self) -> bool:
+        """Whether a round needs a pybullet client: the physics mover or line of sight."""
+        return self.mover == "physics" or self.shooting
+
+    def rules_config(self) -> RulesConfig:
+        """The rules' configuration with this setup's bomb switch."""
+        base = self.rules if self.rules is not None else RulesConfig()
+        if base.bomb_enabled == self.bomb:
+            return base
+        return replace(base, bomb_enabled=self.bomb)
+
+    def open_physics(self) -> PhysicsWorld:
+        """A new pybullet client holding this setup's world (the caller closes it)."""
+        from decoy_cli.world.navmesh import nav_world
+        from decoy_cli.world.physics import PhysicsWorld
+
+        if self.world is not None:
+            return PhysicsWorld(self.world)
+        return PhysicsWorld(nav_world(self.map_name) if self.map_name else nav_world())
+
+
+OpenRound = Callable[..., AbstractContextManager[Simulator]]
+"""The type of `open_round`: what a caller may inject in its place (a test, a recorder)."""
+
+
+@contextmanager
+def open_round(
+    setup: RoundSetup,
+    agents: Agents,
+    policy: Policy,
+    *,
+    physics: PhysicsWorld | None = None,
+    bomb_carrier: int = -1,
+    start_tick: int = 0,
+    record_ticks: Sequence[int] = (),
+    seed: int | None = None,
+) -> Iterator[Simulator]:
+    """A ready `Simulator` for one round of `agents` driven by `policy`.
+
+    `physics` lends a pybullet client (kept open); without it one is opened when the round
+    needs it and closed on exit. The mover's and line of sight's bodies are always removed on
+    exit, so a lent client serves many rounds.
+    """
+    with ExitStack() as stack:
+        if setup.needs_physics and physics is None:
+            physics = setup.open_physics()
+            stack.callback(physics.close)
+        mover: Mover
+        if setup.mover == "physics":
+            assert physics is not None
+            physical = PhysicsMover(physics)
+            stack.callback(physical.close)
+            mover = physical
+        else:
+            mover = KinematicMover()
+        combat = None
+        if setup.shooting:
+            assert physics is not None and setup.damage_model is not None
+            los = LineOfSight(physics, agents.count)
+            stack.callback(los.close)
+            combat = CombatStep(los, setup.damage_model, setup.map_name)
+        rules = BombRules(SiteZones.from_graph(setup.graph), setup.rules_config())
+        yield Simulator(
+            setup.graph,
+            agents,
+            mover,
+            policy,
+            rules,
+            bomb_carrier=bomb_carrier if setup.bomb else -1,
+            combat=combat,
+            combat_every_ticks=setup.combat_every_ticks,
+            start_tick=start_tick,
+            record_ticks=record_ticks,
+            seed=seed,
+        )
