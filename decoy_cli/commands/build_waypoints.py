@@ -11,15 +11,13 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from decoy_cli.errors import DecoyError, GraphError
+from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.build import build_graph, canonical_map, read_manual_waypoints
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.waypoints.plot import plot_graph
-from decoy_cli.waypoints.quality import esta_positions, snap_quality
+from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_aligned
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
-from decoy_cli.world.physics import PhysicsWorld
-from decoy_cli.world.world import World
 
 DEFAULT_OUT = Path("decoy-out") / "waypoints"
 
@@ -171,17 +169,12 @@ def build_waypoints(
         )
         console.print(f"plot written to {png}")
     if check_esta is not None:
-        _alignment(console, graph, result, world, check_esta, min_aligned)
+        quality = alignment_quality(graph, result.pruned_positions, world, check_esta)
+        _show_alignment(console, quality, check_esta)
+        check_aligned(quality, min_aligned)
 
 
-def _alignment(
-    console: Console, graph, result, world: World, path: Path, min_aligned: float
-) -> None:
-    positions = esta_positions(path)
-    with PhysicsWorld(world) as physics:
-        lifted = positions + np.array([0.0, 0.0, 0.1])
-        floor_z = physics.first_floor_below(lifted, 4.0)[0] if len(positions) else None
-    quality = snap_quality(graph, positions, result.pruned_positions, floor_z=floor_z)
+def _show_alignment(console: Console, quality: SnapQuality, path: Path) -> None:
     table = Table(title=f"alignment: {quality.positions:,} alive positions of {path}")
     table.add_column("distance to waypoint")
     table.add_column("median (m)", justify="right")
@@ -208,8 +201,3 @@ def _alignment(
         f"no waypoint on their floor: {quality.unsnapped:,}; "
         f"nearest lattice node was pruned: {quality.on_pruned:.2%}"
     )
-    if quality.within_horizontal < min_aligned:
-        raise DecoyError(
-            f"only {quality.within_horizontal:.1%} of the positions lie within 0.5 m of a "
-            "waypoint: the mesh looks misaligned (check --units, --scale, --up-axis, --offset)"
-        )

@@ -10,12 +10,12 @@ unsnapped (see `decoy_cli.replay.snapping`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError
+from decoy_cli.esta import PlayerInfo, Round
 from decoy_cli.replay.plans import PathCache, PlayerPlan, build_plan
 from decoy_cli.replay.snapping import (
     DEFAULT_MAX_SNAP_M,
@@ -55,8 +55,8 @@ SUMMARY_COLUMNS = (
 class RoundPlan:
     """Snap results and timed plans of every player of one round, in the round's player order."""
 
-    players: list[Any]
-    """The round's player records (with at least `name` and `side`)."""
+    players: list[PlayerInfo]
+    """The round's players, in its row order."""
     frame_seconds: np.ndarray
     """(F,) frame times, seconds since freeze-time end."""
     snaps: list[SnapResult]
@@ -83,7 +83,7 @@ class RoundPlan:
 
 
 def snap_round(
-    round_: Any,
+    round_: Round,
     graph: WaypointGraph,
     *,
     max_distance: float = DEFAULT_MAX_SNAP_M,
@@ -132,7 +132,7 @@ def snap_round(
     )
 
 
-def _summary_row(player: Any, alive: np.ndarray, snap: SnapResult, plan: PlayerPlan) -> list:
+def _summary_row(player: PlayerInfo, alive: np.ndarray, snap: SnapResult, plan: PlayerPlan) -> list:
     """One summary row, in `SUMMARY_COLUMNS` order."""
     errors = snap.error_m[snap.status == SnapStatus.SNAPPED]
     with_position = snap.num_snapped + snap.num_unsnappable

@@ -15,7 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
+from decoy_cli.errors import DecoyError
 from decoy_cli.waypoints.graph import AIRBORNE_M, WaypointGraph
+from decoy_cli.world.world import World
 
 ALIGNED_WITHIN_M = 0.5
 
@@ -117,3 +119,37 @@ def esta_positions(path: str | Path) -> np.ndarray:
         for round_ in read_match(file).rounds:
             chunks.append(round_.position[round_.alive])
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
+
+
+FLOOR_RAY_LIFT_M = 0.1
+"""How far above a position the ray down to its floor starts (a player's feet touch it)."""
+
+FLOOR_RAY_DEPTH_M = 4.0
+"""How far below a position the floor is looked for."""
+
+
+def alignment_quality(
+    graph: WaypointGraph, pruned_positions: np.ndarray, world: World, path: str | Path
+) -> SnapQuality:
+    """Snap quality of the alive positions of the ESTA file or folder `path` on a graph built
+    on `world`, with the world's floor under each position (for the on-the-ground share)."""
+    from decoy_cli.world.physics import PhysicsWorld
+
+    positions = esta_positions(path)
+    floor_z = None
+    if len(positions):
+        with PhysicsWorld(world) as physics:
+            lifted = positions + np.array([0.0, 0.0, FLOOR_RAY_LIFT_M])
+            floor_z = physics.first_floor_below(lifted, FLOOR_RAY_DEPTH_M)[0]
+    return snap_quality(graph, positions, pruned_positions, floor_z=floor_z)
+
+
+def check_aligned(quality: SnapQuality, min_aligned: float) -> None:
+    """A DecoyError when fewer than `min_aligned` of the positions lie within 0.5 m of a
+    waypoint horizontally: the mesh is most likely misaligned."""
+    if quality.within_horizontal < min_aligned:
+        raise DecoyError(
+            f"only {quality.within_horizontal:.1%} of the positions lie within "
+            f"{ALIGNED_WITHIN_M:g} m of a waypoint: the mesh looks misaligned (check --units, "
+            "--scale, --up-axis, --offset)"
+        )

@@ -19,6 +19,7 @@ import ctypes
 import os
 import sys
 import tempfile
+from types import ModuleType
 from typing import Self
 
 import numpy as np
@@ -97,6 +98,12 @@ class PhysicsWorld:
         return p.createMultiBody(
             baseMass=0, baseCollisionShapeIndex=shape, physicsClientId=self.client
         )
+
+    @property
+    def pybullet(self) -> ModuleType:
+        """The pybullet module this client belongs to, for code that adds its own bodies (the
+        movers' and line of sight's capsules)."""
+        return self._p
 
     def close(self) -> None:
         if self.client is not None and self._p.isConnected(self.client):
