@@ -35,6 +35,9 @@ ARRIVE_XY_M = 0.05
 """A held-back physics agent this close to its node horizontally has arrived..."""
 ARRIVE_Z_M = 0.3
 """...if its feet are also this close vertically (3-D: a cell may hold two floors)."""
+OCCUPIED_TOL_M = 0.1
+"""A held-back agent touching another that stands on its goal has arrived if it is within this
+distance of as close as the other lets it get."""
 
 
 class PhysicsMover(MoverBase):
@@ -116,7 +119,7 @@ class PhysicsMover(MoverBase):
             ARRIVE_Z_M,
         )
         prm[P_SIDESTEP_SPEED] = 2.0 * self.radius / (self.sidestep_ticks * self.dt)
-        prm[P_OCCUPIED_TOL] = 0.1
+        prm[P_OCCUPIED_TOL] = OCCUPIED_TOL_M
         prm[P_STUCK_TICKS], prm[P_MAX_SIDESTEPS], prm[P_SIDESTEP_TICKS] = (
             self.stuck_ticks,
             self.max_sidesteps,
