@@ -1,5 +1,9 @@
 """CS:GO facts the whole project shares: units, player dimensions, movement limits.
 
+Most names here are game rules (values of the game). The few marked "project choice" are not:
+they are how this project models the player (the simulated capsule), kept here so the waypoint
+builder, which verifies edges with that capsule, and the simulator, which moves it, share them.
+
 Everything inside the project is in metres (x east, y north, z up, as in the Source engine);
 Hammer units are converted once where data enters (the ESTA reader, the nav assets, user meshes).
 """
@@ -22,6 +26,22 @@ EYE_HEIGHT_M = 64 * HAMMER_TO_M
 
 STEP_HEIGHT_M = 18 * HAMMER_TO_M
 """Highest ledge a player walks up without jumping (sv_stepsize 18)."""
+
+AGENT_RADIUS_M = 0.8 * PLAYER_RADIUS_M
+"""Project choice: radius of the simulated agent's capsule, 20% thinner than the player hull,
+because the nav world's walls are approximate (see `decoy_cli.waypoints.lattice`)."""
+
+AGENT_FLOAT_CLEARANCE_M = 0.03
+"""Project choice: how far above the step height the agent's capsule floats, so that it passes
+ledges of exactly the step height."""
+
+AGENT_FLOAT_M = STEP_HEIGHT_M + AGENT_FLOAT_CLEARANCE_M
+"""Project choice: height of the bottom of the agent's capsule above its feet (a dynamic
+capsule cannot climb steps; a floating one moved kinematically passes over them)."""
+
+AGENT_GRAZE_M = 0.025
+"""Project choice: how deep the agent's capsule may penetrate the world (the walls are
+approximate)."""
 
 JUMP_HEIGHT_M = 64 * HAMMER_TO_M
 """Highest ledge a player reaches with a crouch-jump (a plain jump clears about 55.8 u)."""

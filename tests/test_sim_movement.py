@@ -26,13 +26,14 @@ from worlds import (
     wall,
 )
 
-from decoy_cli.csgo import GRAVITY_M_S2, JUMP_SPEED_M_S, PLAYER_HEIGHT_M
+from decoy_cli.csgo import GRAVITY_M_S2, JUMP_SPEED_M_S, PLAYER_HEIGHT_M, TICK_RATE
 from decoy_cli.sim.movement import (
     DEFAULT_MAX_SPEED_M_S,
     KinematicMover,
     Mover,
     MoveStep,
     PhysicsMover,
+    layout,
 )
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
@@ -41,7 +42,7 @@ from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import AGENT_GROUP, WORLD_GROUP, PhysicsWorld
 from decoy_cli.world.world import World
 
-DT = 1 / 60
+DT = 1 / TICK_RATE
 MOVERS = ("kinematic", "physics")
 CORRIDOR_Y = (2.6, 3.4)
 """The corridor's walls: 0.8 m apart around the lattice line y = 3, room for one capsule
@@ -633,3 +634,41 @@ def test_bad_input_raises_value_errors() -> None:
                 mover.set_goal(0, graph.positions[1], 7, 1.0)
         with pytest.raises(ValueError, match="radius"):
             PhysicsMover(physics, radius=0.8)
+
+
+# ---- the packed state's slot names and the capsule's dimensions ------------------------------
+
+
+@pytest.mark.parametrize(
+    ("prefix", "count"),
+    [
+        ("F_", "FLOAT_SLOTS"),
+        ("I_", "INT_SLOTS"),
+        ("S_", None),
+        ("R_", "FLAG_ROWS"),
+        ("P_", "PARAM_SLOTS"),
+    ],
+)
+def test_slot_names_number_each_slot_once(prefix: str, count: str | None) -> None:
+    names = [n for n in vars(layout) if n.startswith(prefix)]
+    if count is None:  # the scratch arrays: a float and an int one share the prefix
+        floats = {"S_VZ", "S_LEFT"}
+        groups = [(floats, "SCRATCH_FLOAT_SLOTS"), (set(names) - floats, "SCRATCH_INT_SLOTS")]
+    else:
+        groups = [(set(names), count)]
+    for group, size in groups:
+        slots = sorted(getattr(layout, n) for n in group)
+        assert slots == list(range(getattr(layout, size))), (group, size)
+    phases = [layout.IDLE, layout.RISE, layout.LINE, layout.GLIDE, layout.FALL]
+    assert sorted(phases) == list(range(5))
+
+
+def test_physics_capsule_is_the_one_the_waypoint_builder_verified() -> None:
+    world, _ = world_graph("room")
+    params = LatticeParams()
+    with PhysicsWorld(world) as physics:
+        mover = PhysicsMover(physics)
+        assert mover.radius == params.agent_radius
+        assert mover.float_height == params.step_height + params.verify_clearance
+        assert mover.graze == params.graze
+        mover.close()

@@ -1,0 +1,212 @@
+"""State and goal handling shared by both movers: packed per-agent arrays, goals, removal."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from decoy_cli.csgo import GRAVITY_M_S2, HAMMER_TO_M, JUMP_SPEED_M_S, TICK_RATE
+from decoy_cli.sim.movement.interface import MoveStep
+from decoy_cli.sim.movement.layout import (
+    EPS,
+    F_CARRY,
+    F_HEADING,
+    F_MAX_SPEED,
+    F_SIDE,
+    F_SPEED,
+    F_VZ,
+    FALL,
+    FLAG_ROWS,
+    FLOAT_SLOTS,
+    GLIDE,
+    I_ALIVE,
+    I_ATTEMPTS,
+    I_BLOCKED,
+    I_PHASE,
+    I_RECOVER,
+    I_STUCK,
+    I_TELEPORTS,
+    IDLE,
+    INT_SLOTS,
+    LINE,
+    P_DT,
+    P_GRAVITY,
+    P_LOOKAHEAD,
+    P_ON_LINE,
+    PARAM_SLOTS,
+    R_ARRIVED,
+    R_MOVING,
+    R_STUCK,
+    R_TELEPORTED,
+    RISE,
+)
+from decoy_cli.waypoints.graph import EdgeKind
+from decoy_cli.weapons import KNIFE_SPEED
+
+DEFAULT_MAX_SPEED_M_S = KNIFE_SPEED * HAMMER_TO_M
+"""Per-agent speed cap unless told otherwise: the knife, the fastest a CS:GO player runs."""
+LOOKAHEAD_M = 0.3
+"""An agent pushed off its edge steers to the edge point this far ahead of its own projection."""
+ON_LINE_M = 0.01
+"""An agent within this horizontal distance of its edge line is on it."""
+
+
+class MoverBase:
+    """State and goal handling shared by both movers (one row per agent in every array)."""
+
+    def __init__(self, tick_rate: int = TICK_RATE) -> None:
+        if tick_rate <= 0:
+            raise ValueError("tick_rate must be positive")
+        self.tick_rate = tick_rate
+        self.dt = 1.0 / tick_rate
+        self.gravity = GRAVITY_M_S2
+        self.jump_speed = JUMP_SPEED_M_S
+        self._params = np.zeros(PARAM_SLOTS)
+        self._params[[P_DT, P_GRAVITY, P_LOOKAHEAD, P_ON_LINE]] = (
+            self.dt,
+            self.gravity,
+            LOOKAHEAD_M,
+            ON_LINE_M,
+        )
+        self.reset(np.zeros((0, 3)))
+
+    def reset(self, positions: np.ndarray, max_speed: np.ndarray | float | None = None) -> None:
+        """Agents standing at `positions` (N, 3) with no goals; `max_speed` (m/s, per agent or
+        one for all) caps every speed asked for (default: the knife speed)."""
+        pos = np.asarray(positions, dtype=np.float64)
+        if pos.ndim != 2 or pos.shape[1] != 3 or not np.all(np.isfinite(pos)):
+            raise ValueError(f"positions must be finite (N, 3), got shape {pos.shape}")
+        n = len(pos)
+        cap = DEFAULT_MAX_SPEED_M_S if max_speed is None else max_speed
+        try:
+            caps = np.broadcast_to(np.asarray(cap, dtype=np.float64), (n,))
+        except ValueError:
+            raise ValueError(f"max_speed must be one number or one per agent ({n})") from None
+        if not np.all(caps >= 0):
+            raise ValueError("max_speed must be >= 0 m/s")
+        self.n = n
+        self._pos = pos.copy()
+        self._start = pos.copy()  # the node the agent last reached: its edge's start
+        self._target = pos.copy()
+        self._fv = np.zeros((n, FLOAT_SLOTS))
+        self._fv[:, F_MAX_SPEED] = caps
+        self._fv[:, F_SIDE] = 1.0
+        self._iv = np.zeros((n, INT_SLOTS), dtype=np.int64)
+        self._iv[:, I_ALIVE] = 1
+        self._views = {
+            "positions": read_only(self._pos),
+            "heading": read_only(self._fv[:, F_HEADING]),
+            "stuck_events": read_only(self._iv[:, I_STUCK]),
+            "recoveries": read_only(self._iv[:, I_TELEPORTS]),
+        }
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 3) feet positions, metres (a read-only view that follows the agents)."""
+        return self._views["positions"]
+
+    @property
+    def heading(self) -> np.ndarray:
+        """(N,) yaw of the latest horizontal motion (or of the goal), degrees, 0 = +x, CCW."""
+        return self._views["heading"]
+
+    @property
+    def stuck_events(self) -> np.ndarray:
+        """(N,) how often each agent was declared stuck."""
+        return self._views["stuck_events"]
+
+    @property
+    def recoveries(self) -> np.ndarray:
+        """(N,) how often each agent was teleported to its goal (the last-resort recovery)."""
+        return self._views["recoveries"]
+
+    @property
+    def alive(self) -> np.ndarray:
+        """(N,) False for removed agents."""
+        return self._iv[:, I_ALIVE] != 0
+
+    def _agent(self, agent: int, alive: bool = False) -> int:
+        if not 0 <= agent < self.n:
+            raise ValueError(f"no agent {agent} (there are {self.n})")
+        if alive and not self._iv[agent, I_ALIVE]:
+            raise ValueError(f"agent {agent} was removed")
+        return int(agent)
+
+    def _airborne(self, i: int) -> bool:
+        """On a jump or drop edge: rising, gliding over the gap or box edge, or falling."""
+        return self._iv[i, I_PHASE] in (RISE, GLIDE, FALL)
+
+    def set_goal(self, agent: int, target: np.ndarray, kind: int, speed: float) -> None:
+        """Cross the edge from the agent's node to `target` (3,) at `speed` m/s (capped by its
+        max speed); the edge `kind` (EdgeKind) chooses walking, jumping or dropping."""
+        i = self._agent(agent, alive=True)
+        goal = np.asarray(target, dtype=np.float64).reshape(-1)
+        if goal.shape != (3,) or not np.all(np.isfinite(goal)):
+            raise ValueError(f"target must be a finite (3,) position, got {target!r}")
+        if not (math.isfinite(speed) and speed >= 0.0):
+            raise ValueError(f"speed must be a finite number >= 0 m/s, got {speed!r}")
+        kind = EdgeKind(kind)
+        if self._airborne(i):
+            raise ValueError(f"agent {i} is in the air; give it a goal once it lands")
+        self._target[i] = goal
+        fv, iv = self._fv, self._iv
+        fv[i, F_SPEED] = min(float(speed), fv[i, F_MAX_SPEED])
+        fv[i, F_VZ] = 0.0
+        z = self._pos[i, 2]
+        if kind == EdgeKind.JUMP and goal[2] > z + EPS:
+            iv[i, I_PHASE] = RISE
+            fv[i, F_VZ] = max(self.jump_speed, math.sqrt(2.0 * self.gravity * (goal[2] - z)))
+        elif kind in (EdgeKind.JUMP, EdgeKind.DROP):
+            iv[i, I_PHASE] = GLIDE
+        else:
+            iv[i, I_PHASE] = LINE
+        dx, dy = goal[0] - self._pos[i, 0], goal[1] - self._pos[i, 1]
+        if dx * dx + dy * dy > 1e-18:
+            fv[i, F_HEADING] = math.degrees(math.atan2(dy, dx))
+        iv[i, [I_RECOVER, I_BLOCKED, I_ATTEMPTS]] = 0
+
+    def clear_goal(self, agent: int) -> None:
+        """Stand still. An agent on a jump or drop edge cannot stop in the air: it lands at its
+        target first, which is reported as an arrival."""
+        i = self._agent(agent)
+        if not self._airborne(i):
+            self._iv[i, I_PHASE] = IDLE
+            self._fv[i, F_CARRY] = 0.0
+
+    def remove(self, agent: int) -> None:
+        """A dead agent stops where it is, for good, and no longer blocks anyone."""
+        i = self._agent(agent)
+        self._iv[i, I_ALIVE] = 0
+        self._iv[i, I_PHASE] = IDLE
+        self._fv[i, [F_VZ, F_CARRY]] = 0.0
+
+    def place(self, agent: int, position: np.ndarray) -> None:
+        """Put an alive agent on `position` (3,) with no goal: a relocation by the caller."""
+        i = self._agent(agent, alive=True)
+        where = np.asarray(position, dtype=np.float64).reshape(-1)
+        if where.shape != (3,) or not np.all(np.isfinite(where)):
+            raise ValueError(f"position must be a finite (3,) point, got {position!r}")
+        self._pos[i] = where
+        self._start[i] = where
+        self._iv[i, [I_PHASE, I_RECOVER, I_BLOCKED, I_ATTEMPTS]] = 0
+        self._fv[i, [F_VZ, F_CARRY]] = 0.0
+
+    def set_max_speed(self, agent: int, speed: float) -> None:
+        """Change an agent's speed cap; it applies from its next goal."""
+        i = self._agent(agent)
+        if not speed >= 0.0:
+            raise ValueError(f"max speed must be >= 0 m/s, got {speed!r}")
+        self._fv[i, F_MAX_SPEED] = float(speed)
+
+    def _new_flags(self) -> tuple[np.ndarray, MoveStep]:
+        flags = np.zeros((FLAG_ROWS, self.n), dtype=bool)
+        return flags, MoveStep(
+            flags[R_ARRIVED], flags[R_MOVING], flags[R_STUCK], flags[R_TELEPORTED]
+        )
+
+
+def read_only(array: np.ndarray) -> np.ndarray:
+    view = array.view()
+    view.flags.writeable = False
+    return view

@@ -1,0 +1,62 @@
+"""The movers' interface: `Mover`, what every mover does, and `MoveStep`, what a tick did."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+
+@dataclass(slots=True)
+class MoveStep:
+    """What happened to each agent in one tick; every array has one row per agent."""
+
+    arrived: np.ndarray  # bool: reached its goal this tick (then it stands still)
+    moving: np.ndarray  # bool: its feet moved this tick
+    stuck: np.ndarray  # bool: newly declared stuck this tick (a recovery starts)
+    teleported: np.ndarray  # bool: the last-resort recovery put it on its goal this tick
+
+
+class Mover(Protocol):
+    """Moves agents along waypoint edges; see the module docstring."""
+
+    def reset(self, positions: np.ndarray, max_speed: np.ndarray | float | None = None) -> None:
+        """Start over with agents standing at `positions` (N, 3) (waypoints), no goals."""
+        ...
+
+    def set_goal(self, agent: int, target: np.ndarray, kind: int, speed: float) -> None:
+        """Move `agent` from its node to `target` (3,) across an edge of `kind` at `speed`."""
+        ...
+
+    def clear_goal(self, agent: int) -> None:
+        """Stand still (an agent on a jump or drop edge lands at its target first)."""
+        ...
+
+    def remove(self, agent: int) -> None:
+        """A dead agent: it stops where it is and no longer collides."""
+        ...
+
+    def place(self, agent: int, position: np.ndarray) -> None:
+        """Put an agent on a position (a relocation by the caller), with no goal."""
+        ...
+
+    def set_max_speed(self, agent: int, speed: float) -> None:
+        """Change an agent's speed cap (for example after a weapon switch)."""
+        ...
+
+    def step(self) -> MoveStep:
+        """Advance every agent by one tick."""
+        ...
+
+    @property
+    def positions(self) -> np.ndarray: ...
+
+    @property
+    def heading(self) -> np.ndarray: ...
+
+    @property
+    def stuck_events(self) -> np.ndarray: ...
+
+    @property
+    def recoveries(self) -> np.ndarray: ...

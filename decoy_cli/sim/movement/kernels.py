@@ -1,0 +1,143 @@
+"""The edge motion both movers share, compiled with numba: one agent along one edge per call.
+
+`advance` is the motion itself (see the package docstring for the phases); `kinematic_step` is
+the kinematic mover's whole tick; `propose` and `move_to` are the pieces the physics mover's
+collision pass (`collision.py`) reuses. Slots of the packed arrays are named in `layout.py`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from decoy_cli.sim.movement.layout import (
+    EPS,
+    F_CARRY,
+    F_HEADING,
+    F_SPEED,
+    F_VZ,
+    FALL,
+    GLIDE,
+    I_PHASE,
+    IDLE,
+    LINE,
+    P_DT,
+    P_GRAVITY,
+    P_LOOKAHEAD,
+    P_ON_LINE,
+    R_ARRIVED,
+    R_MOVING,
+    RISE,
+)
+
+
+@njit(cache=True)
+def line_z(x, y, sx, sy, sz, tx, ty, tz):
+    """Height of the straight edge line above the projection of (x, y) onto it."""
+    dx, dy = tx - sx, ty - sy
+    seg2 = dx * dx + dy * dy
+    if seg2 <= EPS * EPS:
+        return tz
+    u = min(1.0, max(0.0, ((x - sx) * dx + (y - sy) * dy) / seg2))
+    return sz + u * (tz - sz)
+
+
+@njit(cache=True)
+def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, lookahead, on_line):
+    """Move one agent for `t` seconds along its edge from node (sx, sy, sz) to (tx, ty, tz).
+
+    Phases: RISE (jump: vertical, gravity, until the target height), LINE (walk/step: along the
+    3-D line at `speed`), GLIDE (jump/drop: horizontal at constant height at `speed`), FALL
+    (gravity, until the target height). An agent off its line (pushed aside by another) steers
+    back to it, `lookahead` ahead of its projection. Returns (x, y, z, phase, vz, seconds left,
+    arrived); the seconds left are those after arriving.
+    """
+    for _ in range(4):  # at most RISE -> GLIDE -> FALL -> landed in one call
+        if phase == RISE:
+            disc = max(0.0, vz * vz - 2.0 * gravity * (tz - z))
+            rise_t = (vz - math.sqrt(disc)) / gravity
+            if rise_t <= t:
+                z, t, vz, phase = tz, t - rise_t, 0.0, GLIDE
+                continue
+            z += vz * t - 0.5 * gravity * t * t
+            vz -= gravity * t
+            return x, y, z, phase, vz, 0.0, False
+        if phase in (LINE, GLIDE):
+            dx, dy = tx - sx, ty - sy
+            seg2 = dx * dx + dy * dy
+            h_speed = speed
+            if phase == LINE and seg2 > 0.0:
+                h_speed = speed * math.sqrt(seg2 / (seg2 + (tz - sz) ** 2))
+            if h_speed <= 0.0:
+                return x, y, z, phase, vz, 0.0, False
+            ax, ay, to_target = tx, ty, True
+            if seg2 > EPS * EPS:
+                u = min(1.0, max(0.0, ((x - sx) * dx + (y - sy) * dy) / seg2))
+                off = math.hypot(x - (sx + u * dx), y - (sy + u * dy))
+                if off > on_line:
+                    ua = u + lookahead / math.sqrt(seg2)
+                    if ua < 1.0:
+                        ax, ay, to_target = sx + ua * dx, sy + ua * dy, False
+            ex, ey = ax - x, ay - y
+            dist = math.hypot(ex, ey)
+            reach = h_speed * t
+            if to_target and dist <= reach + EPS:
+                x, y = tx, ty
+                t = max(0.0, t - dist / h_speed)
+                if phase == GLIDE and z > tz + EPS:
+                    phase, vz = FALL, 0.0
+                    continue
+                return x, y, tz, IDLE, 0.0, t, True
+            if dist > 0.0:
+                frac = min(reach, dist) / dist
+                x += ex * frac
+                y += ey * frac
+            if phase == LINE:
+                z = line_z(x, y, sx, sy, sz, tx, ty, tz)
+            return x, y, z, phase, vz, 0.0, False
+        if phase == FALL:
+            land_t = (vz + math.sqrt(vz * vz + 2.0 * gravity * max(0.0, z - tz))) / gravity
+            if land_t <= t:
+                return x, y, tz, IDLE, 0.0, t - land_t, True
+            z += vz * t - 0.5 * gravity * t * t
+            vz -= gravity * t
+            return x, y, z, phase, vz, 0.0, False
+        break
+    return x, y, z, phase, vz, 0.0, False
+
+
+@njit(cache=True)
+def move_to(i, x, y, z, pos, fv, flags):
+    """Put agent i at (x, y, z); update its heading and moving flag from the displacement."""
+    dx, dy, dz = x - pos[i, 0], y - pos[i, 1], z - pos[i, 2]
+    if dx * dx + dy * dy > 1e-18:
+        fv[i, F_HEADING] = math.degrees(math.atan2(dy, dx))
+    flags[R_MOVING, i] = dx != 0.0 or dy != 0.0 or dz != 0.0
+    pos[i, 0], pos[i, 1], pos[i, 2] = x, y, z
+
+
+@njit(cache=True)
+def propose(i, pos, start, target, fv, iv, prm):
+    """The shared edge motion of agent i for this tick (plus time carried from its arrival)."""
+    return advance(
+        pos[i, 0], pos[i, 1], pos[i, 2], start[i, 0], start[i, 1], start[i, 2],
+        target[i, 0], target[i, 1], target[i, 2], iv[i, I_PHASE], fv[i, F_VZ], fv[i, F_SPEED],
+        prm[P_DT] + fv[i, F_CARRY], prm[P_GRAVITY], prm[P_LOOKAHEAD], prm[P_ON_LINE],
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def kinematic_step(pos, start, target, fv, iv, flags, prm):
+    """One tick of the kinematic mover for all agents (no collisions)."""
+    for i in range(pos.shape[0]):
+        if iv[i, I_PHASE] == IDLE:
+            fv[i, F_CARRY] = 0.0
+            continue
+        x, y, z, ph, v, left, arr = propose(i, pos, start, target, fv, iv, prm)
+        move_to(i, x, y, z, pos, fv, flags)
+        iv[i, I_PHASE], fv[i, F_VZ] = ph, v
+        fv[i, F_CARRY] = left if arr else 0.0
+        if arr:
+            flags[R_ARRIVED, i] = True
+            start[i, 0], start[i, 1], start[i, 2] = target[i, 0], target[i, 1], target[i, 2]
