@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from decoy_cli.damage.features import HIT_GROUPS
-from decoy_cli.damage.samples import MAX_DAMAGE_HP, Samples
+from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
 from decoy_cli.figures import save_figure
 
 if TYPE_CHECKING:

@@ -49,7 +49,8 @@ from decoy_cli.damage.evaluation import (
 from decoy_cli.damage.features import HIT_GROUPS, Features, FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import DipNet, DogLossWeights, DogNet, dog_loss, tensors
-from decoy_cli.damage.samples import Samples, Split, balance
+from decoy_cli.damage.sample_set import Samples
+from decoy_cli.damage.split import Split, balance
 from decoy_cli.errors import DecoyError
 
 DIP_EPOCHS = 20
