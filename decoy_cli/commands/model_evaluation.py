@@ -16,7 +16,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 from rich.table import Table
 
-from decoy_cli.damage.evaluation import DRAWS, MIN_CELL, PAPER_DIP, PAPER_DOG
+from decoy_cli.damage.evaluation import DRAWS, PAPER_DIP, PAPER_DOG
 from decoy_cli.damage.samples import (
     DEFAULT_WINDOW_S,
     Samples,
@@ -25,6 +25,7 @@ from decoy_cli.damage.samples import (
     build_samples,
     split_samples,
 )
+from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.errors import ModelError
 from decoy_cli.files import write_atomic
 
@@ -220,12 +221,8 @@ def evaluate(
     else:
         parts = split_samples(samples, split, seed, val_fraction, test_fraction)
         index = parts.part(subset)
-    from decoy_cli.damage.evaluation import (
-        evaluate_dip,
-        evaluate_dog,
-        write_dip_figures,
-        write_dog_figures,
-    )
+    from decoy_cli.damage.evaluation import evaluate_dip, evaluate_dog
+    from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
     from decoy_cli.damage.model_folder import load_dip, load_dog
 
     report: dict[str, Any] = {

@@ -35,8 +35,9 @@ from decoy_cli.commands.model_evaluation import (
     load_samples,
     write_json,
 )
-from decoy_cli.damage.evaluation import DRAWS, MIN_CELL
+from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.samples import DEFAULT_WINDOW_S, SampleStats, Split, split_samples
+from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import write_atomic
 
@@ -174,7 +175,7 @@ def dip(
 
     Binary cross-entropy with early stopping on the validation part; the decision threshold is
     the best F1 on the validation part; test metrics are printed and saved with the model."""
-    from decoy_cli.damage.evaluation import write_dip_figures
+    from decoy_cli.damage.evaluation_figures import write_dip_figures
     from decoy_cli.damage.features import FeatureSpec
     from decoy_cli.damage.model_folder import save_dip
     from decoy_cli.damage.training import TrainOptions, fit_dip
@@ -255,7 +256,7 @@ def dog(
 
     A conditional VAE trained on the damaging samples with early stopping on the validation
     part; test metrics are printed and saved with the model."""
-    from decoy_cli.damage.evaluation import write_dog_figures
+    from decoy_cli.damage.evaluation_figures import write_dog_figures
     from decoy_cli.damage.features import FeatureSpec
     from decoy_cli.damage.model_folder import save_dog
     from decoy_cli.damage.networks import DogLossWeights

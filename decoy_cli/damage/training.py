@@ -38,10 +38,8 @@ from torch import Tensor, nn
 
 from decoy_cli.damage.evaluation import (
     DRAWS,
-    MIN_CELL,
     DipEvaluation,
     DogEvaluation,
-    best_f1_threshold,
     dip_probabilities,
     evaluate_dip,
     evaluate_dog,
@@ -50,6 +48,7 @@ from decoy_cli.damage.features import HIT_GROUPS, Features, FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import DipNet, DogLossWeights, DogNet, dog_loss, tensors
 from decoy_cli.damage.sample_set import Samples
+from decoy_cli.damage.scores import MIN_CELL, best_f1_threshold
 from decoy_cli.damage.split import Split, balance
 from decoy_cli.errors import DecoyError
 
