@@ -120,7 +120,8 @@ def _no_samples_message(data: Sequence[str | Path], stats: SampleStats) -> str:
     if stats.failures:
         shown = "; ".join(f.message for f in stats.failures[:_FAILURES_SHOWN])
         more = len(stats.failures) - _FAILURES_SHOWN
-        line += f"; {len(stats.failures)} inputs failed: {shown}" + (
+        inputs = "input" if len(stats.failures) == 1 else "inputs"
+        line += f"; {len(stats.failures)} {inputs} failed: {shown}" + (
             f" (and {more} more)" if more > 0 else ""
         )
     return line
