@@ -27,7 +27,7 @@ from decoy_cli.commands._damage_output import (
     progress_bars,
 )
 from decoy_cli.damage.evaluation import DRAWS
-from decoy_cli.damage.folder_evaluation import evaluate_model_folder
+from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
 from decoy_cli.damage.provenance import SampleChoice
 from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S
 from decoy_cli.damage.scores import MIN_CELL
@@ -96,7 +96,7 @@ def evaluate(
         DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
     ),
     subset: str = typer.Option(
-        "all",
+        DEFAULT_SUBSET,
         "--subset",
         help="Samples to evaluate on: all, or the train, val or test part of the split below "
         "(the same options as training give the same parts).",
@@ -107,7 +107,7 @@ def evaluate(
     test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
     mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
     window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
-    balanced: bool = typer.Option(True, "--balance/--no-balance", help=BALANCE_HELP),
+    balanced: bool = typer.Option(BALANCED, "--balance/--no-balance", help=BALANCE_HELP),
     threshold: float | None = typer.Option(
         None, "--threshold", help="DIP decision threshold (default: the model's own)."
     ),

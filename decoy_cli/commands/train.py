@@ -49,6 +49,7 @@ from decoy_cli.damage.train_options import (
     LEARNING_RATE,
     PATIENCE,
     THREADS,
+    XAVIER,
     DogLossWeights,
     TrainOptions,
 )
@@ -99,7 +100,7 @@ def dip(
         help="1:1 balancing of positives and negatives: all parts (the paper's), eval (train "
         "on every sample, balance validation and test) or none.",
     ),
-    xavier: bool = typer.Option(True, "--xavier/--no-xavier", help=XAVIER_HELP),
+    xavier: bool = typer.Option(XAVIER, "--xavier/--no-xavier", help=XAVIER_HELP),
     threads: int = typer.Option(THREADS, "--threads", help=THREADS_HELP),
 ) -> None:
     """Train DIP, the Damage Indicator Predictor (does a shot land in a 0.5 s step).
@@ -172,7 +173,7 @@ def dog(
     kl_weight: float = typer.Option(KL_WEIGHT, "--kl-weight", help="Weight of the KL term."),
     draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
     min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),
-    xavier: bool = typer.Option(True, "--xavier/--no-xavier", help=XAVIER_HELP),
+    xavier: bool = typer.Option(XAVIER, "--xavier/--no-xavier", help=XAVIER_HELP),
     threads: int = typer.Option(THREADS, "--threads", help=THREADS_HELP),
 ) -> None:
     """Train DOG, the Damage Outcome Generator (how much damage, which hit group).

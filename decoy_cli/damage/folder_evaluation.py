@@ -21,6 +21,11 @@ from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.damage.split import balance
 from decoy_cli.errors import ModelError
 
+DEFAULT_SUBSET = "all"
+"""Score on every sample; or "train", "val", "test": that part of the split."""
+BALANCED = True
+"""DIP is scored on all positives and as many random negatives (the paper's 1:1)."""
+
 
 @dataclass(frozen=True)
 class FolderEvaluation:
@@ -44,8 +49,8 @@ def evaluate_model_folder(
     folder: Path,
     choice: SampleChoice,
     out: Path,
-    subset: str = "all",
-    balanced: bool = True,
+    subset: str = DEFAULT_SUBSET,
+    balanced: bool = BALANCED,
     threshold: float | None = None,
     draws: int = DRAWS,
     min_cell: int = MIN_CELL,

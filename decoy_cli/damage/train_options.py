@@ -22,6 +22,7 @@ BATCH_SIZE = 256
 LEARNING_RATE = 3e-4
 PATIENCE = 5
 THREADS = 1
+XAVIER = True
 
 DAMAGE_WEIGHT = 1.0
 HIT_GROUP_WEIGHT = 0.7
@@ -43,7 +44,7 @@ class TrainOptions:
     learning_rate: float = LEARNING_RATE
     patience: int = PATIENCE
     seed: int = DEFAULT_SEED
-    xavier: bool = True
+    xavier: bool = XAVIER
     threads: int = THREADS
 
     def __post_init__(self) -> None:
