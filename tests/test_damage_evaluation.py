@@ -1,5 +1,6 @@
-"""Metrics and figures of decoy_cli/damage/evaluation.py: numbers checked by hand, the network
-runners on untrained networks (shapes, ranges, determinism under a seed)."""
+"""Metrics and figures of the damage models (decoy_cli/damage/scores.py, evaluation.py,
+evaluation_figures.py): numbers checked by hand, the network runners on untrained networks
+(shapes, ranges, determinism under a seed)."""
 
 from __future__ import annotations
 
@@ -12,25 +13,22 @@ import torch
 from scipy.stats import wasserstein_distance
 from test_damage_training import planted
 
-from decoy_cli.damage.evaluation import (
+from decoy_cli.damage.evaluation import dog_generate, evaluate_dip, evaluate_dog
+from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
+from decoy_cli.damage.features import FeatureSpec
+from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
+from decoy_cli.damage.networks import DipNet, DogNet
+from decoy_cli.damage.scores import (
     average_precision,
     best_f1_threshold,
     classification_metrics,
     confusion_matrix,
-    dog_generate,
-    evaluate_dip,
-    evaluate_dog,
     precision_recall_curve,
     regression_metrics,
     roc_auc,
     roc_curve,
     wasserstein_cells,
-    write_dip_figures,
-    write_dog_figures,
 )
-from decoy_cli.damage.features import FeatureSpec
-from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
-from decoy_cli.damage.networks import DipNet, DogNet
 
 LABELS = np.array([1, 0, 1, 1, 0], dtype=bool)
 SCORES = np.array([0.9, 0.8, 0.7, 0.4, 0.2])

@@ -24,12 +24,13 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.features import FeatureSpec, map_index
 from decoy_cli.damage.samples import (
     Samples,
+    SampleStats,
     balance,
     build_samples,
     split_samples,
 )
 from decoy_cli.errors import DecoyError
-from decoy_cli.esta import read_match
+from decoy_cli.esta import Round, read_match
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 EVENTS = DATA / "esta_dust2_events"
@@ -272,6 +273,50 @@ def test_bad_options(tmp_path: Path, kwargs: dict[str, Any], message: str) -> No
 def test_missing_data_path(tmp_path: Path) -> None:
     with pytest.raises(DecoyError, match="no such file"):
         build_samples([tmp_path / "nothing.json.xz"])
+
+
+def test_a_corrupt_file_is_a_recorded_failure(tmp_path: Path) -> None:
+    """The one round loop: an unreadable file is a failure in the stats, the others are used."""
+    good = write(tmp_path, make_match())
+    (tmp_path / "corrupt.json.xz").write_bytes(b"not an xz stream")
+    samples, stats = build_samples([tmp_path])
+    assert len(samples) == 288 and stats.files == 2
+    assert [(Path(f.file).name, f.round_num, f.kind) for f in stats.failures] == [
+        ("corrupt.json.xz", None, "unreadable file")
+    ]
+    assert (stats.file_errors, stats.round_errors) == (1, 0)
+    assert stats.to_json()["failures"][0]["kind"] == "unreadable file"
+    assert good.exists()
+
+
+def test_a_round_whose_samples_fail_is_recorded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A round whose sample building raises is one failure (a bug: "internal error", named
+    with where it was raised), its counts are left out, and the other rounds are used."""
+    import decoy_cli.damage.samples as module
+
+    real = module.frame_samples
+
+    def flaky(round_: Round, stats: SampleStats) -> Samples:
+        if round_.round_num == 1:
+            stats.realigned += 99
+            raise ValueError("boom")
+        return real(round_, stats)
+
+    monkeypatch.setattr(module, "frame_samples", flaky)
+    samples, stats = build_samples([write(tmp_path, make_match())])
+    assert np.unique(samples.group).tolist() == ["fixture-0001 r2"]
+    [failure] = stats.failures
+    assert (failure.round_num, failure.kind) == (1, "internal error")
+    assert failure.message.startswith("ValueError: boom (at ")
+    assert stats.round_errors == 1 and stats.rounds_frames == 1 and stats.realigned < 99
+
+
+def test_only_failed_inputs_is_one_error(tmp_path: Path) -> None:
+    (tmp_path / "corrupt.json.xz").write_bytes(b"not an xz stream")
+    with pytest.raises(DecoyError, match=r"no usable samples .*1 input failed: "):
+        build_samples([tmp_path])
 
 
 # ---- features, split and balance --------------------------------------------------------------

@@ -9,11 +9,12 @@ import pytest
 import torch
 import torch.nn.functional as F
 
-from decoy_cli.damage.evaluation import dip_probabilities, evaluate_dog, roc_auc
+from decoy_cli.damage.evaluation import dip_probabilities, evaluate_dog
 from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import tensors
 from decoy_cli.damage.samples import Samples, split_samples
+from decoy_cli.damage.scores import roc_auc
 from decoy_cli.damage.training import (
     TrainOptions,
     dip_parts,

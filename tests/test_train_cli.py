@@ -155,3 +155,37 @@ def test_bad_input_is_one_line(args: list[str], expected: str, data: Path, tmp_p
     assert result.exit_code == 1, result.output
     assert result.stderr.startswith(expected.format(**names))
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.output
+
+
+def test_a_corrupt_file_is_reported_and_training_goes_on(data: Path, tmp_path: Path) -> None:
+    """The one round loop: a corrupt file in the training folder is a recorded failure, printed
+    and kept in the model's metadata, and the model is trained on the rest."""
+    folder = tmp_path / "data"
+    folder.mkdir()
+    (folder / "match.json.xz").write_bytes((data / "match.json.xz").read_bytes())
+    (folder / "corrupt.json.xz").write_bytes(b"not an xz stream")
+    out = tmp_path / "model"
+    result = runner.invoke(app, ["train", "dip", str(folder), "--out", str(out), *FAST], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert "left out 1 failed input:" in result.output
+    assert "corrupt.json.xz (unreadable file):" in result.output
+    assert "split by round (seed 1): 1 test, 1 val, 6 train" in result.output
+    stats = load_dip(out).metadata["sample_stats"]
+    assert stats["files"] == 2 and stats["file_errors"] == 1
+    assert [f["kind"] for f in stats["failures"]] == ["unreadable file"]
+    assert stats["failures"][0]["file"].endswith("corrupt.json.xz")
+
+
+def test_only_corrupt_files_is_one_error_line(tmp_path: Path) -> None:
+    folder = tmp_path / "data"
+    folder.mkdir()
+    for name in ("a.json.xz", "b.json.xz"):
+        (folder / name).write_bytes(b"not an xz stream")
+    result = runner.invoke(
+        app, ["train", "dog", str(folder), "--out", str(tmp_path / "out"), *FAST], env=WIDE
+    )
+    assert result.exit_code == 1, result.output
+    assert result.stderr.startswith(f"error: {folder}: no usable samples (2 files")
+    assert "2 inputs failed" in result.stderr
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.output
+    assert not (tmp_path / "out").exists()

@@ -1,4 +1,5 @@
-"""`decoy models ...`: damage models (DIP and DOG). `import-decoy` imports the paper's."""
+"""`decoy models ...`: damage models (DIP and DOG). `import-decoy` imports the paper's,
+`evaluate` scores a model folder on ESTA data (decoy_cli/damage/folder_evaluation.py)."""
 
 from __future__ import annotations
 
@@ -8,9 +9,37 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from decoy_cli.commands.model_evaluation import evaluate
+from decoy_cli.commands._damage_output import (
+    BALANCE_HELP,
+    DATA_HELP,
+    DRAWS_HELP,
+    MIN_CELL_HELP,
+    MODE_HELP,
+    SEED_HELP,
+    SPLIT_HELP,
+    TEST_HELP,
+    VAL_HELP,
+    WINDOW_HELP,
+    cells_table,
+    dip_table,
+    dog_table,
+    print_samples,
+    progress_bars,
+)
+from decoy_cli.damage.evaluation import DRAWS
+from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
+from decoy_cli.damage.provenance import SampleChoice
+from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S
+from decoy_cli.damage.scores import MIN_CELL
+from decoy_cli.damage.split import (
+    DEFAULT_SEED,
+    DEFAULT_SPLIT,
+    DEFAULT_TEST_FRACTION,
+    DEFAULT_VAL_FRACTION,
+)
 
 DEFAULT_IMPORT_OUT = Path("decoy-out") / "models" / "paper"
+DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
 
 app = typer.Typer(
     help="Damage models (DIP and DOG): import the DECOY paper's checkpoints, evaluate a model.",
@@ -57,4 +86,67 @@ def import_decoy(
     )
 
 
-app.command("evaluate")(evaluate)
+@app.command("evaluate")
+def evaluate(
+    model_folder: Path = typer.Argument(
+        ..., help="A model folder: dip.pt/json and/or dog.pt/json (trained or imported)."
+    ),
+    data: list[Path] = typer.Argument(..., help=DATA_HELP),
+    out: Path = typer.Option(
+        DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
+    ),
+    subset: str = typer.Option(
+        DEFAULT_SUBSET,
+        "--subset",
+        help="Samples to evaluate on: all, or the train, val or test part of the split below "
+        "(the same options as training give the same parts).",
+    ),
+    split: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
+    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
+    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
+    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
+    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+    balanced: bool = typer.Option(BALANCED, "--balance/--no-balance", help=BALANCE_HELP),
+    threshold: float | None = typer.Option(
+        None, "--threshold", help="DIP decision threshold (default: the model's own)."
+    ),
+    draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
+    min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),
+) -> None:
+    """Evaluate a damage-model folder (trained or imported) on ESTA data.
+
+    Prints DIP's and DOG's metrics beside the paper's and writes metrics.json with the figures:
+    ROC and precision-recall curves, reconstructed vs real damage, the error histogram, the
+    hit-group confusion matrix, generated vs real damage per weapon and hit group."""
+    choice = SampleChoice(
+        data=data,
+        mode=mode,
+        window_s=window,
+        split_by=split,
+        seed=seed,
+        val_fraction=val_fraction,
+        test_fraction=test_fraction,
+    )
+    bars, on_file, _ = progress_bars()
+    with bars:
+        result = evaluate_model_folder(
+            folder=model_folder,
+            choice=choice,
+            out=out,
+            subset=subset,
+            balanced=balanced,
+            threshold=threshold,
+            draws=draws,
+            min_cell=min_cell,
+            on_file=on_file,
+        )
+    console = Console()
+    print_samples(console, result.samples, result.stats)
+    if result.dip is not None:
+        console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
+    if result.dog is not None:
+        console.print(dog_table(result.dog.metrics, f"DOG of {result.name} ({subset} samples)"))
+        if result.dog.metrics["cells"]:
+            console.print(cells_table(result.dog.metrics["cells"]))
+    console.print(f"metrics and {len(result.figures)} figures written to {result.out}")

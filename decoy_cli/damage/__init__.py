@@ -4,7 +4,12 @@
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
 * paper.py: import of the paper's published checkpoints;
-* combat.py: `LearnedDamage`, the simulator's `DamageModel` over a DIP and a DOG.
+* combat.py: `LearnedDamage`, the simulator's `DamageModel` over a DIP and a DOG;
+* samples.py: training samples from ESTA rounds (with sample_set.py, damage_rows.py,
+  frames_mode.py, events_mode.py, split.py);
+* train_options.py, training.py, training_run.py, provenance.py: training a model and writing
+  it with where it came from;
+* scores.py, evaluation.py, evaluation_figures.py, folder_evaluation.py: scoring a model.
 
 Importing this package does not import torch; `load_damage_model` does, when it loads a model.
 """

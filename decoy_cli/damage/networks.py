@@ -30,6 +30,7 @@ import torch.nn.functional as F
 from torch import Tensor, nn
 
 from decoy_cli.damage.features import COORDS, HIT_GROUPS, MAPS, WEAPONS, Features
+from decoy_cli.damage.train_options import DogLossWeights
 
 BRANCH_WIDTH = 32
 CONDITION_WIDTH = 4 * BRANCH_WIDTH
@@ -186,15 +187,6 @@ class DogNet(nn.Module):
         z = torch.randn((len(condition), LATENT), generator=generator, dtype=condition.dtype)
         damage, hit_logits = self.vae_decoder(z, condition)
         return 100.0 * damage.squeeze(1), hit_logits
-
-
-@dataclass(frozen=True)
-class DogLossWeights:
-    """Weights of DOG's loss terms; the defaults are the paper's (kl 0.2, hit group 0.7)."""
-
-    damage: float = 1.0
-    hit_group: float = 0.7
-    kl: float = 0.2
 
 
 def dog_loss(

@@ -3,9 +3,7 @@
 Both use Adam, mini-batches shuffled each epoch, and early stopping on the validation split:
 after every epoch the validation loss is measured (eval mode); the weights of the best epoch
 are kept and returned, and training stops when `patience` epochs in a row did not improve it.
-Defaults are the paper's (decoy_checkpoints/dip_args.json and dog_args.json): learning rate
-3e-4, batch size 256, 20 epochs for DIP and 50 for DOG, Xavier-uniform initialisation of every
-Linear layer, DOG loss weights 1 (damage MSE), 0.7 (hit-group cross-entropy) and 0.2 (KL).
+The options and their defaults (the paper's) are in train_options.py, without torch.
 
 * DIP: binary cross-entropy on "the attacker damaged the victim in this step".
 * DOG: `networks.dog_loss` on the damaging pairs: damage in HP/100, hit-group code.
@@ -17,9 +15,8 @@ The validation loss of DOG draws its noise from a generator reset every epoch, s
 compared on the same noise.
 
 Threads: training runs with `TrainOptions.threads` torch threads (default 1; restored after).
-These networks are small and their batches too: measured on the 2-core development machine with
-other jobs running, one DOG step on 32 samples took 2.9 ms with 1 thread and 84.5 ms with 2
-(thread hand-offs dominate), so more threads only pay off for large batches.
+These networks and their batches are small, so thread hand-offs dominate and more threads only
+pay off for large batches.
 """
 
 from __future__ import annotations
@@ -38,48 +35,25 @@ from torch import Tensor, nn
 
 from decoy_cli.damage.evaluation import (
     DRAWS,
-    MIN_CELL,
     DipEvaluation,
     DogEvaluation,
-    best_f1_threshold,
     dip_probabilities,
     evaluate_dip,
     evaluate_dog,
 )
 from decoy_cli.damage.features import HIT_GROUPS, Features, FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
-from decoy_cli.damage.networks import DipNet, DogLossWeights, DogNet, dog_loss, tensors
-from decoy_cli.damage.samples import Samples, Split, balance
+from decoy_cli.damage.networks import DipNet, DogNet, dog_loss, tensors
+from decoy_cli.damage.sample_set import Samples
+from decoy_cli.damage.scores import MIN_CELL, best_f1_threshold
+from decoy_cli.damage.split import Split, balance
+from decoy_cli.damage.train_options import (
+    BALANCE,
+    DEFAULT_BALANCE,
+    DogLossWeights,
+    TrainOptions,
+)
 from decoy_cli.errors import DecoyError
-
-DIP_EPOCHS = 20
-DOG_EPOCHS = 50
-
-
-@dataclass(frozen=True)
-class TrainOptions:
-    """How to train (defaults: the paper's, plus early stopping after 5 epochs without
-    improvement)."""
-
-    epochs: int = DIP_EPOCHS
-    batch_size: int = 256
-    learning_rate: float = 3e-4
-    patience: int = 5
-    seed: int = 0
-    xavier: bool = True
-    threads: int = 1
-
-    def __post_init__(self) -> None:
-        if self.epochs < 1:
-            raise DecoyError(f"epochs must be at least 1, not {self.epochs}")
-        if self.batch_size < 2:
-            raise DecoyError(f"the batch size must be at least 2, not {self.batch_size}")
-        if not (math.isfinite(self.learning_rate) and self.learning_rate > 0):
-            raise DecoyError(f"the learning rate must be positive, not {self.learning_rate}")
-        if self.patience < 1:
-            raise DecoyError(f"patience must be at least 1 epoch, not {self.patience}")
-        if self.threads < 1:
-            raise DecoyError(f"threads must be at least 1, not {self.threads}")
 
 
 @dataclass(frozen=True)
@@ -302,11 +276,6 @@ class Run:
         }
 
 
-BALANCE = ("all", "eval", "none")
-"""DIP's 1:1 balancing: every part (the paper's), validation and test only (train on all
-samples), or none."""
-
-
 def dip_parts(samples: Samples, split: Split, balanced: str, seed: int) -> dict[str, np.ndarray]:
     """Train, validation and test indices for DIP, balanced 1:1 with the seed as `balanced`
     says (BALANCE)."""
@@ -330,7 +299,7 @@ def fit_dip(
     split: Split,
     options: TrainOptions,
     spec: FeatureSpec,
-    balanced: str = "all",
+    balanced: str = DEFAULT_BALANCE,
     progress: ProgressCallback | None = None,
 ) -> Run:
     """Train DIP on the training part, choose its threshold by the best F1 on the validation

@@ -1,0 +1,185 @@
+"""What `decoy train` and `decoy models evaluate` print alike (not a command): option help
+texts, the progress bars, the samples line, the failed inputs, the metric tables beside the
+paper's values."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskID,
+    TextColumn,
+    TimeElapsedColumn,
+)
+from rich.table import Table
+
+from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG
+from decoy_cli.damage.sample_set import SampleStats
+
+if TYPE_CHECKING:
+    from decoy_cli.damage.training import Progress as TrainingProgress
+
+DATA_HELP = "ESTA match files (.json.xz or .json) or folders of them."
+MODE_HELP = (
+    "How rounds become samples: auto (frames of both teams -> frames, else events), frames "
+    "(the paper's, per frame every enemy pair) or events (events-only proxy for files without "
+    "frames)."
+)
+WINDOW_HELP = "Events mode: seconds within which an event row places a player (negatives)."
+SPLIT_HELP = "Split unit: match or round (never single samples)."
+SEED_HELP = "Seed of the split, the 1:1 balancing, and (training) weights and shuffling."
+VAL_HELP = "Share of the split units for validation (early stopping, DIP threshold)."
+TEST_HELP = "Share of the split units held out for the test metrics."
+BALANCE_HELP = "DIP: keep all positives and as many random negatives per part (the paper's 1:1)."
+DRAWS_HELP = "DOG generative mode: samples drawn per test condition."
+MIN_CELL_HELP = "DOG: fewest real samples a (weapon, hit group) cell needs for the Wasserstein."
+
+FAILURES_SHOWN = 5
+"""Failed inputs printed one per line; the rest are counted (all are in the JSON report)."""
+
+
+def progress_bars() -> tuple[
+    Progress, Callable[[Path, int, int], None], Callable[[TrainingProgress], None]
+]:
+    """Progress bars on stderr, drawn only on a terminal (no stray lines in pipes): one over the
+    data files and, once training starts, one over all batches of all epochs; and the two
+    callbacks that drive them (`on_file` for reading, `progress` for training)."""
+    errors = Console(stderr=True)
+    bars = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=errors,
+        transient=True,
+        disable=not errors.is_terminal,
+    )
+    reading = bars.add_task("reading samples", total=None)
+    training: list[TaskID] = []
+    state = {"val": "–"}
+
+    def on_file(_: Path, done: int, total: int) -> None:
+        bars.update(reading, completed=done, total=total)
+
+    def on_step(step: TrainingProgress) -> None:
+        if not training:
+            training.append(bars.add_task("training", total=None))
+        if step.record is not None:
+            state["val"] = f"{step.record.val_loss:.4f}"
+        bars.update(
+            training[0],
+            total=step.epochs * step.batches,
+            completed=(step.epoch - 1) * step.batches + step.batch,
+            description=f"epoch {step.epoch}/{step.epochs}, validation loss {state['val']}",
+        )
+
+    return bars, on_file, on_step
+
+
+def print_samples(console: Console, samples: int, stats: SampleStats) -> None:
+    """One line on the samples read, then the inputs that failed (a count and the first few)."""
+    excluded = sum(stats.excluded.values())
+    console.print(
+        f"{samples:,} samples ({stats.positives:,} damaging) from {stats.files} files: "
+        f"{stats.rounds_frames} rounds in frames mode, {stats.rounds_events} in events mode, "
+        f"{stats.rounds_without_samples} without samples, {stats.round_errors} failed; "
+        f"{excluded} damage rows left out"
+        + (
+            " (" + ", ".join(f"{n} {why}" for why, n in sorted(stats.excluded.items())) + ")"
+            if excluded
+            else ""
+        )
+    )
+    failures = stats.failures
+    if not failures:
+        return
+    inputs = "input" if len(failures) == 1 else "inputs"
+    console.print(f"left out {len(failures)} failed {inputs}:", highlight=False)
+    for failure in failures[:FAILURES_SHOWN]:
+        where = Path(failure.file).name
+        if failure.round_num is not None:
+            where += f" round {failure.round_num}"
+        console.print(f"  {where} ({failure.kind}): {failure.message}", markup=False)
+    if len(failures) > FAILURES_SHOWN:
+        console.print(
+            f"  and {len(failures) - FAILURES_SHOWN} more (all in the report's sample_stats)",
+            highlight=False,
+        )
+
+
+def _number(value: Any, digits: int = 3) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    if isinstance(value, int):
+        return f"{value:,}"
+    return f"{value:.{digits}f}"
+
+
+def dip_table(metrics: dict[str, Any], title: str) -> Table:
+    """DIP's metrics beside the paper's."""
+    table = Table(title=title)
+    for column in ("metric", "value", "paper"):
+        table.add_column(column, justify="left" if column == "metric" else "right")
+    for name in ("accuracy", "precision", "recall", "f1", "roc_auc", "average_precision"):
+        table.add_row(name, _number(metrics[name]), _number(PAPER_DIP.get(name)))
+    table.add_row("threshold", _number(metrics["threshold"]), _number(PAPER_DIP["threshold"]))
+    table.add_row(
+        "samples (positive / negative)",
+        f"{metrics['positives']:,} / {metrics['negatives']:,}",
+        "1:1 balanced",
+    )
+    return table
+
+
+def dog_table(metrics: dict[str, Any], title: str) -> Table:
+    """DOG's metrics beside the paper's."""
+    table = Table(title=title)
+    for column in ("metric", "value", "paper"):
+        table.add_column(column, justify="left" if column == "metric" else "right")
+    rows = (
+        ("damage MAE, reconstruction (HP)", "damage_mae_hp", 2),
+        ("damage R², reconstruction", "damage_r2", 3),
+        ("hit-group accuracy, reconstruction", "hit_group_accuracy", 3),
+        ("hit-group accuracy, generative", "hit_group_accuracy_generated", 3),
+        ("mean Wasserstein per cell (HP)", "mean_wasserstein_hp", 2),
+        ("Wasserstein, all damage (HP)", "wasserstein_all_hp", 2),
+        ("mean damage generated / real (HP)", None, 1),
+    )
+    for label, key, digits in rows:
+        if key is None:
+            value = (
+                f"{metrics['generated_mean_damage_hp']:.1f} / {metrics['real_mean_damage_hp']:.1f}"
+            )
+            table.add_row(label, value, "–")
+            continue
+        table.add_row(label, _number(metrics[key], digits), _number(PAPER_DOG.get(key), digits))
+    table.add_row(
+        "cells in the Wasserstein mean",
+        f"{metrics['wasserstein_cells']} (≥ {metrics['min_cell']} real samples)",
+        "–",
+    )
+    table.add_row("damaging samples", f"{metrics['samples']:,}", "–")
+    return table
+
+
+def cells_table(cells: list[dict[str, Any]]) -> Table:
+    """The (weapon, hit group) cells of the Wasserstein mean."""
+    table = Table(title="generated vs real damage per cell")
+    for column in ("weapon", "hit group", "real", "generated", "Wasserstein (HP)"):
+        table.add_column(column, justify="left" if column in ("weapon", "hit group") else "right")
+    for cell in cells:
+        table.add_row(
+            cell["weapon"],
+            cell["hit_group"],
+            f"{cell['real']:,}",
+            f"{cell['generated']:,}",
+            f"{cell['wasserstein_hp']:.2f}",
+        )
+    return table

@@ -1,0 +1,161 @@
+"""The damage rows of a round, classified for both sample modes, and their sum per pair and step.
+
+Which damage counts (both modes): firearm damage between enemies. Left out, with the reason
+counted in `SampleStats.excluded`: world damage (no attacker), friendly fire, grenade, fire and
+bomb damage (weaponClass "Grenade" or hitGroup "Generic"), weapons outside the models'
+vocabulary (`features.WEAPONS`: knife, Zeus, C4) and rows without a damage value or hit group.
+
+Damage value: `hpDamage` (the raw HP damage of the hit, before the victim's remaining HP caps
+it), summed over the hits of one pair in one step and capped at 100. Not `hpDamageTaken`: that
+is capped by the victim's remaining HP, which is not a model input, so a DOG trained on it
+would learn that an AK-47 chest hit does 20 HP whenever victims happened to be low. The
+simulator applies DOG's damage capped at the victim's HP (decoy_cli/damage/combat.py), which
+gives back exactly ESTA's hpDamageTaken; above 100 every value kills anyone, so the cap loses
+nothing and keeps the target in [0, 1] HP/100. (The paper sums raw hpDamage without the cap.)
+Hit group: the six groups of `HIT_GROUPS` (Left/RightArm -> Arm, Left/RightLeg -> Leg); for a
+pair hit several times in one step, the group of its largest hit (the first such on a tie).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.damage.features import WEAPONS
+from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, SampleStats
+from decoy_cli.esta import Round
+
+_HIT_GROUP_CODE = {
+    "Head": 0,
+    "Neck": 1,
+    "Chest": 2,
+    "Stomach": 3,
+    "LeftArm": 4,
+    "RightArm": 4,
+    "Arm": 4,
+    "LeftLeg": 5,
+    "RightLeg": 5,
+    "Leg": 5,
+}
+
+VOCABULARY = frozenset(WEAPONS)
+"""The firearms the models know (`features.WEAPONS`)."""
+
+
+def player_keys(table: pd.DataFrame, owner: str) -> np.ndarray:
+    """(N,) object array of player keys (steamID string, else name; None when unknown)."""
+    ids = table[f"{owner}SteamID"].to_numpy(dtype=object, na_value=None)
+    names = table[f"{owner}Name"].to_numpy(dtype=object, na_value=None)
+    out = np.empty(len(table), dtype=object)
+    for i, (steam_id, name) in enumerate(zip(ids, names, strict=True)):
+        if steam_id is not None and int(steam_id) != 0:
+            out[i] = str(int(steam_id))
+        elif isinstance(name, str) and name:
+            out[i] = name
+        else:
+            out[i] = None
+    return out
+
+
+def strings(table: pd.DataFrame, column: str) -> np.ndarray:
+    """A string column as an object array with "" for nulls."""
+    values = table[column].to_numpy(dtype=object, na_value=None)
+    return np.array([v if isinstance(v, str) else "" for v in values], dtype=object)
+
+
+def ints(table: pd.DataFrame, column: str) -> np.ndarray:
+    """A nullable integer column as float64 with NaN for nulls."""
+    return table[column].to_numpy(dtype=np.float64, na_value=np.nan)
+
+
+@dataclass(frozen=True)
+class DamageRows:
+    """The damage rows of a round with what sample building needs, and which rows are usable."""
+
+    tick: np.ndarray  # float64, NaN when null
+    attacker: np.ndarray  # object keys or None
+    victim: np.ndarray
+    weapon: np.ndarray
+    hp_damage: np.ndarray  # float64
+    hp_taken: np.ndarray  # float64 (NaN -> 0 when summed)
+    armor_damage: np.ndarray  # float64
+    group_code: np.ndarray  # int64, -1 when none
+    usable: np.ndarray  # bool
+
+
+def damage_rows(round_: Round, stats: SampleStats) -> DamageRows:
+    """Classify every damage row (module docstring) and count the reasons for leaving one out."""
+    table = round_.damages
+    attacker = player_keys(table, "attacker")
+    victim = player_keys(table, "victim")
+    weapon = strings(table, "weapon")
+    weapon_class = strings(table, "weaponClass")
+    hit_group = strings(table, "hitGroup")
+    attacker_side = strings(table, "attackerSide")
+    victim_side = strings(table, "victimSide")
+    friendly = table["isFriendlyFire"].to_numpy(dtype=object, na_value=None)
+    hp_damage = ints(table, "hpDamage")
+    tick = ints(table, "tick")
+    group_code = np.array([_HIT_GROUP_CODE.get(g, -1) for g in hit_group], dtype=np.int64)
+    usable = np.zeros(len(table), dtype=bool)
+    for i in range(len(table)):
+        if attacker[i] is None or weapon[i] == "World":
+            reason = "world damage (no attacker)"
+        elif friendly[i] is True or (attacker_side[i] and attacker_side[i] == victim_side[i]):
+            reason = "friendly fire"
+        elif weapon_class[i] == "Grenade" or hit_group[i] == "Generic":
+            reason = "grenade, fire or bomb"
+        elif weapon[i] not in VOCABULARY:
+            reason = "weapon outside the vocabulary"
+        elif group_code[i] < 0:
+            reason = "unknown hit group"
+        elif not (hp_damage[i] > 0) or victim[i] is None or not np.isfinite(tick[i]):
+            reason = "no damage value, victim or tick"
+        else:
+            usable[i] = True
+            continue
+        stats.excluded[reason] += 1
+    return DamageRows(
+        tick=tick,
+        attacker=attacker,
+        victim=victim,
+        weapon=weapon,
+        hp_damage=hp_damage,
+        hp_taken=np.nan_to_num(ints(table, "hpDamageTaken")),
+        armor_damage=np.nan_to_num(ints(table, "armorDamage")),
+        group_code=group_code,
+        usable=usable,
+    )
+
+
+def aggregate(
+    step: np.ndarray,
+    attacker: np.ndarray,
+    victim: np.ndarray,
+    damages: DamageRows,
+    rows: np.ndarray,
+) -> dict[tuple[int, object, object], tuple[float, int, int]]:
+    """Per (step, attacker, victim): (summed hpDamage capped at 100, hit group of the largest
+    hit, the first row), over the damage rows `rows` (in row order)."""
+    out: dict[tuple[int, object, object], tuple[float, int, int]] = {}
+    largest: dict[tuple[int, object, object], float] = {}
+    for r in rows:
+        key = (int(step[r]), attacker[r], victim[r])
+        value = float(damages.hp_damage[r])
+        if key not in out:
+            out[key] = (value, int(damages.group_code[r]), int(r))
+            largest[key] = value
+            continue
+        total, group, first = out[key]
+        if value > largest[key]:
+            largest[key] = value
+            group = int(damages.group_code[r])
+        out[key] = (total + value, group, first)
+    return {k: (min(v[0], MAX_DAMAGE_HP), v[1], v[2]) for k, v in out.items()}
+
+
+def group_id(round_: Round) -> str:
+    """The split group of a round's samples: "MATCH rROUND"."""
+    return f"{round_.match_id} r{round_.round_num}"

@@ -1,0 +1,267 @@
+"""Events-only mode: samples from a round's event rows, for files without frames (such as
+`esta_dust2_events`).
+
+There are no frames, so a 2 Hz grid of virtual frames (every tick_rate / 2 ticks from the
+round's start tick, as ESTA's frames) stands in. Positives are the damage events, grouped per
+(virtual frame, attacker, victim) like frames mode; the state is the one written in the group's
+first event row. Negatives, an honest proxy: at the virtual frame of every damage, kill, flash
+and bomb event, each player seen in an event row (damage, kill, flash: attacker or
+victim/flashed player) within `window_s` seconds stands where its nearest such row puts it
+(position and view yaw); every ordered enemy pair of such players, both alive, whose attacker
+has a known firearm and dealt the victim no damage of any kind within the window, is a negative
+(by direction, as frames mode labels ordered pairs: a player who was shot and missed back is a
+negative attacker). Bomb events carry no view yaw: they give anchor times, not states. The
+attacker's weapon is the firearm of its nearest-in-time damage or kill row of the round (a
+player who never hits or kills with a firearm in the round is never an attacker). HP is 100
+minus the player's hpDamageTaken in the round before the tick. Armor and helmet, not in events,
+are inferred per round and player: armor if any hit on the player removed armor; helmet if a
+head hit removed armor, no helmet if a head hit removed none, else helmet = armor; a player
+never hit counts as armored with a helmet. The biases of this proxy are stated in
+decoy_cli/models/DIP_CARD.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from decoy_cli.damage.damage_rows import (
+    VOCABULARY,
+    DamageRows,
+    aggregate,
+    damage_rows,
+    group_id,
+    ints,
+    player_keys,
+    strings,
+)
+from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
+from decoy_cli.esta import Round
+from decoy_cli.sim.combat import NO_HIT
+
+
+@dataclass(frozen=True)
+class _Sightings:
+    """Where event rows place players: tick, key, side, position (metres) and view yaw."""
+
+    tick: np.ndarray
+    key: np.ndarray
+    side: np.ndarray
+    position: np.ndarray
+    yaw: np.ndarray
+
+
+def _sightings(round_: Round) -> _Sightings:
+    """Every (player, tick) an event row places with a position and a view yaw."""
+    ticks, keys, sides, positions, yaws = [], [], [], [], []
+    for table, owners in (
+        (round_.damages, ("attacker", "victim")),
+        (round_.kills, ("attacker", "victim")),
+        (round_.flashes, ("attacker", "player")),
+    ):
+        if len(table) == 0:
+            continue
+        tick = ints(table, "tick")
+        for owner in owners:
+            ticks.append(tick)
+            keys.append(player_keys(table, owner))
+            sides.append(strings(table, f"{owner}Side"))
+            positions.append(
+                np.column_stack([table[f"{owner}{axis}_m"].to_numpy() for axis in "XYZ"])
+            )
+            yaws.append(table[f"{owner}ViewX"].to_numpy(dtype=np.float64))
+    if not ticks:
+        empty = np.zeros(0)
+        return _Sightings(empty, np.zeros(0, object), np.zeros(0, object), np.zeros((0, 3)), empty)
+    tick = np.concatenate(ticks)
+    key = np.concatenate(keys)
+    side = np.concatenate(sides)
+    position = np.concatenate(positions)
+    yaw = np.concatenate(yaws)
+    known = (
+        np.isfinite(tick)
+        & np.array([k is not None for k in key], dtype=bool)
+        & np.isin(side, ["T", "CT"])
+        & np.isfinite(position).all(axis=1)
+        & np.isfinite(yaw)
+    )
+    return _Sightings(tick[known], key[known], side[known], position[known], yaw[known])
+
+
+class _EventRound:
+    """What the event rows of one round say about its players over time (events-only mode)."""
+
+    def __init__(self, round_: Round, damages: DamageRows) -> None:
+        self.round = round_
+        self.damages = damages
+        self.step_ticks = max(1, round(round_.tick_rate / 2))
+        self.origin = round_.start_tick if round_.start_tick is not None else 0
+        kills = round_.kills
+        self.kill_tick = ints(kills, "tick")
+        self.kill_victim = player_keys(kills, "victim")
+        ticks, keys, names = [], [], []
+        for table in (round_.damages, kills):
+            weapon = strings(table, "weapon")
+            armed = np.isin(weapon, list(VOCABULARY)) & np.isfinite(ints(table, "tick"))
+            ticks.append(ints(table, "tick")[armed])
+            keys.append(player_keys(table, "attacker")[armed])
+            names.append(weapon[armed])
+        self.weapon_tick = np.concatenate(ticks)
+        self.weapon_key = np.concatenate(keys)
+        self.weapon_name = np.concatenate(names)
+        self.armor = self._infer_armor()
+
+    def frame(self, ticks: np.ndarray) -> np.ndarray:
+        """The virtual 2 Hz frame nearest each tick."""
+        return np.rint((ticks - self.origin) / self.step_ticks).astype(np.int64)
+
+    def frame_tick(self, frame: int) -> int:
+        """The tick of a virtual frame."""
+        return int(self.origin + frame * self.step_ticks)
+
+    def hp_before(self, player: object, tick: float) -> int:
+        """100 minus the player's hpDamageTaken in the round before `tick` (at least 1: the
+        player is alive)."""
+        rows = (self.damages.victim == player) & (self.damages.tick < tick)
+        return int(max(1.0, 100.0 - float(self.damages.hp_taken[rows].sum())))
+
+    def dead_at(self, player: object, tick: float) -> bool:
+        """True when a kill row has the player die at or before `tick`."""
+        return bool(np.any((self.kill_victim == player) & (self.kill_tick <= tick)))
+
+    def weapon_at(self, player: object, tick: float) -> str | None:
+        """The firearm of the player's damage or kill row nearest `tick`; None without one."""
+        rows = np.flatnonzero(self.weapon_key == player)
+        if len(rows) == 0:
+            return None
+        return str(self.weapon_name[rows[np.argmin(np.abs(self.weapon_tick[rows] - tick))]])
+
+    def armor_of(self, player: object) -> tuple[int, bool]:
+        """(armor as 100 or 0, helmet) as inferred; armored with a helmet when never hit."""
+        has_armor, helmet = self.armor.get(player, (True, True))
+        return (100 if has_armor else 0), helmet
+
+    def _infer_armor(self) -> dict[object, tuple[bool, bool]]:
+        """Per player hit in the round: (armor, helmet) from the armor its hits removed."""
+        hit_group = strings(self.round.damages, "hitGroup")
+        out: dict[object, tuple[bool, bool]] = {}
+        for player in {k for k in self.damages.victim if k is not None}:
+            rows = self.damages.victim == player
+            armor = bool(np.any(self.damages.armor_damage[rows] > 0))
+            head = rows & (hit_group == "Head")
+            helmet = bool(np.any(self.damages.armor_damage[head] > 0)) if head.any() else armor
+            out[player] = (armor or helmet, helmet)
+        return out
+
+
+def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples:
+    """Events-only mode (module docstring): positives from the damage rows, then negatives."""
+    events = _EventRound(round_, damage_rows(round_, stats))
+    rows: list[dict[str, object]] = []
+    rows += _event_positives(events, stats)
+    rows += _event_negatives(events, window_s * round_.tick_rate)
+    common = {
+        "map_name": round_.map_name,
+        "group": group_id(round_),
+        "match": round_.match_id,
+        "mode": "events",
+    }
+    return samples_from_rows([{**common, **row} for row in rows])
+
+
+def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, object]]:
+    """One sample per (virtual frame, attacker, victim) with usable damage; the state of the
+    group's first damage row."""
+    damages, table = events.damages, events.round.damages
+    usable = np.flatnonzero(damages.usable)
+    frame = events.frame(np.nan_to_num(damages.tick))
+    rows = []
+    for (k, attacker, victim), (total, code, first) in aggregate(
+        frame, damages.attacker, damages.victim, damages, usable
+    ).items():
+        a_pos = np.array([table[f"attacker{axis}_m"].iloc[first] for axis in "XYZ"])
+        v_pos = np.array([table[f"victim{axis}_m"].iloc[first] for axis in "XYZ"])
+        a_yaw = float(table["attackerViewX"].iloc[first])
+        v_yaw = float(table["victimViewX"].iloc[first])
+        if not np.isfinite([*a_pos, *v_pos, a_yaw, v_yaw]).all():
+            stats.excluded["no attacker or victim state"] += 1
+            continue
+        tick = float(damages.tick[first])
+        armor, helmet = events.armor_of(victim)
+        rows.append(
+            {
+                "attacker_position": a_pos,
+                "victim_position": v_pos,
+                "attacker_yaw": a_yaw,
+                "victim_yaw": v_yaw,
+                "attacker_hp": events.hp_before(attacker, tick),
+                "victim_hp": events.hp_before(victim, tick),
+                "attacker_weapon": str(damages.weapon[first]),
+                "victim_armor": armor,
+                "victim_helmet": helmet,
+                "hit": True,
+                "damage": total,
+                "hit_group": code,
+                "tick": events.frame_tick(k),
+            }
+        )
+    return rows
+
+
+def _event_negatives(events: _EventRound, window: float) -> list[dict[str, object]]:
+    """At the virtual frame of every damage, kill, flash and bomb event: the ordered enemy pairs
+    of players seen within `window` ticks, alive, the attacker with a known firearm, and the
+    attacker having dealt the victim no damage of any kind within the window."""
+    round_, damages = events.round, events.damages
+    sightings = _sightings(round_)
+    tables = (round_.damages, round_.kills, round_.flashes, round_.bomb_events)
+    ticks = np.concatenate([ints(t, "tick") for t in tables])
+    ticks = ticks[np.isfinite(ticks)]
+    any_damage = np.isfinite(damages.tick) & np.array(
+        [
+            a is not None and v is not None
+            for a, v in zip(damages.attacker, damages.victim, strict=True)
+        ],
+        dtype=bool,
+    )
+    rows = []
+    for k in np.unique(events.frame(ticks)):
+        anchor = float(events.frame_tick(int(k)))
+        seen: dict[object, int] = {}  # per player, its sighting nearest the anchor
+        distance = np.abs(sightings.tick - anchor)
+        for s in np.flatnonzero(distance <= window):
+            best = seen.get(sightings.key[s])
+            if best is None or distance[s] < distance[best]:
+                seen[sightings.key[s]] = s
+        players = [p for p in seen if not events.dead_at(p, anchor)]
+        near = any_damage & (np.abs(damages.tick - anchor) <= window)
+        dealt = {(damages.attacker[r], damages.victim[r]) for r in np.flatnonzero(near)}
+        for attacker in players:
+            weapon = events.weapon_at(attacker, anchor)
+            if weapon is None:
+                continue
+            sa = seen[attacker]
+            for victim in players:
+                sv = seen[victim]
+                if sightings.side[sa] == sightings.side[sv] or (attacker, victim) in dealt:
+                    continue
+                armor, helmet = events.armor_of(victim)
+                rows.append(
+                    {
+                        "attacker_position": sightings.position[sa],
+                        "victim_position": sightings.position[sv],
+                        "attacker_yaw": float(sightings.yaw[sa]),
+                        "victim_yaw": float(sightings.yaw[sv]),
+                        "attacker_hp": events.hp_before(attacker, anchor),
+                        "victim_hp": events.hp_before(victim, anchor),
+                        "attacker_weapon": weapon,
+                        "victim_armor": armor,
+                        "victim_helmet": helmet,
+                        "hit": False,
+                        "damage": 0.0,
+                        "hit_group": NO_HIT,
+                        "tick": int(anchor),
+                    }
+                )
+    return rows

@@ -1,0 +1,99 @@
+"""What a damage model was trained or scored on: the choice of data and split, the provenance
+kept in a trained model's metadata, and strict JSON writing of both.
+
+One `SampleChoice` reads and splits the samples for training and for `decoy models evaluate`,
+so the same choice gives the same train, validation and test parts in both.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from decoy_cli import __version__
+from decoy_cli.damage.sample_set import Samples, SampleStats
+from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, build_samples
+from decoy_cli.damage.split import (
+    DEFAULT_SEED,
+    DEFAULT_SPLIT,
+    DEFAULT_TEST_FRACTION,
+    DEFAULT_VAL_FRACTION,
+    Split,
+    split_samples,
+)
+from decoy_cli.damage.train_options import TrainOptions
+from decoy_cli.files import write_atomic
+
+FileCallback = Callable[[Path, int, int], None]
+"""Called after each data file is read: (path, files done, files in all)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class SampleChoice:
+    """Which ESTA files, how their rounds become samples (`mode`, `window_s`) and how the
+    samples are split (by match or round, with `seed`)."""
+
+    data: Sequence[Path]
+    mode: str = DEFAULT_MODE
+    window_s: float = DEFAULT_WINDOW_S
+    split_by: str = DEFAULT_SPLIT
+    seed: int = DEFAULT_SEED
+    val_fraction: float = DEFAULT_VAL_FRACTION
+    test_fraction: float = DEFAULT_TEST_FRACTION
+
+    def read(self, on_file: FileCallback | None = None) -> tuple[Samples, SampleStats]:
+        """The samples of the data, and what reading them counted and left out."""
+        return build_samples(self.data, self.mode, self.window_s, on_file=on_file)
+
+    def split(self, samples: Samples) -> Split:
+        """The samples' train, validation and test parts."""
+        return split_samples(
+            samples, self.split_by, self.seed, self.val_fraction, self.test_fraction
+        )
+
+
+def provenance(
+    *, command: str, choice: SampleChoice, split: Split, stats: SampleStats, options: TrainOptions
+) -> dict[str, Any]:
+    """What a model was trained on and how (`command` is "dip" or "dog"): kept in the model's
+    JSON metadata, so a model folder says where it came from."""
+    return {
+        "trained_with": f"decoy {__version__}: decoy train {command}",
+        "data": [str(d) for d in choice.data],
+        "mode": choice.mode,
+        "window_s": choice.window_s,
+        "split": {
+            "by": choice.split_by,
+            "seed": choice.seed,
+            "val_fraction": choice.val_fraction,
+            "test_fraction": choice.test_fraction,
+            "units": split.units,
+        },
+        "sample_stats": stats.to_json(),
+        "options": options.to_json(),
+    }
+
+
+def json_ready(value: Any) -> Any:
+    """`value` with NaN and infinities as None and numpy scalars as Python numbers (strict
+    JSON has no NaN)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.generic):
+        return json_ready(value.item())
+    return value
+
+
+def write_json(path: Path, data: dict[str, Any]) -> None:
+    """Pretty strict JSON (see `json_ready`), written atomically."""
+    write_atomic(path, (json.dumps(json_ready(data), indent=2) + "\n").encode())

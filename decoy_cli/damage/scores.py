@@ -1,0 +1,175 @@
+"""The numbers of the damage models' evaluation, plain numpy (scipy for the Wasserstein):
+ROC AUC, average precision, their curves, the best-F1 threshold, classification and regression
+metrics, the confusion matrix and the Wasserstein distance per (weapon, hit group) cell.
+
+No scikit-learn: these few metrics do not justify the dependency, and each is checked by hand
+in tests/test_damage_evaluation.py.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from decoy_cli.damage.features import HIT_GROUPS
+
+MIN_CELL = 10
+"""Fewest real samples a (weapon, hit group) cell needs to enter the mean Wasserstein."""
+
+
+def _check(labels: np.ndarray, scores: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    labels = np.asarray(labels, dtype=bool).ravel()
+    scores = np.asarray(scores, dtype=np.float64).ravel()
+    if labels.shape != scores.shape:
+        raise ValueError(f"{len(labels)} labels for {len(scores)} scores")
+    if not np.all(np.isfinite(scores)):
+        raise ValueError("scores must be finite")
+    return labels, scores
+
+
+def roc_auc(labels: np.ndarray, scores: np.ndarray) -> float:
+    """Area under the ROC curve (the Mann-Whitney U statistic, ties counted half); NaN when
+    only one class is present."""
+    from scipy.stats import rankdata
+
+    labels, scores = _check(labels, scores)
+    positives = int(labels.sum())
+    negatives = len(labels) - positives
+    if positives == 0 or negatives == 0:
+        return math.nan
+    ranks = rankdata(scores)
+    return float((ranks[labels].sum() - positives * (positives + 1) / 2) / (positives * negatives))
+
+
+def _ranked(labels: np.ndarray, scores: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """True and false positives when predicting positive at or above each distinct score
+    (descending), and those scores."""
+    order = np.argsort(-scores, kind="stable")
+    sorted_scores, sorted_labels = scores[order], labels[order]
+    last = np.r_[np.flatnonzero(np.diff(sorted_scores)), len(scores) - 1]
+    true_pos = np.cumsum(sorted_labels)[last]
+    false_pos = last + 1 - true_pos
+    return true_pos, false_pos, sorted_scores[last]
+
+
+def average_precision(labels: np.ndarray, scores: np.ndarray) -> float:
+    """Average precision, sum over thresholds of (recall step) x precision; NaN without
+    positives."""
+    labels, scores = _check(labels, scores)
+    positives = int(labels.sum())
+    if positives == 0:
+        return math.nan
+    true_pos, false_pos, _ = _ranked(labels, scores)
+    precision = true_pos / (true_pos + false_pos)
+    recall = true_pos / positives
+    return float(np.sum(np.diff(recall, prepend=0.0) * precision))
+
+
+def roc_curve(labels: np.ndarray, scores: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """False and true positive rates from (0, 0) to (1, 1)."""
+    labels, scores = _check(labels, scores)
+    true_pos, false_pos, _ = _ranked(labels, scores)
+    positives, negatives = max(int(labels.sum()), 1), max(int((~labels).sum()), 1)
+    return np.r_[0.0, false_pos / negatives], np.r_[0.0, true_pos / positives]
+
+
+def precision_recall_curve(labels: np.ndarray, scores: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Recall and precision at each distinct threshold, from the highest threshold down."""
+    labels, scores = _check(labels, scores)
+    true_pos, false_pos, _ = _ranked(labels, scores)
+    return true_pos / max(int(labels.sum()), 1), true_pos / (true_pos + false_pos)
+
+
+def best_f1_threshold(labels: np.ndarray, scores: np.ndarray) -> float:
+    """The score threshold (predict positive at or above it) with the highest F1; the highest
+    such threshold on a tie. Used on the validation split, never on test."""
+    labels, scores = _check(labels, scores)
+    if not labels.any():
+        raise ValueError("choosing a threshold needs at least one positive")
+    true_pos, false_pos, thresholds = _ranked(labels, scores)
+    f1 = 2 * true_pos / (true_pos + false_pos + int(labels.sum()))
+    return float(thresholds[int(np.argmax(f1))])
+
+
+def classification_metrics(
+    labels: np.ndarray, scores: np.ndarray, threshold: float
+) -> dict[str, float]:
+    """Accuracy, precision, recall and F1 at `threshold` (positive at or above it), ROC AUC,
+    average precision, the threshold and the class counts."""
+    labels, scores = _check(labels, scores)
+    predicted = scores >= threshold
+    tp = int(np.sum(predicted & labels))
+    fp = int(np.sum(predicted & ~labels))
+    fn = int(np.sum(~predicted & labels))
+    precision = tp / (tp + fp) if tp + fp else math.nan
+    recall = tp / (tp + fn) if tp + fn else math.nan
+    f1 = 2 * tp / (2 * tp + fp + fn) if tp + fp + fn else math.nan
+    return {
+        "accuracy": float(np.mean(predicted == labels)) if len(labels) else math.nan,
+        "precision": precision,
+        "recall": recall,
+        "f1": f1,
+        "roc_auc": roc_auc(labels, scores),
+        "average_precision": average_precision(labels, scores),
+        "threshold": float(threshold),
+        "positives": int(labels.sum()),
+        "negatives": int((~labels).sum()),
+    }
+
+
+def regression_metrics(real: np.ndarray, predicted: np.ndarray) -> dict[str, float]:
+    """Mean absolute error and R² (1 - residual / total sum of squares; NaN for constant real
+    values)."""
+    real = np.asarray(real, dtype=np.float64)
+    predicted = np.asarray(predicted, dtype=np.float64)
+    if real.shape != predicted.shape or real.size == 0:
+        raise ValueError("regression metrics need two non-empty arrays of one shape")
+    residual = float(np.sum((real - predicted) ** 2))
+    total = float(np.sum((real - real.mean()) ** 2))
+    return {
+        "mae": float(np.mean(np.abs(real - predicted))),
+        "r2": 1.0 - residual / total if total > 0 else math.nan,
+    }
+
+
+def confusion_matrix(real: np.ndarray, predicted: np.ndarray, classes: int) -> np.ndarray:
+    """(classes, classes) counts, rows the real class, columns the predicted one."""
+    matrix = np.zeros((classes, classes), dtype=np.int64)
+    np.add.at(matrix, (np.asarray(real, int), np.asarray(predicted, int)), 1)
+    return matrix
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One (weapon, hit group) cell: sample counts and the Wasserstein distance in HP."""
+
+    weapon: str
+    hit_group: str
+    real: int
+    generated: int
+    wasserstein_hp: float
+
+
+def wasserstein_cells(
+    real_weapon: np.ndarray,
+    real_group: np.ndarray,
+    real_damage: np.ndarray,
+    generated_weapon: np.ndarray,
+    generated_group: np.ndarray,
+    generated_damage: np.ndarray,
+    min_cell: int = MIN_CELL,
+) -> list[Cell]:
+    """The cells with at least `min_cell` real and generated samples, most real samples first."""
+    from scipy.stats import wasserstein_distance
+
+    cells = []
+    for weapon in np.unique(real_weapon):
+        for code, name in enumerate(HIT_GROUPS):
+            real = real_damage[(real_weapon == weapon) & (real_group == code)]
+            generated = generated_damage[(generated_weapon == weapon) & (generated_group == code)]
+            if len(real) >= min_cell and len(generated) >= min_cell:
+                distance = float(wasserstein_distance(real, generated))
+                cells.append(Cell(str(weapon), name, len(real), len(generated), distance))
+    return sorted(cells, key=lambda c: (-c.real, c.weapon, c.hit_group))

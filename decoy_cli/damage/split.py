@@ -1,0 +1,91 @@
+"""Splitting samples into train, validation and test parts by match or by round, and the 1:1
+balancing of DIP's positives and negatives.
+
+A split never cuts a round (or, by match, a match) in two: samples of one step share their
+round's game state, so a split by sample would leak the test part into training.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from decoy_cli.damage.sample_set import Samples
+from decoy_cli.errors import DecoyError
+
+SPLITS = ("match", "round")
+DEFAULT_SPLIT = "match"
+DEFAULT_SEED = 0
+"""The seed of the split, the balancing and (training) the weights and shuffling."""
+DEFAULT_VAL_FRACTION = 0.15
+DEFAULT_TEST_FRACTION = 0.15
+
+
+@dataclass(frozen=True)
+class Split:
+    """Sample indices of the train, validation and test parts, and the groups of each."""
+
+    train: np.ndarray
+    val: np.ndarray
+    test: np.ndarray
+    units: dict[str, list[str]]
+
+    def part(self, name: str) -> np.ndarray:
+        """The indices of "train", "val", "test" or "all" (every index, sorted)."""
+        if name == "all":
+            return np.sort(np.concatenate([self.train, self.val, self.test]))
+        if name not in ("train", "val", "test"):
+            raise DecoyError(f"subset must be all, train, val or test, not {name!r}")
+        return getattr(self, name)
+
+
+def split_samples(
+    samples: Samples, by: str, seed: int, val_fraction: float, test_fraction: float
+) -> Split:
+    """Split by match or by round (never by sample): the units, sorted, are shuffled with the
+    seed; the first round(test_fraction * n) (at least 1) go to test, the next
+    round(val_fraction * n) (at least 1) to validation, the rest to training."""
+    if by not in SPLITS:
+        raise DecoyError(f"split must be match or round, not {by!r}")
+    for name, value in (("validation", val_fraction), ("test", test_fraction)):
+        if not (0.0 < value < 1.0):
+            raise DecoyError(f"the {name} fraction must be between 0 and 1, not {value}")
+    if val_fraction + test_fraction >= 1.0:
+        raise DecoyError("the validation and test fractions leave nothing to train on")
+    unit_of = samples.match if by == "match" else samples.group
+    units = sorted(set(unit_of.tolist()))
+    n = len(units)
+    n_test = max(1, round(test_fraction * n))
+    n_val = max(1, round(val_fraction * n))
+    if n - n_test - n_val < 1:
+        what = "matches" if by == "match" else "rounds"
+        hint = ": use --split round" if by == "match" else ""
+        raise DecoyError(
+            f"a split by {by} needs at least 3 {what} with samples, the data has {n}{hint}"
+        )
+    order = np.random.default_rng(seed).permutation(n)
+    shuffled = [units[i] for i in order]
+    parts = {
+        "test": shuffled[:n_test],
+        "val": shuffled[n_test : n_test + n_val],
+        "train": shuffled[n_test + n_val :],
+    }
+    index = {
+        name: np.flatnonzero(np.isin(unit_of, np.array(members, dtype=object)))
+        for name, members in parts.items()
+    }
+    return Split(
+        index["train"], index["val"], index["test"], {k: sorted(v) for k, v in parts.items()}
+    )
+
+
+def balance(samples: Samples, index: np.ndarray, seed: int) -> np.ndarray:
+    """The indices in `index` with all positives and as many negatives, drawn with the seed (all
+    negatives when there are fewer), sorted: the paper's 1:1 balanced DIP set."""
+    index = np.asarray(index, dtype=np.int64)
+    positive = index[samples.hit[index]]
+    negative = index[~samples.hit[index]]
+    if len(negative) > len(positive):
+        negative = np.random.default_rng(seed).choice(negative, len(positive), replace=False)
+    return np.sort(np.concatenate([positive, negative]))
