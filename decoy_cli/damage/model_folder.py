@@ -30,7 +30,7 @@ from torch import nn
 from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
-from decoy_cli.files import write_atomic
+from decoy_cli.files import json_text, write_atomic
 
 FORMAT = "decoy-damage-model"
 FORMAT_VERSION = 1
@@ -101,7 +101,7 @@ def _save(
         "parameters": sum(p.numel() for p in net.parameters()),
         "metadata": metadata,
     }
-    text = json.dumps(description, indent=2) + "\n"  # before writing: unserialisable metadata
+    text = json_text(description, sort_keys=False)  # before writing: unserialisable metadata
     buffer = io.BytesIO()
     torch.save({k: v.detach().cpu().clone() for k, v in net.state_dict().items()}, buffer)
     write_atomic(folder / f"{kind}.pt", buffer.getvalue())

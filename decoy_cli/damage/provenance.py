@@ -7,16 +7,12 @@ so the same choice gives the same train, validation and test parts in both.
 
 from __future__ import annotations
 
-import json
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from decoy_cli import __version__
+from decoy_cli import __version__, files
 from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, build_samples
 from decoy_cli.damage.split import (
@@ -28,7 +24,6 @@ from decoy_cli.damage.split import (
     split_samples,
 )
 from decoy_cli.damage.train_options import TrainOptions
-from decoy_cli.files import write_atomic
 
 FileCallback = Callable[[Path, int, int], None]
 """Called after each data file is read: (path, files done, files in all)."""
@@ -80,20 +75,6 @@ def provenance(
     }
 
 
-def json_ready(value: Any) -> Any:
-    """`value` with NaN and infinities as None and numpy scalars as Python numbers (strict
-    JSON has no NaN)."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: json_ready(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [json_ready(v) for v in value]
-    if isinstance(value, np.generic):
-        return json_ready(value.item())
-    return value
-
-
 def write_json(path: Path, data: dict[str, Any]) -> None:
-    """Pretty strict JSON (see `json_ready`), written atomically."""
-    write_atomic(path, (json.dumps(json_ready(data), indent=2) + "\n").encode())
+    """Pretty strict JSON in the order given (`decoy_cli.files.write_json`)."""
+    files.write_json(path, data, sort_keys=False)

@@ -19,7 +19,6 @@ from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import (
     FileCallback,
     SampleChoice,
-    json_ready,
     provenance,
     write_json,
 )
@@ -33,7 +32,7 @@ from decoy_cli.damage.train_options import (
     TrainOptions,
 )
 from decoy_cli.errors import DecoyError
-from decoy_cli.files import write_atomic
+from decoy_cli.files import json_ready, write_atomic
 
 if TYPE_CHECKING:
     from decoy_cli.damage.training import EpochRecord, Progress, Run
