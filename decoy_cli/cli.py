@@ -20,6 +20,7 @@ from decoy_cli.commands import (
     snap,
     train,
 )
+from decoy_cli.commands.help_text import reflow_help
 from decoy_cli.errors import DecoyError
 
 _debug = False
@@ -75,3 +76,4 @@ app.command("replay")(replay.replay)
 app.command("snap")(snap.snap)
 app.add_typer(models.app, name="models")
 app.add_typer(train.app, name="train")
+reflow_help(app)  # last: help reflows to the terminal's width instead of keeping docstring wraps

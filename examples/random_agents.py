@@ -1,10 +1,17 @@
 """Random agents on de_dust2: every agent picks a uniformly random allowed action whenever it
 needs a decision, for a few rounds; prints how each round ended and what it cost.
 
-    python examples/random_agents.py --rounds 3 --seed 0 --mover kinematic
+    python examples/random_agents.py --rounds 3 --seed 0 --mover kinematic --models shipped
 
-Random walkers rarely reach a bomb site from the T spawn, let alone STOP there for the 3.2 s
-plant, and no damage model ships yet (so nobody dies): most rounds end "TargetSaved" at 115 s.
+Combat: `--models shipped` (the default) shoots with the DIP and DOG damage models shipped with
+decoy (`models/`, trained by the project; see their cards), `--models none` turns shooting off
+(nobody dies), and `--models FOLDER` uses another model folder (e.g. from `decoy models
+import-decoy`). In code it is `DecoyParallelEnv(damage_model="shipped" | "none" | folder)`; the
+environment's own default is no combat.
+
+Random walkers stay near their spawns (in the seed-0 round the two sides never come closer than
+about 50 m): they rarely reach a bomb site, let alone STOP there for the 3.2 s plant, and rarely
+meet, so even with combat on most rounds end "TargetSaved" at 115 s.
 """
 
 from __future__ import annotations
@@ -29,11 +36,17 @@ def main() -> None:
         default="kinematic",
         help="kinematic (no collisions) or physics (pybullet capsules that block each other)",
     )
+    parser.add_argument(
+        "--models",
+        default="shipped",
+        help='damage models: "shipped" (the DIP and DOG shipped with decoy), "none" (no '
+        "shooting) or a model folder",
+    )
     args = parser.parse_args()
     if args.rounds < 1:
         parser.error("--rounds must be at least 1")
 
-    env = DecoyParallelEnv(mover=args.mover)
+    env = DecoyParallelEnv(mover=args.mover, damage_model=args.models)
     rng = np.random.default_rng(args.seed)
     print(f"{'round':>5} {'winner':>6} {'reason':<14} {'ticks':>6} {'decisions':>9} {'wall s':>7}")
     try:

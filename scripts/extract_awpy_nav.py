@@ -5,7 +5,7 @@ Run once by a maintainer (the project never imports awpy):
     pip download awpy==1.3.1 --no-deps -d /tmp/awpy
     python scripts/extract_awpy_nav.py /tmp/awpy/awpy-1.3.1.tar.gz
 
-Writes `decoy_cli/assets/de_dust2/nav_areas.csv` (one row per nav area: id, place name and the
+Writes `assets/de_dust2/nav_areas.csv` (one row per nav area: id, place name and the
 two corner points awpy kept, in Hammer units), `nav_connections.csv` (directed area pairs) and
 `map.json` (radar transform and attribution). awpy names the corners "northWest" and "southEast",
 but in its data the first corner is always the minimum x and minimum y: the files here use
@@ -23,7 +23,7 @@ from pathlib import Path
 
 AWPY_VERSION = "1.3.1"
 MAP = "de_dust2"
-OUT = Path(__file__).resolve().parents[1] / "decoy_cli" / "assets" / MAP
+OUT = Path(__file__).resolve().parents[1] / "assets" / MAP
 
 
 def _member(archive: tarfile.TarFile, suffix: str) -> str:

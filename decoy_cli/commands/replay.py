@@ -38,7 +38,7 @@ def replay(
     models: str = typer.Option(
         "shipped",
         "--models",
-        help='Damage models for shooting: "shipped" (decoy_cli/models), "none" (no shooting: '
+        help='Damage models for shooting: "shipped" (models/), "none" (no shooting: '
         "deaths in the data are scripted) or a model folder (e.g. from `decoy models "
         "import-decoy`).",
     ),

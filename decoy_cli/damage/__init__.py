@@ -20,14 +20,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from decoy_cli.errors import ModelError
+from decoy_cli.package_data import packaged_dir
 
 if TYPE_CHECKING:
     from decoy_cli.sim.combat import DamageModel
 
-SHIPPED_MODELS = Path(__file__).resolve().parents[1] / "models"
-"""The project's own trained DIP and DOG, shipped inside the package."""
+SHIPPED_MODELS = packaged_dir("models")
+"""The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
-CHOICES_HELP = '"shipped" (the models in decoy_cli/models), "none" (no shooting) or a model folder'
+CHOICES_HELP = (
+    '"shipped" (the DIP and DOG shipped with decoy), "none" (no shooting) or a model folder'
+)
 
 
 def shipped_models_installed() -> bool:

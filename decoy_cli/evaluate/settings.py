@@ -148,14 +148,17 @@ def code_fingerprint(map_name: str) -> str:
     runs in one process (a test's interrupted run and its resume) agree even if files change.
     """
     package = Path(__file__).resolve().parents[1]
-    files: list[Path] = []
+    files: list[tuple[str, Path]] = []
     for part in _CODE_PARTS:
         path = package / part
-        files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
-    files.extend(sorted(p for p in asset_dir(map_name).rglob("*") if p.is_file()))
+        for file in sorted(path.rglob("*.py")) if path.is_dir() else [path]:
+            files.append((file.relative_to(package).as_posix(), file))
+    assets = asset_dir(map_name)  # the top-level assets/ in a checkout, decoy_cli/assets installed
+    for file in sorted(p for p in assets.rglob("*") if p.is_file()):
+        files.append((f"assets/{map_name}/{file.relative_to(assets).as_posix()}", file))
     digest = hashlib.sha256()
-    for path in files:
-        digest.update(str(path.relative_to(package)).encode() + b"\0")
+    for name, path in files:
+        digest.update(name.encode() + b"\0")
         digest.update(path.read_bytes())
     return digest.hexdigest()
 

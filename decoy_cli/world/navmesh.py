@@ -34,7 +34,6 @@ import csv
 import json
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +42,7 @@ from scipy.sparse.linalg import lsqr
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import WorldError
+from decoy_cli.package_data import packaged_dir
 from decoy_cli.world.world import World
 
 BUILTIN_MAP = "de_dust2"
@@ -135,8 +135,8 @@ class NavMesh:
 
 
 def asset_dir(map_name: str = BUILTIN_MAP) -> Path:
-    """Folder of a built-in map's assets inside the installed package."""
-    return Path(str(resources.files("decoy_cli") / "assets" / map_name))
+    """Folder of a built-in map's assets (top-level `assets/`, installed as decoy_cli.assets)."""
+    return packaged_dir("assets") / map_name
 
 
 @cache
