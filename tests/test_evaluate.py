@@ -28,15 +28,8 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
 from decoy_cli.evaluate.cache import RunCache
-from decoy_cli.evaluate.job import (
-    PlaceFinder,
-    RoundTask,
-    evaluate_round,
-    grid_sums,
-    hp_stats,
-    is_synthetic,
-    read_grid_sums,
-)
+from decoy_cli.evaluate.job import RoundTask, evaluate_round, is_synthetic
+from decoy_cli.evaluate.record import PlaceFinder, grid_sums, hp_stats, read_grid_sums
 from decoy_cli.evaluate.report import FAILURE_COLUMNS
 from decoy_cli.evaluate.runner import Evaluation, ProgressEvent, make_settings, run_evaluation
 from decoy_cli.evaluate.settings import EvalSettings, HeatGrid

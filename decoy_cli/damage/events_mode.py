@@ -17,7 +17,7 @@ minus the player's hpDamageTaken in the round before the tick. Armor and helmet,
 are inferred per round and player: armor if any hit on the player removed armor; helmet if a
 head hit removed armor, no helmet if a head hit removed none, else helmet = armor; a player
 never hit counts as armored with a helmet. The biases of this proxy are stated in
-decoy_cli/models/DIP_CARD.md.
+models/DIP_CARD.md.
 """
 
 from __future__ import annotations

@@ -15,7 +15,8 @@ from typing import Any
 import msgspec
 import numpy as np
 
-from decoy_cli.evaluate.job import FileIndex, RoundRecord
+from decoy_cli.evaluate.job import FileIndex
+from decoy_cli.evaluate.record import RoundRecord
 from decoy_cli.files import write_atomic
 
 CACHE_DIR = "cache"

@@ -34,12 +34,11 @@ from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.job import (
     FileIndex,
     IndexTask,
-    RoundRecord,
     RoundTask,
     evaluate_round,
     index_file,
-    place_names,
 )
+from decoy_cli.evaluate.record import RoundRecord, place_names
 from decoy_cli.evaluate.settings import (
     EvalSettings,
     HeatGrid,

@@ -41,6 +41,7 @@ _CODE_PARTS = (
     "world",
     "damage",
     "evaluate/job.py",
+    "evaluate/record.py",
     "evaluate/settings.py",
 )
 """The package's modules that decide a round's result (presentation code is left out)."""

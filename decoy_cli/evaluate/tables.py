@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from decoy_cli.evaluate.job import PLAYER_COLUMNS, ROUND_COLUMNS, RoundRecord, read_grid_sums
+from decoy_cli.evaluate.record import PLAYER_COLUMNS, ROUND_COLUMNS, RoundRecord, read_grid_sums
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.metrics import (
     GROUPS,

@@ -1,1 +1,32 @@
-"""The headless simulator: round state, movement, line of sight and combat, bomb rules, env."""
+"""The headless simulator: round state, movement, line of sight and combat, bomb rules, env.
+
+Entry points: `RoundSetup` and `open_round` (decoy_cli/sim/setup.py) build a ready `Simulator`
+for a round; `DecoyParallelEnv` is the PettingZoo environment over it. They are imported on
+first use, so importing one part of the simulator does not load PettingZoo or gymnasium.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from decoy_cli.sim.engine import Decision, Simulator
+    from decoy_cli.sim.env import DecoyParallelEnv
+    from decoy_cli.sim.setup import RoundSetup, open_round
+
+_EXPORTS = {
+    "Decision": "decoy_cli.sim.engine",
+    "Simulator": "decoy_cli.sim.engine",
+    "DecoyParallelEnv": "decoy_cli.sim.env",
+    "RoundSetup": "decoy_cli.sim.setup",
+    "open_round": "decoy_cli.sim.setup",
+}
+
+__all__ = ["Decision", "DecoyParallelEnv", "RoundSetup", "Simulator", "open_round"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        return getattr(import_module(_EXPORTS[name]), name)
+    raise AttributeError(f"module 'decoy_cli.sim' has no attribute {name!r}")

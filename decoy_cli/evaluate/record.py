@@ -1,0 +1,323 @@
+"""The compact result of one replayed round: what the aggregate tables and figures need.
+
+A `RoundRecord` holds, for one round: the per-player and per-round table rows, 2-D histogram
+counts of original and replayed positions on the fixed `HeatGrid` and the replay's distance
+error by original position, sample counts and errors by nav place, and HP as integer sums
+(pooled, per data frame and per time bin): integers only, so the aggregates are exact and do
+not depend on the order in which rounds finish. `build_record` makes it from a replay.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+import numpy as np
+
+from decoy_cli.esta import Round
+from decoy_cli.evaluate.settings import HeatGrid
+from decoy_cli.metrics import METRIC_NAMES, player_metrics
+
+if TYPE_CHECKING:
+    from decoy_cli.evaluate.job import RoundTask
+    from decoy_cli.replay.replayer import ReplayResult
+    from decoy_cli.waypoints.graph import WaypointGraph
+
+
+class HpStats(msgspec.Struct, frozen=True, array_like=True):
+    """Integer HP sums of one round over its player-frames with a known original HP.
+
+    `pooled` = [n, Σo, Σs, Σo², Σs², Σo·s, Σ(o−s)²]; `frame_*` per data frame index (for the
+    population-mean curves); `bin_*` per bin of the HP time grid starting at `bin_first`.
+    """
+
+    pooled: list[int]
+    frame_count: list[int]
+    frame_sum_original: list[int]
+    frame_sum_replay: list[int]
+    bin_first: int
+    bin_count: list[int]
+    bin_sum_original: list[int]
+    bin_sum2_original: list[int]
+    bin_sum_replay: list[int]
+    bin_sum2_replay: list[int]
+
+
+class RoundRecord(msgspec.Struct, frozen=True):
+    """The result of one round (see the module docstring); cached as one msgpack file."""
+
+    key: str
+    file_sha: str
+    match_id: str
+    round_num: int
+    round: dict[str, Any]
+    """The rounds.csv row, but `file` (where the content was read, set by whoever reads it)."""
+    players: list[dict[str, Any]]
+    heat_original: bytes
+    """Alive samples by grid cell of the original position (`grid_sums` encoding)."""
+    heat_replay: bytes
+    """Alive samples by grid cell of the replayed position."""
+    heat_off_graph: bytes
+    """Original alive samples with no waypoint on their floor, by grid cell."""
+    heat_error: bytes
+    """Samples alive in both, with their summed distance original-replay in integer mm, by
+    grid cell of the original position (`grid_sums` with weights)."""
+    places_original: list[int]
+    """Samples by nav place: index i counts `place_names(graph)[i]`."""
+    places_off_graph: list[int]
+    """Original samples with no waypoint on their floor (the replay cannot stand there)."""
+    places_replay: list[int]
+    places_error_count: list[int]
+    """Samples alive in both by the original position's place, and their summed distance (mm)."""
+    places_error_mm: list[int]
+    hp: HpStats
+
+
+_REPLAY_COLUMNS = ("late_share", "late_p95_s", "stuck", "recoveries", "relocations")
+"""Player columns taken as they are from `metrics.player_metrics`: timing and the mover's
+troubles."""
+
+PLAYER_COLUMNS = (
+    "match",
+    "round",
+    "player",
+    "side",
+    "frames_original",
+    "frames_replay",
+    "died_original",
+    "died_replay",
+    "death",
+    "death_time_original_s",
+    "death_time_replay_s",
+    "hp_frames",
+    "hp_rmse",
+    "hp_final_original",
+    "hp_final_replay",
+    *_REPLAY_COLUMNS,
+)
+"""Columns of a player row before the trajectory metrics and `reason` (players.csv)."""
+
+ROUND_COLUMNS = (
+    "match",
+    "round",
+    "file",
+    "frames",
+    "seconds",
+    "players_t",
+    "players_ct",
+    "winner_original",
+    "reason_original",
+    "winner_replay",
+    "reason_replay",
+    "played_out_s",
+    "stuck",
+    "recoveries",
+    "relocations",
+    "wall_seconds",
+)
+"""Columns of a round row (rounds.csv)."""
+
+
+def build_record(
+    task: RoundTask, round_: Round, result: ReplayResult, places: PlaceFinder, seconds: float
+) -> RoundRecord:
+    """The `RoundRecord` of a replayed round (see the module docstring)."""
+    settings = task.settings
+    rec = result.recording
+    metrics = player_metrics(round_, result.trace())
+    frame_seconds = np.asarray(round_.frame_seconds, dtype=np.float64)
+    original = np.asarray(round_.position, dtype=np.float64)  # (P, F, 3)
+    present = np.asarray(round_.present, dtype=bool)
+    alive_o = np.asarray(round_.alive, dtype=bool) & present & np.isfinite(original).all(axis=2)
+    alive_r = rec.alive.T & present  # (P, F)
+    hp_o = np.asarray(round_.hp, dtype=np.int64)  # (P, F), -1 unknown
+    hp_r = rec.hp.T.astype(np.int64)
+    hp_known = present & (hp_o >= 0)
+
+    players = []
+    for p, row in enumerate(metrics.to_dict("records")):
+        replay_death = np.nan
+        if row["died_replay"]:
+            last_alive = int(np.flatnonzero(rec.alive[:, p])[-1])
+            replay_death = float(frame_seconds[min(last_alive + 1, len(frame_seconds) - 1)])
+        known = np.flatnonzero(hp_known[p])
+        diff = hp_o[p, known] - hp_r[p, known]
+        players.append(
+            {
+                "match": round_.match_id,
+                "round": round_.round_num,
+                "player": row["player"],
+                "side": row["side"],
+                "frames_original": int(alive_o[p].sum()),
+                "frames_replay": int(alive_r[p].sum()),
+                "died_original": bool(row["died_original"]),
+                "died_replay": bool(row["died_replay"]),
+                "death": row["death"],
+                "death_time_original_s": float(result.plan.plans[p].death_seconds),
+                "death_time_replay_s": replay_death,
+                "hp_frames": len(known),
+                "hp_rmse": float(np.sqrt(np.mean(diff**2))) if len(known) else np.nan,
+                "hp_final_original": int(hp_o[p, known[-1]]) if len(known) else -1,
+                "hp_final_replay": int(hp_r[p, known[-1]]) if len(known) else -1,
+                **{name: row[name] for name in _REPLAY_COLUMNS},
+                **{name: float(row[name]) for name in METRIC_NAMES},
+                "reason": row["reason"],
+            }
+        )
+    sides = [p.side for p in round_.players]
+    round_row = {
+        "match": round_.match_id,
+        "round": round_.round_num,
+        "frames": int(round_.num_frames),
+        "seconds": float(frame_seconds[-1] - frame_seconds[0]) if len(frame_seconds) else 0.0,
+        "players_t": sides.count("T"),
+        "players_ct": sides.count("CT"),
+        "winner_original": round_.winning_side,
+        "reason_original": round_.end_reason,
+        "winner_replay": result.outcome.winner if result.outcome else None,
+        "reason_replay": result.outcome.reason if result.outcome else None,
+        "played_out_s": round(result.played_out_s, 3),
+        "stuck": int(metrics["stuck"].sum()),
+        "recoveries": int(metrics["recoveries"].sum()),
+        "relocations": int(metrics["relocations"].sum()),
+        "wall_seconds": round(seconds, 4),
+    }
+    replayed = rec.position.transpose(1, 0, 2)  # (P, F, 3) like the original
+    points_o = original[alive_o]  # (M, 3), player-major
+    points_r = replayed[alive_r]
+    both = alive_o & alive_r
+    error_mm = np.rint(1000 * np.linalg.norm(original[both] - replayed[both], axis=1))
+    n_places = len(places.names)
+    place_o, on_floor = places.find(points_o)
+    place_r, _ = places.find(points_r)
+    place_both = place_o[both[alive_o]]
+    return RoundRecord(
+        key=task.key,
+        file_sha=task.file_sha,
+        match_id=round_.match_id,
+        round_num=round_.round_num,
+        round=round_row,
+        players=players,
+        heat_original=grid_sums(settings.grid, points_o),
+        heat_replay=grid_sums(settings.grid, points_r),
+        heat_off_graph=grid_sums(settings.grid, points_o[~on_floor]),
+        heat_error=grid_sums(settings.grid, original[both], error_mm.astype(np.int64)),
+        places_original=np.bincount(place_o, minlength=n_places).tolist(),
+        places_off_graph=np.bincount(place_o[~on_floor], minlength=n_places).tolist(),
+        places_replay=np.bincount(place_r, minlength=n_places).tolist(),
+        places_error_count=np.bincount(place_both, minlength=n_places).tolist(),
+        places_error_mm=np.bincount(place_both, weights=error_mm, minlength=n_places)
+        .astype(np.int64)
+        .tolist(),
+        hp=hp_stats(
+            hp_o[hp_known],
+            hp_r[hp_known],
+            np.nonzero(hp_known)[1],
+            frame_seconds,
+            settings.hp_bin_s,
+            settings.hp_bins,
+        ),
+    )
+
+
+def grid_sums(grid: HeatGrid, points: np.ndarray, weights: np.ndarray | None = None) -> bytes:
+    """Sparse per-cell sample counts of x-y points on the grid, and with integer `weights`
+    their per-cell sums: uint32 distinct flat cell indices, counts[, sums], little-endian.
+    Points outside the grid are left out."""
+    i = np.floor((points[:, 0] - grid.x0) / grid.cell).astype(np.int64)
+    j = np.floor((points[:, 1] - grid.y0) / grid.cell).astype(np.int64)
+    inside = (i >= 0) & (i < grid.nx) & (j >= 0) & (j < grid.ny)
+    cells, inverse, counts = np.unique(
+        j[inside] * grid.nx + i[inside], return_inverse=True, return_counts=True
+    )
+    parts = [cells, counts]
+    if weights is not None:
+        sums = np.bincount(inverse, weights=np.asarray(weights)[inside], minlength=len(cells))
+        parts.append(sums.astype(np.int64))
+    return b"".join(part.astype("<u4").tobytes() for part in parts)
+
+
+def read_grid_sums(data: bytes, columns: int = 2) -> list[np.ndarray]:
+    """The int64 arrays of a `grid_sums` encoding: cells, counts (and sums: `columns` = 3)."""
+    values = np.frombuffer(data, dtype="<u4").astype(np.int64)
+    return list(values.reshape(columns, -1))
+
+
+NO_PLACE = "(no place)"
+
+
+def place_names(graph: WaypointGraph) -> list[str]:
+    """The place labels of the per-place counts: the graph's places, then `NO_PLACE`."""
+    return [*graph.place_names, NO_PLACE]
+
+
+class PlaceFinder:
+    """The nav place of positions: the place of the nearest waypoint on the position's floor,
+    or, for a position with no waypoint on its floor, of the nearest waypoint in x-y."""
+
+    def __init__(self, graph: WaypointGraph) -> None:
+        from scipy.spatial import cKDTree
+
+        self.graph = graph
+        self.names = place_names(graph)
+        self._place = np.where(graph.node_place < 0, len(self.names) - 1, graph.node_place)
+        self._tree_xy = cKDTree(graph.positions[:, :2])
+
+    def find(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(place index into `names`, whether a waypoint is on the point's floor) per point."""
+        if not len(points):
+            return np.zeros(0, np.int64), np.zeros(0, bool)
+        nodes, _ = self.graph.nearest(points)
+        on_floor = nodes >= 0
+        if not on_floor.all():
+            _, nodes[~on_floor] = self._tree_xy.query(points[~on_floor, :2])
+        return self._place[nodes].astype(np.int64), on_floor
+
+
+def hp_stats(
+    original: np.ndarray,
+    replay: np.ndarray,
+    frame_index: np.ndarray,
+    frame_seconds: np.ndarray,
+    bin_s: float,
+    bins: int,
+) -> HpStats:
+    """Integer HP sums of pooled player-frames (original, replay HP at frame `frame_index`)."""
+    o = np.asarray(original, dtype=np.int64)
+    s = np.asarray(replay, dtype=np.int64)
+    frames = np.asarray(frame_index, dtype=np.int64)
+    size = len(frame_seconds)
+    pooled = [
+        len(o),
+        int(o.sum()),
+        int(s.sum()),
+        int((o * o).sum()),
+        int((s * s).sum()),
+        int((o * s).sum()),
+        int(((o - s) ** 2).sum()),
+    ]
+    frame_bin = np.floor(np.asarray(frame_seconds, dtype=np.float64) / bin_s).astype(np.int64)
+    b = frame_bin[frames] if len(frames) else np.zeros(0, np.int64)
+    keep = (b >= 0) & (b < bins)
+    b, bo, bs = b[keep], o[keep], s[keep]
+    first = int(b.min()) if len(b) else 0
+    length = int(b.max()) - first + 1 if len(b) else 0
+
+    def per_bin(weights: np.ndarray | None) -> list[int]:
+        return np.bincount(b - first, weights=weights, minlength=length).astype(np.int64).tolist()
+
+    def per_frame(weights: np.ndarray | None) -> list[int]:
+        return np.bincount(frames, weights=weights, minlength=size).astype(np.int64).tolist()
+
+    return HpStats(
+        pooled=pooled,
+        frame_count=per_frame(None),
+        frame_sum_original=per_frame(o),
+        frame_sum_replay=per_frame(s),
+        bin_first=first,
+        bin_count=per_bin(None),
+        bin_sum_original=per_bin(bo),
+        bin_sum2_original=per_bin(bo * bo),
+        bin_sum_replay=per_bin(bs),
+        bin_sum2_replay=per_bin(bs * bs),
+    )
