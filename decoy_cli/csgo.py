@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import math
 
+BUILTIN_MAP = "de_dust2"
+"""The map whose world, waypoint graph and bomb sites ship with the project."""
+
 HAMMER_TO_M = 0.01905
 """One Hammer unit in metres."""
 

@@ -15,6 +15,7 @@ import time
 
 import numpy as np
 
+from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.sim.combat import DamageModel, LineOfSight, apply_damage, make_batch
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
@@ -65,7 +66,7 @@ def time_steps(
         t0 = time.perf_counter()
         pairs = los.visible_pairs(agents)
         t1 = time.perf_counter()
-        batch = make_batch(agents, pairs, "de_dust2")
+        batch = make_batch(agents, pairs, BUILTIN_MAP)
         t2 = time.perf_counter()
         result = model(batch, rng)
         t3 = time.perf_counter()

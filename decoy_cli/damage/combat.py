@@ -18,15 +18,13 @@ few matrix products: every BatchNorm into the Linear before it
 (`torch.nn.utils.fusion.fuse_linear_bn_eval`), the four encoder branches into one block-diagonal
 Linear over the concatenated features, DOG's two heads into one, Dropout dropped (the identity in
 eval mode). The result equals the modules' forward up to float rounding (tested); it is a
-snapshot: later changes to the networks' weights are not seen. Measured in
-benchmarks/bench_damage.py, the folding took a 5v5 step's inference from about 0.5 ms to about
-0.2 ms.
+snapshot: later changes to the networks' weights are not seen. The folding makes a small
+step's inference several times faster (benchmarks/bench_damage.py measures it).
 
 Threads: by default the inference runs on one torch thread (the previous count is restored
-after each call). Measured on the 2-core machines shared with other jobs, torch's default of
-two threads made a 300 x 128 product 12 times slower (1.9 ms against 0.15 ms) and a 50v50 step's
-inference up to a hundred times slower, while on an idle machine it saved at most a third on
-the largest batches (5,000 pairs) and nothing at 5v5. `threads=None` keeps torch's setting.
+after each call): on machines shared with other jobs, torch's default of one thread per core
+made small products many times slower, while on an idle machine it saved little, and only on
+the largest batches (benchmarks/bench_damage.py). `threads=None` keeps torch's setting.
 """
 
 from __future__ import annotations

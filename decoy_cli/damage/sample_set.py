@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage.features import Features, FeatureSpec, encode
 from decoy_cli.esta import RoundFailure
 from decoy_cli.sim.combat import CombatBatch
@@ -91,7 +92,7 @@ class Samples:
             victim_helmet=self.victim_helmet[rows],
             distance=np.linalg.norm(delta, axis=1),
             bearing=bearing,
-            map_name=str(maps[0]) if len(maps) else "de_dust2",
+            map_name=str(maps[0]) if len(maps) else BUILTIN_MAP,
         )
 
     def features(self, spec: FeatureSpec) -> Features:

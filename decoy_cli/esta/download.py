@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import BinaryIO
 
 from decoy_cli import __version__
+from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.errors import DownloadError, EstaError, OutputError
 from decoy_cli.esta.reader import read_match
 from decoy_cli.esta.source import XZ_MAGIC
@@ -49,7 +50,7 @@ SUBSETS = ("lan", "online")
 DEFAULT_DEST = Path("decoy-out") / "data" / "esta"
 """Where downloaded matches go unless told otherwise (`decoy evaluate` can be pointed at it)."""
 
-MAP_NAME = "de_dust2"
+MAP_NAME = BUILTIN_MAP
 SUFFIX = ".json.xz"
 CHUNK_BYTES = 1 << 16
 LFS_POINTER = b"version https://git-lfs.github.com/spec/"

@@ -40,12 +40,10 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.linalg import lsqr
 
-from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.package_data import packaged_dir
 from decoy_cli.world.world import World
-
-BUILTIN_MAP = "de_dust2"
 
 WALL_PUSH_U = 16.0
 """How far walls stand beyond the nav edge (half a player hull)."""
