@@ -29,8 +29,8 @@ from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.job import RoundTask, evaluate_round, is_synthetic
+from decoy_cli.evaluate.outputs import FAILURE_COLUMNS
 from decoy_cli.evaluate.record import PlaceFinder, grid_sums, hp_stats, read_grid_sums
-from decoy_cli.evaluate.report import FAILURE_COLUMNS
 from decoy_cli.evaluate.runner import Evaluation, ProgressEvent, make_settings, run_evaluation
 from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
 from decoy_cli.evaluate.tables import Tables, build_tables, hp_metrics_from_sums

@@ -23,6 +23,7 @@ from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
+from decoy_cli.evaluate.outputs import write_outputs
 from decoy_cli.evaluate.report import (
     RunInfo,
     combat_caveats,
@@ -31,7 +32,6 @@ from decoy_cli.evaluate.report import (
     mechanics,
     num,
     table_groups,
-    write_outputs,
 )
 from decoy_cli.evaluate.runner import (
     Evaluation,

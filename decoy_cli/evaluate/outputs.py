@@ -1,0 +1,131 @@
+"""Write an evaluation's outputs: the CSV tables, summary.json, the figures and report.md.
+
+Every file is written atomically; a file that cannot be written (a full disk) is one
+OutputError, and what was written before it stays. Every output is written on every run (empty
+tables keep their header), so a folder never mixes files of two runs.
+
+Layout of the output folder:
+
+* `players.csv` (one row per player-round), `rounds.csv`, `failures.csv`;
+* `tables/`: `trajectory.csv`, `unevaluated.csv`, `combat.csv`, `death_counts.csv`,
+  `outcome_winner_confusion.csv`, `outcome_reason_confusion.csv`, `hp_over_time.csv`,
+  `places.csv`;
+* `summary.json`: what was run and every aggregate table;
+* `figures/`: see decoy_cli/evaluate/figures.py; `report.md` (decoy_cli/evaluate/report.py)
+  shows them all;
+* `cache/`: the per-round results (decoy_cli/evaluate/cache.py).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from decoy_cli.evaluate.figures import draw_figures
+from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
+from decoy_cli.evaluate.runner import Evaluation
+from decoy_cli.evaluate.tables import Tables
+from decoy_cli.files import json_ready, write_atomic, write_json
+
+FAILURE_COLUMNS = ("file", "round", "kind", "message")
+
+
+def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
+    """Write every output (see the module docstring); returns the paths written."""
+    from decoy_cli.world.navmesh import load_navmesh
+
+    written = [
+        _csv(out / "players.csv", tables.players),
+        _csv(out / "rounds.csv", tables.rounds),
+        _csv(out / "failures.csv", failures_frame(evaluation)),
+    ]
+    folder = out / "tables"
+    frames = {
+        "trajectory": tables.trajectory,
+        "unevaluated": tables.summary.unevaluated,
+        "combat": tables.combat,
+        "death_counts": pd.DataFrame([tables.deaths.counts]),
+        "outcome_winner_confusion": _confusion(tables, "winner_confusion"),
+        "outcome_reason_confusion": _confusion(tables, "end_reason_confusion"),
+        "hp_over_time": tables.hp_curve,
+        "places": tables.places,
+    }
+    written += [_csv(folder / f"{name}.csv", frame) for name, frame in frames.items()]
+    written.append(
+        write_json(out / "summary.json", summary(evaluation, tables, info), sort_keys=False)
+    )
+    figures = draw_figures(out / "figures", evaluation.accumulator, tables, load_navmesh())
+    written += list(figures.values())
+    text = report_markdown(
+        evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}
+    )
+    written.append(write_atomic(out / "report.md", text.encode()))
+    return written
+
+
+def failures_frame(evaluation: Evaluation) -> pd.DataFrame:
+    rows = [
+        {"file": f.file, "round": f.round_num, "kind": f.kind, "message": f.message}
+        for f in evaluation.failures
+    ]
+    return pd.DataFrame(rows, columns=list(FAILURE_COLUMNS)).astype({"round": "Int64"})
+
+
+def _confusion(tables: Tables, name: str) -> pd.DataFrame:
+    matrix = getattr(tables.outcome, name, None) if tables.outcome is not None else None
+    if matrix is None:
+        return pd.DataFrame(columns=["original"])
+    return matrix.reset_index()
+
+
+def _csv(path: Path, frame: pd.DataFrame) -> Path:
+    return write_atomic(path, frame.to_csv(index=False).encode())
+
+
+def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
+    return json_ready(frame.astype(object).where(frame.notna(), None).to_dict("records"))
+
+
+def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, Any]:
+    """What was run and every aggregate, as one JSON-able dict."""
+    settings = evaluation.settings
+    outcome = tables.outcome
+    return json_ready(
+        {
+            "data": data_kind(evaluation),
+            "command": info.command,
+            "backend": info.backend,
+            "machine": info.machine,
+            "inputs": [str(p) for p in evaluation.inputs],
+            "options": {
+                "map": settings.map_name,
+                "combat": settings.combat,
+                "bomb": settings.bomb,
+                "models": settings.models,
+                "mover": settings.mover,
+                "seed": settings.seed,
+                "sample": info.sample,
+            },
+            "mechanics": mechanics(evaluation.settings),
+            "counts": run_counts(evaluation, tables),
+            "wall_seconds": evaluation.wall_seconds,
+            "compute_seconds": evaluation.compute_seconds,
+            "trajectory": _records(tables.trajectory),
+            "unevaluated": _records(tables.summary.unevaluated),
+            "combat": _records(tables.combat),
+            "death_counts": tables.deaths.counts,
+            "outcome_winner_confusion": None
+            if outcome is None
+            else outcome.winner_confusion.to_dict(),
+            "outcome_reason_confusion": None
+            if outcome is None or outcome.end_reason_confusion is None
+            else outcome.end_reason_confusion.to_dict(),
+            "failures_by_kind": dict(Counter(f.kind for f in evaluation.failures)),
+        }
+    )
+
+
+# ---- the Markdown report ------------------------------------------------------------------------

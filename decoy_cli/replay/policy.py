@@ -1,0 +1,136 @@
+"""The timed plan as an engine policy: each agent reaches each data frame's waypoint by its time.
+
+`PlanPolicy` executes the timed plans of `snap_round` (see decoy_cli/replay/plans.py for the
+contract): each move runs at the speed that reaches the interval's target waypoint by its frame
+time (capped by the weapon's CS:GO maximum, or the interval's cap), a STOP holds until the
+deadline (so an agent early waits, one late catches up instead of drifting), and the arrival
+at every target is logged against its deadline in an `AgentLog` (the lateness).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from decoy_cli.csgo import TICK_RATE
+from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.waypoints.graph import STOP_ACTION
+
+_FOREVER = 10**9
+
+
+@dataclass
+class AgentLog:
+    """What happened to one agent's plan: arrival at each target against its deadline."""
+
+    arrival_tick: np.ndarray  # (T,) tick the agent stood at each target, -1 = never
+    deadline_tick: np.ndarray  # (T,)
+    relocations: int = 0
+
+    @property
+    def lateness_s(self) -> np.ndarray:
+        """(T,) seconds late at each reached target (0 when on time or early), NaN if unreached."""
+        late = np.where(
+            self.arrival_tick >= 0,
+            np.maximum(0, self.arrival_tick - self.deadline_tick) / TICK_RATE,
+            np.nan,
+        )
+        return late
+
+
+class PlanPolicy:
+    """Executes timed plans (see decoy_cli/replay/plans.py for the contract)."""
+
+    def __init__(
+        self,
+        plans: list[PlayerPlan],
+        tick_of: Callable[[float], int],
+        graph_edge_length: np.ndarray,
+        plant_from_tick: int | None = None,
+        defuse_from_tick: dict[int, int] | None = None,
+        interval_caps: list[np.ndarray] | None = None,
+    ) -> None:
+        self.plans = plans
+        self.interval_caps = interval_caps  # per plan: (T-1,) speed cap of each interval, m/s
+        self.tick_of = tick_of  # seconds -> simulator tick
+        self.next_action = np.zeros(len(plans), dtype=np.int64)
+        self.plant_from_tick = plant_from_tick
+        self.defuse_from_tick = defuse_from_tick or {}
+        self.logs = []
+        # per plan and action: path length of this and the later moves of its interval, and
+        # whether it is the last move of its interval
+        self._remaining = []
+        self._last_move = []
+        for plan in plans:
+            n_targets = len(plan.target_node)
+            arrival = np.full(n_targets, -1, dtype=np.int64)
+            if n_targets:
+                arrival[0] = tick_of(plan.target_seconds[0])
+            self.logs.append(
+                AgentLog(arrival, np.array([tick_of(s) for s in plan.target_seconds], np.int64))
+            )
+            lengths = np.where(
+                plan.action_edge >= 0, graph_edge_length[np.maximum(plan.action_edge, 0)], 0.0
+            )
+            remaining = np.zeros(len(plan.action))
+            last_move = np.zeros(len(plan.action), dtype=bool)
+            running = 0.0
+            seen: set[int] = set()
+            for a in range(len(plan.action) - 1, -1, -1):
+                interval = int(plan.action_interval[a])
+                if a == len(plan.action) - 1 or plan.action_interval[a + 1] != interval:
+                    running = 0.0
+                running += lengths[a]
+                remaining[a] = running
+                if plan.action_edge[a] >= 0 and interval not in seen:
+                    last_move[a] = True
+                    seen.add(interval)
+            self._remaining.append(remaining)
+            self._last_move.append(last_move)
+
+    def decide(self, sim: Simulator, agent: int) -> Decision:
+        plan = self.plans[agent]
+        now = sim.tick
+        plant = self.plant_from_tick is not None and now >= self.plant_from_tick
+        defuse = agent in self.defuse_from_tick and now >= self.defuse_from_tick[agent]
+        first_deadline = self.logs[agent].deadline_tick[0] if len(plan.target_node) else 0
+        if now < first_deadline:  # not on stage yet
+            return Decision(STOP_ACTION, hold_ticks=int(first_deadline - now), plant=plant)
+        a = int(self.next_action[agent])
+        if a > 0 and self._last_move[agent][a - 1]:  # just finished an interval's moves
+            self._arrive(agent, int(plan.action_interval[a - 1]), now)
+        while a < len(plan.action):
+            act = int(plan.action[a])
+            interval = int(plan.action_interval[a])
+            deadline = self.tick_of(plan.action_deadline_s[a])
+            if act == RELOCATE_ACTION and now < deadline:
+                return Decision(STOP_ACTION, hold_ticks=deadline - now, plant=plant)
+            a += 1
+            self.next_action[agent] = a
+            if act == RELOCATE_ACTION:
+                sim.relocate(agent, int(plan.action_node[a - 1]))
+                self.logs[agent].relocations += 1
+                self._arrive(agent, interval, now)
+                continue
+            if act == STOP_ACTION:
+                self._arrive(agent, interval, now)  # standing still: already at the target
+                if deadline > now:
+                    return Decision(
+                        STOP_ACTION, hold_ticks=deadline - now, plant=plant, defuse=defuse
+                    )
+                continue
+            seconds_left = (deadline - now) / TICK_RATE
+            speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
+            cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
+            return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
+        return Decision(STOP_ACTION, hold_ticks=_FOREVER, plant=plant, defuse=defuse)
+
+    def _arrive(self, agent: int, interval: int, now: int) -> None:
+        """Log the arrival at the target that ends `interval` (first arrival only)."""
+        log = self.logs[agent]
+        target = interval + 1
+        if 0 <= target < len(log.arrival_tick) and log.arrival_tick[target] < 0:
+            log.arrival_tick[target] = now
