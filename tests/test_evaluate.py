@@ -266,14 +266,19 @@ def test_an_interrupted_run_resumes_with_only_the_rest(
 
 
 def test_a_damaged_cache_file_is_computed_again(
-    clean: Path, settings: EvalSettings, pool: LocalBackend, tmp_path: Path
+    clean: Path,
+    settings: EvalSettings,
+    pool: LocalBackend,
+    reference: tuple[Evaluation, Tables],
+    tmp_path: Path,
 ) -> None:
     run_evaluation([clean], settings, tmp_path, pool)
     victim = sorted((tmp_path / "cache" / "rounds").glob("*.msgpack"))[0]
     victim.write_bytes(victim.read_bytes()[:50])
     rerun = run_evaluation([clean], settings, tmp_path, pool)
     assert (rerun.cached, rerun.computed) == (CLEAN_ROUNDS - 1, 1)
-    assert RunCache(tmp_path).load_round(victim.stem) is not None
+    assert RunCache(tmp_path).load_round(victim.stem) is not None  # readable again
+    assert_same_results(rerun, reference)  # and computed to the same numbers
 
 
 def test_a_sample_is_fixed_by_its_seed_not_by_the_paths(
