@@ -304,6 +304,7 @@ def test_replay_with_a_model_folder_shoots(match_file: Path, firing: Path, tmp_p
     events = pd.read_csv(out / "events.csv")
     damage = events[events["kind"] == "damage"]
     assert len(damage) > 0
+    assert (damage["tick"] % 30 == 0).all()  # only the combat step, every 30 ticks, shoots
     data = [json.loads(d) for d in damage["data"]]
     assert all(d["damage"] >= 1 and d["hit_group"] in range(6) for d in data)
     summary = json.loads((out / "summary.json").read_text())

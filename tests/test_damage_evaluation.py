@@ -135,6 +135,11 @@ def test_evaluate_dip_shapes() -> None:
     assert result.probabilities.shape == (300,)
     assert ((result.probabilities > 0) & (result.probabilities < 1)).all()
     assert result.metrics["threshold"] == 0.5
+    # the metrics are those of the returned probabilities at the threshold
+    predicted = result.probabilities >= 0.5
+    assert result.metrics["accuracy"] == pytest.approx(np.mean(predicted == samples.hit))
+    hits = int(samples.hit.sum())
+    assert result.metrics["recall"] == pytest.approx(np.sum(predicted & samples.hit) / hits)
     assert evaluate_dip(untrained_dip(), samples, threshold=0.2).metrics["threshold"] == 0.2
 
 

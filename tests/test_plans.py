@@ -306,11 +306,11 @@ def test_infeasible_interval_and_ratio() -> None:
     assert plan.interval_length_m.tolist() == pytest.approx([2.8, 0.7])
     assert plan.interval_required_speed_m_s.tolist() == pytest.approx([5.6, 1.4])
     assert plan.interval_max_speed_m_s.tolist() == pytest.approx([AK_M_S, KNIFE_M_S])
-    assert plan.interval_speed_ratio[0] == pytest.approx(1.3672709516)
-    assert plan.interval_speed_ratio[1] == pytest.approx(0.2939632546)
+    assert plan.interval_speed_ratio[0] == pytest.approx(5.6 / AK_M_S)
+    assert plan.interval_speed_ratio[1] == pytest.approx(1.4 / KNIFE_M_S)
     assert plan.interval_infeasible.tolist() == [True, False]
     assert plan.num_infeasible == 1
-    assert plan.worst_ratio == pytest.approx(1.3672709516)
+    assert plan.worst_ratio == pytest.approx(5.6 / AK_M_S)
 
 
 def test_speed_uses_weapon_at_interval_start_and_no_weapon_is_knife() -> None:
@@ -331,7 +331,7 @@ def test_interval_table_lists_every_interval() -> None:
     assert len(table) == 2
     assert table["infeasible"].tolist() == [True, False]
     assert table[["from_node", "to_node"]].values.tolist() == [[0, 20], [20, 21]]
-    assert table["ratio"].iloc[0] == pytest.approx(1.3672709516)
+    assert table["ratio"].iloc[0] == pytest.approx(5.6 / AK_M_S)
 
 
 # ---- alive, death and gaps --------------------------------------------------------------------

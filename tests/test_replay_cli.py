@@ -210,6 +210,11 @@ def test_replay_shoots_with_the_shipped_models_and_decides_the_round(tmp_path: P
     summary = json.loads((out / "summary.json").read_text())
     assert summary["damage_models"] == "shipped"
     assert summary["outcome_replay"]["winner"] in ("T", "CT")
-    assert summary["played_out_s"] >= 0
     events = pd.read_csv(out / "events.csv")
     assert "damage" in set(events["kind"])
+    # played on: the seconds from the data's last frame (the last recorded tick) to the round end
+    last_frame_tick = int(pd.read_csv(out / "replay.csv")["tick"].max())
+    (end_tick,) = events.loc[events["kind"] == "round_end", "tick"].tolist()
+    assert end_tick > last_frame_tick  # this round is left open by its data
+    assert summary["played_out_s"] == pytest.approx((end_tick - last_frame_tick) / 60, abs=1e-3)
+    assert f"({summary['played_out_s']:.1f} s after the data)" in result.stdout

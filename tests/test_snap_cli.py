@@ -177,6 +177,9 @@ def test_study_files_totals_and_failures(match_file: Path, tmp_path: Path) -> No
     assert places["intervals"].tolist() == [1] and places["share"].tolist() == [1.0]
     empty = combine([], metrics=True)
     assert empty.totals.player_rounds == 0 and empty.metrics is not None
+    # asked for metrics of nothing: every group is there, with nothing evaluated in it
+    assert empty.metrics.n_evaluated == {"T": 0, "CT": 0, "all": 0}
+    assert combine([], metrics=False).metrics is None
 
 
 # --- decoy snap FILE:ROUND ----------------------------------------------------------------

@@ -69,7 +69,9 @@ def test_train_writes_model_folder_and_report(trained: Path) -> None:
         "dog_reconstruction.png",
     ]
     dip, dog = load_dip(trained), load_dog(trained)
-    assert 0.0 <= dip.threshold <= 1.0
+    assert 0.0 <= dip.threshold <= 1.0  # a probability, not a logit
+    # the test metrics were taken at the threshold the model ships with
+    assert dip.metadata["test_metrics"]["threshold"] == dip.threshold
     units = dip.metadata["split"]["units"]
     assert [len(units[n]) for n in ("train", "val", "test")] == [6, 1, 1]
     assert not set(units["train"]) & set(units["test"])
