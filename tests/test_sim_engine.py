@@ -17,9 +17,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from decoy_cli.sim.engine import Decision, SimConfig, Simulator
+from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
+from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, EdgeKind, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -110,12 +111,9 @@ def make_sim(
     policy: Script | None = None,
     combat: FakeCombat | None = None,
     every: int = 30,
-    combat_on: bool = True,
-    max_ticks: int | None = None,
     **kwargs,
 ) -> Simulator:
-    """The one place that builds a Simulator (and its SimConfig) for these tests."""
-    config = SimConfig(combat=combat_on, combat_every_ticks=every, max_ticks=max_ticks)
+    """The one place that builds a Simulator for these tests (combat None: nobody shoots)."""
     return Simulator(
         LINE,
         agents,
@@ -123,7 +121,7 @@ def make_sim(
         policy or Script(),
         RULES,
         combat=combat,
-        config=config,
+        combat_every_ticks=every,
         seed=0,
         **kwargs,
     )
@@ -163,11 +161,15 @@ def test_a_round_nobody_wins_ends_target_saved_at_the_time_limit() -> None:
     assert sim.needs_decision.tolist() == [False, False]
 
 
-def test_max_ticks_bounds_the_run_from_the_start_tick() -> None:
-    sim = make_sim(t_and_ct(), max_ticks=50, start_tick=10)
+def test_a_late_start_still_ends_on_the_round_clock() -> None:
+    sim = make_sim(t_and_ct(), start_tick=10)
     sim.run()
-    assert sim.done
-    assert (sim.tick, sim.outcome, sim.events) == (60, None, [])
+    assert (sim.tick, sim.outcome) == (ROUND_TICKS, RoundOutcome("CT", "TargetSaved", ROUND_TICKS))
+
+
+def test_a_combat_step_more_often_than_every_tick_is_refused() -> None:
+    with pytest.raises(ValueError, match="combat_every_ticks"):
+        make_sim(t_and_ct(), combat=FakeCombat(), every=0)
 
 
 # ---- combat cadence --------------------------------------------------------------------------
@@ -191,10 +193,18 @@ def test_combat_runs_every_combat_every_ticks(every: int, start: int, expected: 
 
 
 def test_no_combat_when_it_is_switched_off() -> None:
-    combat = FakeCombat(kills={30: [(0, 1)]})
-    sim = make_sim(t_and_ct(), combat=combat, combat_on=False)
-    sim.run()
-    assert combat.ticks == []
+    """`RoundSetup(combat=False)` with a damage model: no combat step at all, nobody dies."""
+
+    def lethal(batch, rng):  # would kill at once; must never be called
+        raise AssertionError("the damage model was called with combat off")
+
+    setup = RoundSetup(
+        graph=LINE, combat=False, damage_model=lethal, rules=RULES.config, zones=RULES.zones
+    )
+    assert not setup.shooting and not setup.needs_physics
+    with open_round(setup, t_and_ct(), Script(), seed=0) as sim:
+        sim.run()
+    assert sim.combat is None
     assert sim.agents.alive.tolist() == [True, True]
     assert sim.outcome == RoundOutcome("CT", "TargetSaved", ROUND_TICKS)
 
@@ -398,3 +408,17 @@ def test_nothing_requested_nothing_recorded() -> None:
     rec = make_sim(t_and_ct()).run()
     assert rec.ticks.tolist() == []
     assert rec.position.shape == (0, 2, 3)
+
+
+def test_a_relocation_from_outside_a_decision_asks_the_agent_again() -> None:
+    """A walking agent relocated by the caller between ticks (not by its own policy) stops its
+    walk and is asked for a decision at the next tick, from the new node."""
+    policy = Script({0: [walk(E), walk(W)]})
+    sim = make_sim(t_and_ct(), policy=policy)
+    sim.run(until=lambda s: s.tick == 5)  # walking node 0 -> 1
+    sim.relocate(0, 3)
+    assert sim.needs_decision.tolist() == [True, False]
+    sim.step()
+    assert policy.ticks_of(0) == [1, 6]
+    sim.run(until=lambda s: s.tick == 6 + WALK_3)
+    assert sim.agents.node[0] == 2  # walked west from node 3

@@ -122,6 +122,7 @@ class Simulator:
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
+        self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
@@ -198,11 +199,18 @@ class Simulator:
         return self.recording
 
     def relocate(self, agent: int, node: int) -> None:
-        """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event."""
+        """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event.
+
+        Inside the agent's own decision the decision that follows says what it does next;
+        from anywhere else its walk or STOP ends and it is asked again at the next tick."""
         self.mover.place(agent, self.graph.positions[node])
         self.agents.position[agent] = self.graph.positions[node]
         self.agents.node[agent] = node
         self.goal_node[agent] = -1
+        if agent != self._deciding:
+            self.mover.clear_goal(agent)
+            self.hold_until[agent] = 0
+            self.waiting[agent] = bool(self.agents.alive[agent])
         self.events.append(SimEvent(self.tick, "relocate", agent, data={"node": int(node)}))
 
     def kill(self, agent: int, reason: str) -> None:
@@ -241,7 +249,9 @@ class Simulator:
             agent = int(agent)
             self.hold_until[agent] = 0
             self.waiting[agent] = False
+            self._deciding = agent
             decision = self.policy.decide(self, agent)
+            self._deciding = -1
             self.decisions[agent] += 1
             self.wants_plant[agent] = decision.plant
             self.wants_defuse[agent] = decision.defuse

@@ -55,7 +55,8 @@ class RoundSetup:
 
     `world` is the geometry for pybullet (None: the nav world of the graph's map); it is used
     only when a client is opened here, not when the caller lends one. `rules` overrides the
-    rules' durations and ranges (its `bomb_enabled` is replaced by `bomb`).
+    rules' durations and ranges (its `bomb_enabled` is replaced by `bomb`); `zones` the bomb
+    sites (None: the graph's bomb-site regions).
     """
 
     graph: WaypointGraph
@@ -66,6 +67,7 @@ class RoundSetup:
     combat_every_ticks: int = COMBAT_EVERY_TICKS
     world: World | None = None
     rules: RulesConfig | None = None
+    zones: SiteZones | None = None
 
     def __post_init__(self) -> None:
         check_mover(self.mover)
@@ -144,7 +146,8 @@ def open_round(
             los = LineOfSight(physics, agents.count)
             stack.callback(los.close)
             combat = CombatStep(los, setup.damage_model, setup.map_name)
-        rules = BombRules(SiteZones.from_graph(setup.graph), setup.rules_config())
+        zones = setup.zones if setup.zones is not None else SiteZones.from_graph(setup.graph)
+        rules = BombRules(zones, setup.rules_config())
         yield Simulator(
             setup.graph,
             agents,
