@@ -28,9 +28,10 @@ def draw_nav_areas(ax: Any, nav: Any, **style: Any) -> None:
         ],
         axis=1,
     )
-    look = {"facecolor": "#e6e6e6", "edgecolor": "#cfcfcf", "lw": 0.3, "zorder": 0}
+    look: dict[str, Any] = {"facecolor": "#e6e6e6", "edgecolor": "#cfcfcf", "lw": 0.3, "zorder": 0}
     look.update(style)
-    ax.add_collection(PolyCollection(corners * HAMMER_TO_M, **look))
+    # The stubs want a Sequence of polygons; a (N, 4, 2) array is one (and takes the fast path).
+    ax.add_collection(PolyCollection(corners * HAMMER_TO_M, **look))  # type: ignore[arg-type]
 
 
 def save_figure(fig: Any, path: str | Path, dpi: int = 130) -> None:

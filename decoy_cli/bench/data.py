@@ -151,8 +151,8 @@ def replay_throughput(
             started = time.perf_counter()
             cpu_started = time.process_time()
             try:
-                result = replay_round(item, graph, options, physics=physics)
-                player_metrics(item, result.trace())
+                replayed = replay_round(item, graph, options, physics=physics)
+                player_metrics(item, replayed.trace())
             except DecoyError as error:
                 failures.append(failure_from(error, item.path, item.round_num, "replay error"))
                 continue

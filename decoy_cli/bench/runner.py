@@ -28,6 +28,7 @@ from decoy_cli.bench.simspeed import (
     PAPER_DECISIONS,
     PAPER_TICKS_PER_S,
     NeverHits,
+    Switches,
     speed_table,
 )
 from decoy_cli.errors import DecoyError
@@ -82,7 +83,7 @@ class BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
         round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
         check_mover(mover)
-        switches = {"mover": mover, "combat": combat, "bomb": bomb, "seed": seed}
+        switches = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
         if not quick:
             return cls(quick=False, models=models, **switches)
         return cls(
@@ -160,8 +161,8 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
             "rows": [row.to_dict() for row in rows],
         }
     elif name == "combat_step":
-        rows = step_costs(model or NeverHits(), 5, config.combat_repeats, config.seed)
-        result = {"damage_model": status.label, "rows": rows}
+        costs = step_costs(model or NeverHits(), 5, config.combat_repeats, config.seed)
+        result = {"damage_model": status.label, "rows": costs}
     elif name == "replay":
         data = _needed(data, name)
         result = replay_throughput(

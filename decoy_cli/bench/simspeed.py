@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass
+from typing import TypedDict
 
 import numpy as np
 
@@ -56,6 +57,15 @@ class RandomPolicy:
         mask = sim.graph.action_mask(int(sim.agents.node[agent]))
         action = int(self.rng.choice(np.flatnonzero(mask)))
         return Decision(action, hold_ticks=30, plant=action == STOP_ACTION)
+
+
+class Switches(TypedDict):
+    """The mechanics a Table 1 run switches (keyword arguments of `run_agents`)."""
+
+    mover: str
+    combat: bool
+    bomb: bool
+    seed: int
 
 
 @dataclass
@@ -127,7 +137,11 @@ def run_agents(
         ) as sim:
             start_tick = sim.tick
             left = decisions - made
-            sim.run(until=lambda s, left=left: int(s.decisions.sum()) >= left)
+
+            def enough(s: Simulator, left: int = left) -> bool:
+                return int(s.decisions.sum()) >= left
+
+            sim.run(until=enough)
         made += int(sim.decisions.sum())
         ticks += sim.tick - start_tick
         kills += int((~agents.alive).sum())
@@ -171,7 +185,7 @@ def speed_table(
     """
     graph = builtin_graph()
     model = NeverHits() if model is None else model
-    options = {"mover": mover, "combat": combat, "bomb": bomb, "seed": seed}
+    options = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
     with PhysicsWorld(nav_world()) as physics:
         if warmup_decisions:
             run_agents(physics, graph, 2, warmup_decisions, model, **options)

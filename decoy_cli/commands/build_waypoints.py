@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from decoy_cli.errors import GraphError
@@ -97,7 +97,7 @@ def build_waypoints(
         console=console,
         transient=False,
     ) as progress:
-        tasks: dict[str, int] = {}
+        tasks: dict[str, TaskID] = {}
 
         def report(stage: str, done: int, total: int) -> None:
             if stage not in tasks:
@@ -183,7 +183,7 @@ def _show_alignment(console: Console, quality: SnapQuality, path: Path) -> None:
     table.add_row(
         "3-D", f"{quality.median_3d:.3f}", f"{quality.p95_3d:.3f}", f"{quality.within_3d:.2%}"
     )
-    if quality.grounded_within_3d is not None:
+    if quality.grounded_within_3d is not None and quality.airborne is not None:
         table.add_row(
             f"3-D, on the ground ({quality.positions - quality.airborne:,})",
             "",

@@ -11,6 +11,7 @@ from rich.progress import (
     BarColumn,
     DownloadColumn,
     Progress,
+    TaskID,
     TextColumn,
     TimeRemainingColumn,
     TransferSpeedColumn,
@@ -77,7 +78,7 @@ def download(
         for match_id in dict.fromkeys(ids):
             task = progress.add_task(escape(match_id), total=None)
 
-            def advance(done: int, total: int | None, task: int = task) -> None:
+            def advance(done: int, total: int | None, task: TaskID = task) -> None:
                 progress.update(task, completed=done, total=total)
 
             try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.console import Console
@@ -42,6 +43,9 @@ from decoy_cli.evaluate.runner import (
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+
+if TYPE_CHECKING:
+    from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
 
 DEFAULT_OUT = Path("decoy-out") / "evaluate"
 
@@ -112,6 +116,7 @@ def evaluate(
         map_name=map_name, combat=combat, bomb=bomb, models=models, mover=mover, seed=seed
     )
     command = command_line(inputs, settings, sample, out)
+    backend: DaskBackend | LocalBackend
     if scheduler:
         from decoy_cli.evaluate.backends import DaskBackend
 

@@ -80,7 +80,7 @@ def _show_match(console: Console, match: Match) -> None:
     for column in ("round", "frames", "T", "CT", "plant tick", "winner", "reason"):
         table.add_column(column, justify="right" if column != "reason" else "left")
     for played in match.rounds:
-        seen = played.present.any(axis=1)
+        seen = np.any(played.present, axis=1)
         table.add_row(
             str(played.round_num),
             str(played.num_frames),

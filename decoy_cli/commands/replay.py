@@ -73,6 +73,7 @@ def replay(
     outcome.add_column("winner")
     outcome.add_column("reason")
     outcome.add_row("original", str(real[0] or "not recorded"), str(real[1] or "not recorded"))
+    replayed: tuple[str | None, str | None]
     if result.outcome is None:
         replayed = ("undecided", "end of the data")
     elif result.played_out_s > 0:

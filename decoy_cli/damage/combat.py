@@ -144,9 +144,10 @@ class LearnedDamage:
     def _inference(self) -> Iterator[None]:
         """torch inference mode on `self.threads` threads, restored afterwards."""
         previous = torch.get_num_threads()
-        change = self.threads is not None and self.threads != previous
-        if change:
-            torch.set_num_threads(self.threads)
+        threads = self.threads
+        change = threads is not None and threads != previous
+        if threads is not None and change:
+            torch.set_num_threads(threads)
         try:
             with torch.inference_mode():
                 yield

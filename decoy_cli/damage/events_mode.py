@@ -233,7 +233,7 @@ def _event_negatives(events: _EventRound, window: float) -> list[dict[str, objec
         for s in np.flatnonzero(distance <= window):
             best = seen.get(sightings.key[s])
             if best is None or distance[s] < distance[best]:
-                seen[sightings.key[s]] = s
+                seen[sightings.key[s]] = int(s)
         players = [p for p in seen if not events.dead_at(p, anchor)]
         near = any_damage & (np.abs(damages.tick - anchor) <= window)
         dealt = {(damages.attacker[r], damages.victim[r]) for r in np.flatnonzero(near)}

@@ -26,7 +26,7 @@ import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import Any, Generic, TypeVar, cast
 
 import numpy as np
 import torch
@@ -255,15 +255,19 @@ def train_dog(
 # ---- a whole run: split, train, threshold, test ----------------------------------------------
 
 
+EvaluationT = TypeVar("EvaluationT", bound=DipEvaluation | DogEvaluation)
+ModelT = TypeVar("ModelT", bound=LoadedDip | LoadedDog)
+
+
 @dataclass
-class Run:
+class Run(Generic[EvaluationT, ModelT]):
     """A trained model with the indices of its split parts (into the samples), its training
-    history and its evaluation on the test part."""
+    history and its evaluation on the test part (`DipRun` or `DogRun`)."""
 
     trained: Trained
     parts: dict[str, np.ndarray]
-    test: DipEvaluation | DogEvaluation
-    model: LoadedDip | LoadedDog
+    test: EvaluationT
+    model: ModelT
 
     def summary(self) -> dict[str, Any]:
         """Sizes, best epoch and test metrics as a JSON-ready dict."""
@@ -274,6 +278,10 @@ class Run:
             "stopped_early": self.trained.stopped_early,
             "test_metrics": {k: v for k, v in self.test.metrics.items() if k != "cells"},
         }
+
+
+DipRun = Run[DipEvaluation, LoadedDip]
+DogRun = Run[DogEvaluation, LoadedDog]
 
 
 def dip_parts(samples: Samples, split: Split, balanced: str, seed: int) -> dict[str, np.ndarray]:
@@ -301,7 +309,7 @@ def fit_dip(
     spec: FeatureSpec,
     balanced: str = DEFAULT_BALANCE,
     progress: ProgressCallback | None = None,
-) -> Run:
+) -> DipRun:
     """Train DIP on the training part, choose its threshold by the best F1 on the validation
     part, and evaluate it on the test part."""
     parts = dip_parts(samples, split, balanced, options.seed)
@@ -333,7 +341,7 @@ def fit_dog(
     draws: int = DRAWS,
     min_cell: int = MIN_CELL,
     progress: ProgressCallback | None = None,
-) -> Run:
+) -> DogRun:
     """Train DOG on the damaging samples of the training part (early stopping on those of the
     validation part) and evaluate it on those of the test part."""
     parts = dog_parts(samples, split)

@@ -13,7 +13,7 @@ import io
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import (
@@ -35,7 +35,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.files import json_ready, write_atomic
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.training import EpochRecord, Progress, Run
+    from decoy_cli.damage.training import DipRun, DogRun, EpochRecord, Progress, Run
 
 ProgressCallback = Callable[["Progress"], None]
 """Called after every batch and every epoch of training (`training.Progress`)."""
@@ -44,8 +44,11 @@ DIP_THRESHOLD_RULE = "the highest F1 on the validation part"
 DOG_DAMAGE_TARGET = "hpDamage summed per pair and step, capped at 100 HP"
 
 
+RunT = TypeVar("RunT", bound="Run[Any, Any]")
+
+
 @dataclass(frozen=True)
-class TrainingResult:
+class TrainingResult(Generic[RunT]):
     """What a run made: the samples it read (`samples` of them, `stats` with the failures),
     their split, the trained model with its test evaluation (`run`), the metadata saved with
     it, and where the model and the report were written."""
@@ -53,7 +56,7 @@ class TrainingResult:
     samples: int
     stats: SampleStats
     split: Split
-    run: Run
+    run: RunT
     metadata: dict[str, Any]
     model_folder: Path
     report_folder: Path
@@ -68,7 +71,7 @@ def train_dip_model(
     balanced: str = DEFAULT_BALANCE,
     on_file: FileCallback | None = None,
     progress: ProgressCallback | None = None,
-) -> TrainingResult:
+) -> TrainingResult[DipRun]:
     """Train DIP on `choice`'s training part, choose its threshold by the best F1 on the
     validation part, evaluate it on the test part; write `out`/dip.pt and .json and the report
     (default `out`/report)."""
@@ -108,7 +111,7 @@ def train_dog_model(
     min_cell: int = MIN_CELL,
     on_file: FileCallback | None = None,
     progress: ProgressCallback | None = None,
-) -> TrainingResult:
+) -> TrainingResult[DogRun]:
     """Train DOG on the damaging samples of `choice`'s training part (early stopping on those of
     the validation part), evaluate it on those of the test part; write `out`/dog.pt and .json
     and the report (default `out`/report)."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from functools import cache
+from typing import cast
 
 import msgspec
 import numpy as np
@@ -70,7 +71,7 @@ def _build(
         data["distance_m"] = np.asarray(data["distance"]) * HAMMER_TO_M
     if "weapon" in columns and table != "bomb_events":
         _check_weapons(table, np.asarray(data["weapon"]))
-    ticks = data["tick"]
+    ticks = cast(pd.arrays.IntegerArray, data["tick"])  # every table's tick is an "int" column
     tick_values = ticks.to_numpy(dtype=np.float64, na_value=np.nan)
     data["frame_index"] = nearest_frame(tick_values, frame_ticks)
     return pd.DataFrame(data, index=pd.RangeIndex(len(rows)))

@@ -14,9 +14,10 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.esta.schema import FrameState, Invalid, PlayerState
+from decoy_cli.esta.schema import FrameState, Invalid, PlayerState, TeamState
 from decoy_cli.weapons import is_known
 
 Side = Literal["T", "CT"]
@@ -170,7 +171,8 @@ def _players(
     frame_of: list[int] = []
     side_of: list[Side] = []
     for j, frame in enumerate(frames):
-        for side, team in (("T", frame.t), ("CT", frame.ct)):
+        teams: tuple[tuple[Side, TeamState | None], ...] = (("T", frame.t), ("CT", frame.ct))
+        for side, team in teams:
             if team is not None and team.players:
                 entries.extend(team.players)
                 frame_of.extend([j] * len(team.players))
@@ -213,7 +215,7 @@ def _players(
     shape = (len(players), len(frames))
     p, f = player_of[placed], frame_idx[placed]
 
-    def scatter(values: np.ndarray, fill: object, dtype: object) -> np.ndarray:
+    def scatter(values: np.ndarray, fill: float | str, dtype: npt.DTypeLike) -> np.ndarray:
         """(P, F, ...) array holding each placed entry's value in its cell, `fill` elsewhere."""
         out = np.full(shape + values.shape[1:], fill, dtype=dtype)
         out[p, f] = values[placed]

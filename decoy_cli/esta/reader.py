@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pandas as pd
@@ -155,13 +155,6 @@ def read_match(path: str | Path) -> Match:
         raise EstaError(f"{path}: not an ESTA match file (mapName {map_name!r} is not a string)")
     match_id = _match_id(path, top.get("matchID"))
     meta = {k: v for k, v in top.items() if k not in ("matchID", "mapName", "tickRate")}
-    context = {
-        "match_id": match_id,
-        "path": path,
-        "map_name": map_name or "",
-        "tick_rate": tick_rate,
-    }
-
     rounds: list[Round] = []
     errors: dict[int, EstaError] = {}
     position_of: dict[int, int] = {}
@@ -176,7 +169,16 @@ def read_match(path: str | Path) -> Match:
             continue
         _claim(path, position_of, num, i)
         try:
-            rounds.append(_build_round(state, num, **context))
+            rounds.append(
+                _build_round(
+                    state,
+                    num,
+                    match_id=match_id,
+                    path=path,
+                    map_name=map_name or "",
+                    tick_rate=tick_rate,
+                )
+            )
         except Invalid as problem:
             errors[num] = EstaError(f"{path}: round {num}: {problem}")
     rounds.sort(key=lambda r: r.round_num)
@@ -239,6 +241,7 @@ def _build_round(
     winning_side = state.winningSide or None
     if winning_side not in (None, "T", "CT"):
         raise Invalid(f"winningSide {winning_side!r} is not T or CT")
+    winner = cast("Side | None", winning_side)  # checked just above
     return Round(
         match_id=match_id,
         path=path,
@@ -265,7 +268,7 @@ def _build_round(
         kills=build_table("kills", state.kills, KILL_COLUMNS, ticks),
         bomb_events=build_table("bomb_events", state.bombEvents, BOMB_EVENT_COLUMNS, ticks),
         flashes=build_table("flashes", state.flashes, FLASH_COLUMNS, ticks),
-        winning_side=winning_side,
+        winning_side=winner,
         end_reason=state.roundEndReason or None,
         bomb_plant_tick=_optional_int(state.bombPlantTick, "bombPlantTick"),
         start_tick=start_tick,

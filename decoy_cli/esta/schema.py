@@ -9,7 +9,7 @@ and the builders check integrality where an int is meant. Unknown keys are ignor
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import TYPE_CHECKING, Literal, TypeAlias
 
 import msgspec
 
@@ -208,10 +208,19 @@ def _event_struct(name: str, columns: dict[str, Kind]) -> type[msgspec.Struct]:
     )
 
 
-DamageEvent = _event_struct("DamageEvent", DAMAGE_COLUMNS)
-KillEvent = _event_struct("KillEvent", KILL_COLUMNS)
-BombEvent = _event_struct("BombEvent", BOMB_EVENT_COLUMNS)
-FlashEvent = _event_struct("FlashEvent", FLASH_COLUMNS)
+if TYPE_CHECKING:
+    # The event structs are built from the column tables at run time (msgspec.defstruct), which a
+    # type checker cannot follow: it sees them as plain structs. msgspec resolves the (postponed)
+    # annotations of RoundState with the run-time classes below, so decoding is unchanged.
+    DamageEvent: TypeAlias = msgspec.Struct
+    KillEvent: TypeAlias = msgspec.Struct
+    BombEvent: TypeAlias = msgspec.Struct
+    FlashEvent: TypeAlias = msgspec.Struct
+else:
+    DamageEvent = _event_struct("DamageEvent", DAMAGE_COLUMNS)
+    KillEvent = _event_struct("KillEvent", KILL_COLUMNS)
+    BombEvent = _event_struct("BombEvent", BOMB_EVENT_COLUMNS)
+    FlashEvent = _event_struct("FlashEvent", FLASH_COLUMNS)
 
 
 class RoundHead(msgspec.Struct):

@@ -26,7 +26,7 @@ from __future__ import annotations
 import multiprocessing
 import signal
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Generator, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
@@ -98,7 +98,9 @@ class LocalBackend:
             for task in suspects:
                 yield task, self._run_alone(job, task)
 
-    def _run_pooled(self, job: Callable[[Any], Any], queue: deque) -> Iterator:
+    def _run_pooled(
+        self, job: Callable[[Any], Any], queue: deque
+    ) -> Generator[tuple[Any, Any], None, list[Any]]:
         """Run the queue until it is empty or the pool breaks; returns the suspects."""
         if self._pool is None:
             self._pool = ProcessPoolExecutor(

@@ -95,7 +95,7 @@ def _dtw_kernel(a: np.ndarray, b: np.ndarray, rtol: float) -> tuple[float, int]:
         cost_c[hi + 2] = math.inf
         cost_pp, cost_p, cost_c = cost_p, cost_c, cost_pp
         steps_pp, steps_p, steps_c = steps_p, steps_c, steps_pp
-    return cost_p[n], steps_p[n]
+    return float(cost_p[n]), int(steps_p[n])
 
 
 @njit(cache=True, nogil=True)

@@ -63,10 +63,11 @@ def plot_round_plan(
         draw_nav_areas(ax, nav, facecolor="#ececec")
     pos = graph.positions
     edges = np.stack([pos[graph.edge_source, :2], pos[graph.edge_target, :2]], axis=1)
-    ax.add_collection(LineCollection(edges, colors="#c4c4c4", lw=0.25, zorder=1))
+    # The collections' stubs want a Sequence of lines; an (N, 2, 2) array is one to matplotlib.
+    ax.add_collection(LineCollection(edges, colors="#c4c4c4", lw=0.25, zorder=1))  # type: ignore[arg-type]
 
     # tab10 without its red, which marks the intervals that are too fast.
-    colours = [c for i, c in enumerate(plt.get_cmap("tab10").colors) if i != 3]
+    colours = [c for i, c in enumerate(matplotlib.color_sequences["tab10"]) if i != 3]
     drawn: list[np.ndarray] = []
     for n, p in enumerate(rows):
         colour = colours[n % len(colours)]
@@ -81,18 +82,22 @@ def plot_round_plan(
         drawn.extend([original, waypoint])
         name = f"{plan.players[p].name} ({plan.players[p].side})"
         ax.plot(*original.T, ls="--", lw=0.6, color=colour, zorder=3)
-        ax.scatter(*original.T, s=9, color=colour, zorder=4, label=f"{name}: original")
-        ax.scatter(*waypoint.T, s=22, marker="x", lw=0.9, color=colour, zorder=5)
+        ax.scatter(
+            original[:, 0], original[:, 1], s=9, color=colour, zorder=4, label=f"{name}: original"
+        )
+        ax.scatter(waypoint[:, 0], waypoint[:, 1], s=22, marker="x", lw=0.9, color=colour, zorder=5)
         ax.add_collection(
             LineCollection(
-                np.stack([positions[p, snapped, :2], waypoint], axis=1),
+                np.stack([positions[p, snapped, :2], waypoint], axis=1),  # type: ignore[arg-type]
                 colors="#555555",
                 lw=0.5,
                 zorder=4,
             )
         )
         lost = positions[p, window & (snap.status == SnapStatus.NO_WAYPOINT), :2]
-        ax.scatter(*lost.T, s=60, facecolors="none", edgecolors="#d62728", lw=1.2, zorder=6)
+        ax.scatter(
+            lost[:, 0], lost[:, 1], s=60, facecolors="none", edgecolors="#d62728", lw=1.2, zorder=6
+        )
         drawn.append(lost)
 
         if player_plan.is_empty:
@@ -101,7 +106,7 @@ def plot_round_plan(
         shown = (ends >= first) & (ends <= last) & ~player_plan.interval_unreachable
         ax.add_collection(
             LineCollection(
-                _path_segments(player_plan, shown, pos),
+                _path_segments(player_plan, shown, pos),  # type: ignore[arg-type]
                 colors=[colour],
                 lw=1.6,
                 alpha=0.75,
@@ -110,7 +115,9 @@ def plot_round_plan(
         )
         ax.add_collection(
             LineCollection(
-                _path_segments(player_plan, shown & player_plan.interval_infeasible, pos),
+                _path_segments(  # type: ignore[arg-type]
+                    player_plan, shown & player_plan.interval_infeasible, pos
+                ),
                 colors="#d62728",
                 lw=2.4,
                 zorder=7,
@@ -123,7 +130,8 @@ def plot_round_plan(
         start = player_plan.target_frame[0]
         if first <= start <= last:
             ax.scatter(
-                *positions[p, start, :2],
+                positions[p, start, 0],
+                positions[p, start, 1],
                 marker="^",
                 s=70,
                 color=colour,
@@ -132,7 +140,8 @@ def plot_round_plan(
             )
         if player_plan.died and first <= player_plan.last_alive_frame <= last:
             ax.scatter(
-                *positions[p, player_plan.last_alive_frame, :2],
+                positions[p, player_plan.last_alive_frame, 0],
+                positions[p, player_plan.last_alive_frame, 1],
                 marker="X",
                 s=90,
                 color=colour,

@@ -183,8 +183,8 @@ def replay_round(
         weapons=weapons,
         hp=np.clip(at_first(np.asarray(round_.hp), 100), 1, 100),
         armor=np.clip(at_first(np.asarray(round_.armor), 0), 0, 100),
-        helmet=at_first(np.asarray(round_.helmet), False),
-        has_defuser=at_first(np.asarray(round_.has_defuser), False),
+        helmet=np.asarray(at_first(np.asarray(round_.helmet), False), bool),
+        has_defuser=np.asarray(at_first(np.asarray(round_.has_defuser), False), bool),
         yaw=np.nan_to_num(np.asarray(at_first(np.asarray(round_.yaw), 0.0), dtype=float)),
     )
     never = np.array([len(p.target_node) == 0 for p in plan.plans])
@@ -236,10 +236,11 @@ def replay_round(
             sim.step()
             f = frame_of_tick.get(sim.tick)
             if f is not None:  # follow the weapon in hand, as the data shows it
-                for i in np.nonzero(agents.alive)[0]:
+                for alive in np.nonzero(agents.alive)[0]:
+                    i = int(alive)
                     if weapon_frames[i, f]:
                         agents.weapon[i] = weapon_frames[i, f]
-                        sim.mover.set_max_speed(int(i), max_speed_m_s(str(weapon_frames[i, f])))
+                        sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
         played_from = sim.tick
         if options.play_out and sim.combat is not None and not sim.done:
             # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later

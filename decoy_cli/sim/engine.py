@@ -245,8 +245,8 @@ class Simulator:
     def _decide(self) -> None:
         agents = self.agents
         due = self._due_at(self.tick)
-        for agent in np.nonzero(due)[0]:
-            agent = int(agent)
+        for index in np.nonzero(due)[0]:
+            agent = int(index)
             self.hold_until[agent] = 0
             self.waiting[agent] = False
             self._deciding = agent

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from contextlib import ExitStack
 from numbers import Integral
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeGuard, cast
 
 import gymnasium
 import numpy as np
@@ -164,9 +164,11 @@ class DecoyParallelEnv(ParallelEnv):
         self.graph = builtin_graph() if graph is None else graph
         self.world = world
         self.mover_kind = mover
-        self.damage_model: DamageModel | None = (
-            damage_model() if _is_loader(damage_model) else damage_model  # type: ignore[assignment,operator]
-        )
+        self.damage_model: DamageModel | None
+        if _is_loader(damage_model):
+            self.damage_model = damage_model()
+        else:  # not a loader: a model or None
+            self.damage_model = cast("DamageModel | None", damage_model)
         self.bomb = bool(bomb)
         self.setup = RoundSetup(
             graph=self.graph,
@@ -404,7 +406,7 @@ class DecoyParallelEnv(ParallelEnv):
         }
 
 
-def _is_loader(value: object) -> bool:
+def _is_loader(value: object) -> TypeGuard[Callable[[], DamageModel | None]]:
     """Whether `value` is a function that loads a damage model rather than a model itself
     (a model is called with a batch and a generator, a loader with nothing)."""
     import inspect

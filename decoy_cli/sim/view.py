@@ -49,10 +49,11 @@ class TopDownView:
         colours = np.array([self.COLOURS[str(side)] for side in self.sides])
         colours[~agents.alive] = self.COLOURS["dead"]
         self.agents.set_offsets(agents.position[:, :2])
-        self.agents.set_facecolors(colours)
-        show_bomb = bomb is not None and not (
-            bomb.status == BombStatus.CARRIED and bomb.carrier < 0
-        )
-        self.bomb.set_offsets(bomb.position[None, :2] if show_bomb else np.empty((0, 2)))
+        # (set_facecolors is an alias the stubs lack; they also lack (N, 4) RGBA arrays)
+        self.agents.set_facecolor(colours)  # type: ignore[arg-type]
+        if bomb is None or (bomb.status == BombStatus.CARRIED and bomb.carrier < 0):
+            self.bomb.set_offsets(np.empty((0, 2)))
+        else:
+            self.bomb.set_offsets(bomb.position[None, :2])
         self.canvas.draw()
         return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()

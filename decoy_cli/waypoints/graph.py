@@ -202,7 +202,7 @@ class WaypointGraph:
 
         Written to a temporary file beside the target, then renamed: never half-written.
         """
-        arrays = {
+        arrays: dict[str, np.ndarray] = {
             "format_version": np.array(FORMAT_VERSION, dtype=np.int32),
             "positions": np.asarray(self.positions, dtype=np.float64),
             "edge_source": np.asarray(self.edge_source, dtype=np.int32),

@@ -37,8 +37,10 @@ def plot_graph(
     if nav is not None:
         draw_nav_areas(ax, nav)
     if floor_triangles is not None and len(floor_triangles):
+        # The collections' stubs want a Sequence of polygons or lines; an array is one too.
+        triangles = floor_triangles[:, :, :2]
         ax.add_collection(
-            PolyCollection(floor_triangles[:, :, :2], facecolor="#e6e6e6", edgecolor="none")
+            PolyCollection(triangles, facecolor="#e6e6e6", edgecolor="none")  # type: ignore[arg-type]
         )
     pos = graph.positions
     segments = np.stack([pos[graph.edge_source, :2], pos[graph.edge_target, :2]], axis=1)
@@ -58,14 +60,16 @@ def plot_graph(
     if removed_segments is not None and len(removed_segments):
         ax.add_collection(
             LineCollection(
-                removed_segments[:, :, :2],
+                removed_segments[:, :, :2],  # type: ignore[arg-type]
                 colors="#e377c2",
                 lw=0.8,
                 label="removed by verification",
             )
         )
     if pruned_positions is not None and len(pruned_positions):
-        ax.scatter(*pruned_positions[:, :2].T, s=2, c="#7f7f7f", label="pruned nodes")
+        ax.scatter(
+            pruned_positions[:, 0], pruned_positions[:, 1], s=2, c="#7f7f7f", label="pruned nodes"
+        )
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.set_xlabel("x (m, east)")

@@ -111,11 +111,12 @@ def check_extent(world: World) -> None:
     width = max(dx, dy)
     size = f"{dx:.4g} m x {dy:.4g} m across and {dz:.4g} m tall"
     units = world.meta.get("units")  # None when read with an explicit scale or built in code
+    unit = units if isinstance(units, str) else ""
     if width < MIN_EXTENT_M:
-        hint = {"hammer": "--units m", "m": "--scale"}.get(units, "--units m or --scale")
+        hint = {"hammer": "--units m", "m": "--scale"}.get(unit, "--units m or --scale")
         raise WorldError(f"{world.source}: the mesh is {size}, too small for a map; try {hint}")
     if width > MAX_EXTENT_M:
-        hint = {"m": "--units hammer", "hammer": "--scale"}.get(units, "--units hammer or --scale")
+        hint = {"m": "--units hammer", "hammer": "--scale"}.get(unit, "--units hammer or --scale")
         raise WorldError(f"{world.source}: the mesh is {size}, too large for a map; try {hint}")
     if dz > min(dx, dy):
         raise WorldError(
@@ -253,8 +254,8 @@ def _parse_obj(data: bytes, path: Path) -> np.ndarray:
     vertices = _numbers(coords, np.float64, path, lambda i: vertex_lines[i // 3]).reshape(-1, 3)
     bad = ~np.isfinite(vertices).all(axis=1)
     if bad.any():
-        line = vertex_lines[int(np.argmax(bad))]
-        raise WorldError(f"{path}: line {line}: vertex has a NaN or infinite coordinate")
+        bad_line = vertex_lines[int(np.argmax(bad))]
+        raise WorldError(f"{path}: line {bad_line}: vertex has a NaN or infinite coordinate")
 
     sizes = np.asarray(face_sizes, dtype=np.int64)
     ref_face = np.repeat(np.arange(len(sizes)), sizes)

@@ -66,7 +66,7 @@ class PhysicsWorld:
         pybullet = load_pybullet()
         self.world = world
         self._p = pybullet
-        self.client = pybullet.connect(pybullet.DIRECT)
+        self.client: int | None = pybullet.connect(pybullet.DIRECT)
         self.body = self._load(world)
         pybullet.setCollisionFilterGroupMask(
             self.body, -1, WORLD_GROUP, WORLD_GROUP | AGENT_GROUP, physicsClientId=self.client
@@ -108,7 +108,7 @@ class PhysicsWorld:
     def close(self) -> None:
         if self.client is not None and self._p.isConnected(self.client):
             self._p.disconnect(self.client)
-        self.client = None  # type: ignore[assignment]
+        self.client = None
 
     def __enter__(self) -> Self:
         return self
@@ -198,9 +198,9 @@ class PhysicsWorld:
             p.performCollisionDetection(physicsClientId=self.client)
             for contact in p.getContactPoints(bodyA=self.body, physicsClientId=self.client):
                 if contact[8] < -tolerance:
-                    k = index.get(contact[2])
-                    if k is not None and k < len(chunk):
-                        blocked[lo + k] = True
+                    hit = index.get(contact[2])
+                    if hit is not None and hit < len(chunk):
+                        blocked[lo + hit] = True
             self._park(len(chunk))
         return blocked
 
