@@ -28,13 +28,11 @@ import numpy as np
 
 from decoy_cli.csgo import PLAYER_RADIUS_M
 from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.los_pairs import disagreement_by_place, eye_pairs, random_node_pairs
 from decoy_cli.world.los import (
     check_placement,
     compare_line_of_sight,
-    disagreement_by_place,
-    eye_pairs,
     plot_los_comparison,
-    random_node_pairs,
     sideways,
 )
 from decoy_cli.world.meshfile import check_extent, read_mesh

@@ -12,14 +12,12 @@ from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.errors import GraphError, OutputError, WorldError
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.los_pairs import disagreement_by_place, eye_pairs, random_node_pairs
 from decoy_cli.world.los import (
     LosComparison,
     check_placement,
     compare_line_of_sight,
-    disagreement_by_place,
-    eye_pairs,
     plot_los_comparison,
-    random_node_pairs,
     sideways,
 )
 from decoy_cli.world.meshfile import read_mesh

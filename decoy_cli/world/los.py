@@ -5,13 +5,14 @@ an approximation (nav holes become walls; windows, low cover and door gaps vanis
 brush mesh has its own gaps (missing props, no clip brushes, displacement mounds). This module
 measures how much the two disagree:
 
-* `random_node_pairs` draws waypoint pairs (seeded, optionally within a combat distance) and
-  `eye_pairs` lifts them to standing eye height;
 * `compare_line_of_sight` ray-tests every pair in both worlds (one pybullet client per world,
   batched rays) and returns per-pair visibility, the agreement and the confusion counts;
 * `check_placement` finds points that do not stand properly in a world (geometry inside the
   body, or no floor under the feet), so pairs whose endpoints are misplaced can be set apart;
-* `disagreement_by_place` and `plot_los_comparison` say where the worlds disagree.
+* `plot_los_comparison` draws where the worlds disagree.
+
+Which pairs to compare (waypoints of a graph, lifted to eye height) and the disagreement by nav
+place are chosen over a waypoint graph, a layer above the world: decoy_cli/waypoints/los_pairs.py.
 """
 
 from __future__ import annotations
@@ -23,18 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, STEP_HEIGHT_M
-from decoy_cli.errors import GraphError, WorldError
+from decoy_cli.csgo import PLAYER_HEIGHT_M, STEP_HEIGHT_M
+from decoy_cli.errors import WorldError
 from decoy_cli.figures import draw_nav_areas, save_figure
-from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import NavMesh
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
 CONFUSION_KEYS = ("both", "only_a", "only_b", "neither")
 """Confusion cells: both worlds see, only world A sees, only world B sees, neither sees."""
-
-_MAX_DRAW_ROUNDS = 200
 
 
 @dataclass(frozen=True)
@@ -157,54 +155,6 @@ def sideways(pairs: np.ndarray, distance: float) -> np.ndarray:
     return pairs + np.concatenate([left * distance, np.zeros((len(pairs), 1))], axis=1)[:, None]
 
 
-# ---- waypoint pairs ---------------------------------------------------------------------------
-
-
-def random_node_pairs(
-    graph: WaypointGraph,
-    count: int,
-    seed: int = 0,
-    max_distance: float | None = None,
-    min_distance: float = 0.0,
-) -> np.ndarray:
-    """(count, 2) indices of distinct random waypoints, uniformly over the ordered pairs whose
-    3-D distance lies in [min_distance, max_distance] (metres); the same seed gives the same
-    pairs. A GraphError when such pairs are too rare to find."""
-    if count < 0:
-        raise GraphError(f"cannot draw {count} pairs")
-    if graph.num_nodes < 2:
-        raise GraphError(f"a graph of {graph.num_nodes} waypoints has no pairs")
-    upper = np.inf if max_distance is None else max_distance
-    rng = np.random.default_rng(seed)
-    found: list[np.ndarray] = []
-    have = 0
-    batch = max(4 * count, 1024)
-    for _ in range(_MAX_DRAW_ROUNDS):
-        if have >= count:
-            break
-        nodes = rng.integers(0, graph.num_nodes, size=(batch, 2))
-        dist = np.linalg.norm(graph.positions[nodes[:, 0]] - graph.positions[nodes[:, 1]], axis=1)
-        keep = (nodes[:, 0] != nodes[:, 1]) & (dist >= min_distance) & (dist <= upper)
-        found.append(nodes[keep])
-        have += int(keep.sum())
-    if have < count:
-        raise GraphError(
-            f"found only {have} of {count} waypoint pairs between {min_distance:g} m and "
-            f"{upper:g} m apart in {_MAX_DRAW_ROUNDS * batch:,} draws"
-        )
-    return np.concatenate(found)[:count].astype(np.int64).reshape(-1, 2)
-
-
-def eye_pairs(
-    graph: WaypointGraph, nodes: np.ndarray, eye_height: float = EYE_HEIGHT_M
-) -> np.ndarray:
-    """(P, 2, 3) eye points of node pairs: each waypoint (a floor point) raised by `eye_height`."""
-    nodes = np.asarray(nodes, dtype=np.int64).reshape(-1, 2)
-    if len(nodes) and (nodes.min() < 0 or nodes.max() >= graph.num_nodes):
-        raise GraphError(f"node pairs refer to waypoints outside 0..{graph.num_nodes - 1}")
-    return graph.positions[nodes] + np.array([0.0, 0.0, eye_height])
-
-
 # ---- placement --------------------------------------------------------------------------------
 
 
@@ -243,52 +193,6 @@ def check_placement(
         buried = ~physics.line_of_sight(feet + knee * up, feet + head * up)
         floor_z, _ = physics.first_floor_below(feet + knee * up, knee + floor_tolerance)
     return Placement(buried=buried, floating=np.isnan(floor_z))
-
-
-# ---- where --------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class PlaceDisagreement:
-    """Pairs with an endpoint in one place, and how many of them the worlds disagree on."""
-
-    place: str
-    pairs: int
-    disagree: int
-    only_a: int
-    only_b: int
-
-    @property
-    def share(self) -> float:
-        return self.disagree / self.pairs if self.pairs else float("nan")
-
-
-def disagreement_by_place(
-    comparison: LosComparison, nodes: np.ndarray, graph: WaypointGraph
-) -> list[PlaceDisagreement]:
-    """Per nav place, the pairs with at least one endpoint there and their disagreements,
-    most disagreements first (a pair between two places counts for both; '-' = no place)."""
-    nodes = np.asarray(nodes, dtype=np.int64).reshape(-1, 2)
-    if len(nodes) != comparison.num_pairs:
-        raise GraphError(f"{len(nodes)} node pairs for {comparison.num_pairs} compared pairs")
-    names = [*graph.place_names, "-"]
-    place = np.where(graph.node_place < 0, len(names) - 1, graph.node_place)[nodes]  # (P, 2)
-    only_a = comparison.visible_a & ~comparison.visible_b
-    only_b = comparison.visible_b & ~comparison.visible_a
-    rows = []
-    for k, name in enumerate(names):
-        touches = (place == k).any(axis=1)
-        if touches.any():
-            rows.append(
-                PlaceDisagreement(
-                    place=name,
-                    pairs=int(touches.sum()),
-                    disagree=int(np.sum(touches & ~comparison.agree)),
-                    only_a=int(np.sum(touches & only_a)),
-                    only_b=int(np.sum(touches & only_b)),
-                )
-            )
-    return sorted(rows, key=lambda r: (-r.disagree, r.place))
 
 
 def plot_los_comparison(
