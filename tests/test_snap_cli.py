@@ -161,7 +161,7 @@ def test_study_files_totals_and_failures(match_file: Path, tmp_path: Path) -> No
         *[(1.5, 4), (2.0, 5), (2.0, 5)],  # bad-round.json: round 2 failed in the reader
         (3.0, 5),  # corrupt.json.xz
     ]
-    assert [(f.file.name, f.round_num) for f in study.failures] == [
+    assert [(Path(f.file).name, f.round_num) for f in study.failures] == [
         ("bad-round.json", 2),
         ("corrupt.json.xz", None),
     ]

@@ -15,22 +15,23 @@ protocols of docs/metrics.md: S_t is the position of the waypoint frame t snappe
 it snapped; O_t the original position where the player is alive with a position. That is a first
 bound on what a perfect replay on this graph can reach.
 
-A file or round that cannot be read, or a round that cannot be snapped, is recorded as a
-`Failure` with its one-line message and the rest go on.
+The files are read through the one round loop (`decoy_cli.esta.iter_matches`): a file or round
+that cannot be read, a match of another map, or a round that cannot be snapped is recorded as a
+`RoundFailure` with its one-line message and the rest go on.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError, EstaError, OutputError
-from decoy_cli.esta import Match, read_match
+from decoy_cli.esta import Match, Round, RoundFailure, failure_from, iter_matches, match_rounds
+from decoy_cli.esta.batch import OTHER_MAP
 from decoy_cli.metrics import METRIC_NAMES, MetricSummary, PlayerRound, summarize
 from decoy_cli.metrics.trajectory import trajectory_metrics_frame
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -81,15 +82,6 @@ between the two waypoints (far from `original_dz_m`: a snap to another floor).
 
 
 @dataclass(frozen=True)
-class Failure:
-    """A file (round None) or one round that could not be read or snapped."""
-
-    file: Path
-    round_num: int | None
-    message: str
-
-
-@dataclass(frozen=True)
 class SnapTotals:
     """Pooled snap quality and plan feasibility over a set of player-rounds."""
 
@@ -136,7 +128,7 @@ class SnapStudy:
     rows: pd.DataFrame
     intervals: pd.DataFrame
     totals: SnapTotals
-    failures: list[Failure]
+    failures: list[RoundFailure]
     metrics: MetricSummary | None
     """Aggregated fidelity metrics of the snapped trajectories (None without `metrics=True`)."""
 
@@ -190,8 +182,11 @@ def check_map(match: Match, graph: WaypointGraph) -> None:
         )
 
 
+SNAP_ERROR = "snap error"
+
+
 def study_round(
-    round_: Any,
+    round_: Round,
     graph: WaypointGraph,
     *,
     metrics: bool = False,
@@ -248,35 +243,52 @@ def study_files(
     `files_done` counts a file's rounds as fractions of it (1.5 = half of the second file).
     """
     studies: list[RoundStudy] = []
-    failures: list[Failure] = []
-    for i, path in enumerate(files):
-        try:
-            match = read_match(path)
-            check_map(match, graph)
-        except DecoyError as error:
-            failures.append(Failure(path, None, str(error)))
+    failures: list[RoundFailure] = []
+    for i, item in enumerate(iter_matches(files)):
+        if isinstance(item, RoundFailure):
+            failures.append(item)
         else:
-            failures.extend(Failure(path, n, str(e)) for n, e in match.round_errors.items())
-            for k, round_ in enumerate(match.rounds):
-                try:
-                    studies.append(
-                        study_round(round_, graph, metrics=metrics, max_distance=max_distance)
-                    )
-                except DecoyError as error:
-                    failures.append(
-                        Failure(
-                            path, round_.round_num, f"{path}: round {round_.round_num}: {error}"
-                        )
-                    )
-                if on_progress is not None:
-                    on_progress(i + (k + 1) / len(match.rounds), len(studies))
+            try:
+                check_map(item, graph)
+            except DecoyError as error:
+                failures.append(failure_from(error, item.path, None, OTHER_MAP))
+            else:
+                _study_match(item, graph, metrics, max_distance, studies, failures, i, on_progress)
         if on_progress is not None:
             on_progress(i + 1.0, len(studies))
     return combine(studies, failures, metrics=metrics)
 
 
+def _study_match(
+    match: Match,
+    graph: WaypointGraph,
+    metrics: bool,
+    max_distance: float,
+    studies: list[RoundStudy],
+    failures: list[RoundFailure],
+    index: int,
+    on_progress: Callable[[float, int], None] | None,
+) -> None:
+    """Study the rounds of one match into `studies`, recording the ones that fail."""
+    count = len(match.rounds)  # progress counts the rounds the reader built
+    built = 0
+    for item in match_rounds(match):
+        if isinstance(item, RoundFailure):
+            failures.append(item)
+            continue
+        built += 1
+        try:
+            studies.append(study_round(item, graph, metrics=metrics, max_distance=max_distance))
+        except DecoyError as error:
+            failure = failure_from(error, match.path, item.round_num, SNAP_ERROR)
+            prefix = f"{match.path}: round {item.round_num}: "
+            failures.append(replace(failure, message=prefix + failure.message))
+        if on_progress is not None:
+            on_progress(index + built / count, len(studies))
+
+
 def combine(
-    studies: list[RoundStudy], failures: list[Failure] | None = None, *, metrics: bool = False
+    studies: list[RoundStudy], failures: list[RoundFailure] | None = None, *, metrics: bool = False
 ) -> SnapStudy:
     """Join round studies into one; with `metrics`, aggregate the metrics by side."""
     if studies:
