@@ -21,10 +21,10 @@ from decoy_cli.esta import read_match
 from decoy_cli.esta.writer import (
     BombEventRecord,
     DamageRecord,
+    EstaRoundRecord,
     KillRecord,
     MatchRecord,
     PlayerRecord,
-    RoundRecord,
     encode_match,
     match_document,
     write_match,
@@ -68,7 +68,7 @@ def _positions() -> np.ndarray:
     return position
 
 
-def make_round(num: int = 1) -> RoundRecord:
+def make_round(num: int = 1) -> EstaRoundRecord:
     """Round 1: alpha plants at A, gamma kills beta at frame 2, delta is absent from frame 2."""
     alive = np.ones((4, 4), dtype=bool)
     alive[1, 2:] = False
@@ -86,7 +86,7 @@ def make_round(num: int = 1) -> RoundRecord:
     planted = np.array([False, False, True, True])
     planting = np.zeros((4, 4), dtype=bool)
     planting[0, 1] = True
-    return RoundRecord(
+    return EstaRoundRecord(
         round_num=num,
         start_tick=900,
         freeze_end_tick=FREEZE_END,
@@ -141,7 +141,7 @@ def make_round(num: int = 1) -> RoundRecord:
     )
 
 
-def quiet_round(num: int = 2) -> RoundRecord:
+def quiet_round(num: int = 2) -> EstaRoundRecord:
     """A round without events or bomb that the CT win."""
     base = make_round(num)
     return dataclasses.replace(
@@ -166,7 +166,7 @@ def quiet_round(num: int = 2) -> RoundRecord:
     )
 
 
-def make_record(rounds: list[RoundRecord] | None = None) -> MatchRecord:
+def make_record(rounds: list[EstaRoundRecord] | None = None) -> MatchRecord:
     return MatchRecord(
         match_id="writer-test",
         map_name="de_dust2",

@@ -136,7 +136,7 @@ class BombEventRecord:
 
 
 @dataclass(frozen=True, eq=False)
-class RoundRecord:
+class EstaRoundRecord:
     """One round as arrays: P players by F frames, metres and degrees; ticks are demo ticks.
 
     A player whose position is NaN in a frame is absent from it. Optional per-frame flags
@@ -188,7 +188,7 @@ class MatchRecord:
     match_id: str
     map_name: str
     tick_rate: int
-    rounds: list[RoundRecord]
+    rounds: list[EstaRoundRecord]
     team_names: dict[str, str]
     provenance: dict[str, Any]
     client_name: str = ""
@@ -268,7 +268,7 @@ def match_document(match: MatchRecord) -> dict[str, Any]:
 # ---- checks ------------------------------------------------------------------------------------
 
 
-def _check_round(r: RoundRecord) -> None:
+def _check_round(r: EstaRoundRecord) -> None:
     """Shapes, names and indices a reader would reject, caught before anything is written."""
     where = f"round {r.round_num}"
     p, f = len(r.players), r.num_frames
@@ -330,7 +330,7 @@ def _check_weapon(where: str, name: str, allow_world: bool = False) -> None:
         raise ValueError(f"{where}: unknown weapon {name!r}")
 
 
-def _check_player(where: str, r: RoundRecord, index: int, allow_none: bool = False) -> None:
+def _check_player(where: str, r: EstaRoundRecord, index: int, allow_none: bool = False) -> None:
     if not (0 <= index < len(r.players) or (allow_none and index == -1)):
         raise ValueError(f"{where}: no player {index}")
 
@@ -382,7 +382,7 @@ def _weapon_class(name: str) -> str | None:
 
 def _round_document(
     match: MatchRecord,
-    r: RoundRecord,
+    r: EstaRoundRecord,
     scores: dict[str, int],
     spent_total: dict[str, int],
     global_frame: int,
@@ -449,7 +449,7 @@ def _side_roster(team: str, players: list[PlayerRecord]) -> dict[str, Any]:
 class _EventContext:
     """Turns event records into awpy event dicts (identity, Hammer positions, time)."""
 
-    def __init__(self, match: MatchRecord, r: RoundRecord, plant_s: float | None) -> None:
+    def __init__(self, match: MatchRecord, r: EstaRoundRecord, plant_s: float | None) -> None:
         self.rate = match.tick_rate
         self.teams = match.team_names
         self.r = r
@@ -564,7 +564,7 @@ class _EventContext:
 
 def _frames(
     match: MatchRecord,
-    r: RoundRecord,
+    r: EstaRoundRecord,
     plant_s: float | None,
     spent_total: dict[str, int],
     global_frame: int,

@@ -2,7 +2,9 @@
 
 * routes.py: nav places, T strategies and CT setups as routes of waypoint legs;
 * loadouts.py: what each side buys (pistol, eco, force and full buys);
-* player.py: the scripted policy and one round played and recorded (`play_round`);
+* policy.py: the scripted policy that drives the agents;
+* recording.py: frames and events recorded as ESTA round data;
+* player.py: one round set up, played and recorded (`play_round`);
 * sample.py: the shipped sample, a match of such rounds labelled synthetic (`write_sample`).
 """
 

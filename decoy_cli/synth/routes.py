@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from decoy_cli.csgo import TICK_RATE
+from decoy_cli.csgo import tick_at
 from decoy_cli.errors import GraphError
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -185,7 +185,7 @@ class Places:
 
 
 @dataclass(frozen=True)
-class RoundPlan:
+class RoutePlan:
     """The scripted plan of one round: T agents 0..4, CT agents 5..9, one route each, and the
     leg each CT that defends elsewhere takes when the T reach the site (`rotations`, by agent)."""
 
@@ -210,12 +210,12 @@ def plant_nodes(places: Places, zones: SiteZones, site: str) -> np.ndarray:
     return inside
 
 
-def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> RoundPlan:
+def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> RoutePlan:
     """Draw a T strategy, a CT setup and every player's route (5 against 5)."""
     strategy = T_STRATEGIES[int(rng.integers(len(T_STRATEGIES)))]
     names = list(CT_SETUPS)
     ct_setup = str(rng.choice(names, p=[CT_SETUP_WEIGHTS[n] for n in names]))
-    execute = _ticks(rng.uniform(*EXECUTE_S))
+    execute = tick_at(rng.uniform(*EXECUTE_S))
     site_place = SITE_PLACES[strategy.site]
 
     groups = [group for group in strategy.groups for _ in range(group.count)]
@@ -226,10 +226,10 @@ def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> Ro
     routes: list[list[Leg]] = []
     for agent in range(TEAM_SIZE):
         group = groups[int(order[agent])]
-        legs = [Leg(int(t_spawns[agent]), _ticks(rng.uniform(*START_HOLD_S)))]
+        legs = [Leg(int(t_spawns[agent]), tick_at(rng.uniform(*START_HOLD_S)))]
         for place in group.via:
             if place == group.stage:
-                jitter = _ticks(rng.uniform(*STAGE_JITTER_S))
+                jitter = tick_at(rng.uniform(*STAGE_JITTER_S))
                 node = places.spot(place, rng, group.stage_near)
                 legs.append(Leg(node, jitter, execute + jitter, watch=site_place))
             else:
@@ -243,12 +243,8 @@ def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> Ro
     for k, role_name in enumerate(CT_SETUPS[ct_setup]):
         role = CT_ROLES[role_name]
         hold = Leg(places.spot(role.place, rng, role.near), watch=role.watch)
-        routes.append([Leg(int(ct_spawns[k]), _ticks(rng.uniform(*START_HOLD_S))), hold])
+        routes.append([Leg(int(ct_spawns[k]), tick_at(rng.uniform(*START_HOLD_S))), hold])
         if role.site != strategy.site:
             entry = places.spot(site_place, rng, RETAKE_FROM[strategy.site])
             rotations[TEAM_SIZE + k] = Leg(entry, watch=site_place)
-    return RoundPlan(strategy, ct_setup, routes, carrier, plant_node, rotations)
-
-
-def _ticks(seconds: float) -> int:
-    return round(seconds * TICK_RATE)
+    return RoutePlan(strategy, ct_setup, routes, carrier, plant_node, rotations)
