@@ -18,17 +18,15 @@ from esta_fixtures import make_match
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import OutputError
 from decoy_cli.esta import read_match
-from decoy_cli.esta.writer import (
+from decoy_cli.esta.records import (
     BombEventRecord,
     DamageRecord,
     EstaRoundRecord,
     KillRecord,
     MatchRecord,
     PlayerRecord,
-    encode_match,
-    match_document,
-    write_match,
 )
+from decoy_cli.esta.writer import encode_match, match_document, write_match
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 TSIDE = DATA / "esta_dust2_tside"

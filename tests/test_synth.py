@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from decoy_cli.esta import Match, read_match
-from decoy_cli.esta.writer import AWPY_HIT_GROUPS, encode_match, write_match
+from decoy_cli.esta.records import AWPY_HIT_GROUPS
+from decoy_cli.esta.writer import encode_match, write_match
 from decoy_cli.metrics import player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import HIT_GROUPS, NO_HIT, CombatBatch, DamageResult

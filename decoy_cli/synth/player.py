@@ -17,10 +17,7 @@ from typing import cast
 import numpy as np
 
 from decoy_cli.esta.frames import Side
-from decoy_cli.esta.writer import (
-    EstaRoundRecord,
-    PlayerRecord,
-)
+from decoy_cli.esta.records import EstaRoundRecord, PlayerRecord
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import SiteZones

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
-from decoy_cli.esta.writer import (
+from decoy_cli.esta.records import (
     BOMB_ACTIONS,
     FREEZE_TIME_S,
     TRADE_TIME_S,

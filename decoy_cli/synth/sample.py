@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from decoy_cli import __version__
-from decoy_cli.esta.writer import MatchRecord, write_match
+from decoy_cli.esta.records import MatchRecord
+from decoy_cli.esta.writer import write_match
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.synth.loadouts import buy_kind, side_loadouts
