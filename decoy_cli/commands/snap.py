@@ -463,7 +463,7 @@ def _player_rows(round_: Round, names: list[str]) -> list[int]:
     """Row indices of the named players (by name or key), all players when none is named."""
     if not names:
         return list(range(round_.num_players))
-    rows = []
+    rows: list[int] = []
     for name in names:
         found = [i for i, p in enumerate(round_.players) if name in (p.name, p.key)]
         if not found:

@@ -209,7 +209,8 @@ def check_round(r: EstaRoundRecord) -> None:
             _check_weapon(where, item)
     for name in set(np.asarray(r.weapon).ravel().tolist()):
         _check_weapon(where, name)
-    for event in (*r.damages, *r.kills):
+    events: list[DamageRecord | KillRecord] = [*r.damages, *r.kills]
+    for event in events:
         _check_weapon(where, event.weapon, allow_world=True)
         _check_player(where, r, event.victim)
         _check_player(where, r, event.attacker, allow_none=True)
@@ -219,10 +220,10 @@ def check_round(r: EstaRoundRecord) -> None:
     for kill in r.kills:
         _check_player(where, r, kill.assister, allow_none=True)
         _check_player(where, r, kill.traded, allow_none=True)
-    for event in r.bomb_events:
-        if event.action not in BOMB_ACTIONS:
-            raise ValueError(f"{where}: unknown bomb action {event.action!r}")
-        _check_player(where, r, event.player, allow_none=True)
+    for bomb_event in r.bomb_events:
+        if bomb_event.action not in BOMB_ACTIONS:
+            raise ValueError(f"{where}: unknown bomb action {bomb_event.action!r}")
+        _check_player(where, r, bomb_event.player, allow_none=True)
 
 
 def _check_weapon(where: str, name: str, allow_world: bool = False) -> None:

@@ -96,7 +96,8 @@ def buy_kind(
         return "pistol"
     if position == 1 and previous_winner is not None:
         return "force" if previous_winner == side else "eco"
-    names, weights = zip(*_LATER_BUYS, strict=True)
+    names = [name for name, _ in _LATER_BUYS]
+    weights = [weight for _, weight in _LATER_BUYS]
     return str(rng.choice(names, p=weights))
 
 

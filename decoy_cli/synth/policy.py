@@ -161,8 +161,9 @@ class ScriptedPolicy:
         """The waypoint under the bomb (cached while the bomb lies in one place)."""
         key = tuple(np.round(position, 6).tolist())
         if self._bomb_node is None or self._bomb_node[0] != key:
-            index, _ = self.graph.nearest(np.asarray(position, dtype=np.float64))
-            if index[0] < 0:  # off every floor band: the nearest waypoint in plain 3-D
-                index = [int(np.argmin(np.linalg.norm(self.graph.positions - position, axis=1)))]
-            self._bomb_node = (key, int(index[0]))
+            found, _ = self.graph.nearest(np.asarray(position, dtype=np.float64))
+            node = int(found[0])
+            if node < 0:  # off every floor band: the nearest waypoint in plain 3-D
+                node = int(np.argmin(np.linalg.norm(self.graph.positions - position, axis=1)))
+            self._bomb_node = (key, node)
         return self._bomb_node[1]

@@ -469,10 +469,10 @@ def build_lattice(
     while done < len(drops):
         pending, done = drops[done:], len(drops)
         new_nodes = []
-        for u, d, z in pending:
+        for u, d, drop_z in pending:
             ci, cj = lattice.cell_of[u]
             di, dj = DIRECTION_VECTORS[d]
-            v, new = lattice.find_or_add((ci + int(di), cj + int(dj)), z)
+            v, new = lattice.find_or_add((ci + int(di), cj + int(dj)), drop_z)
             edges.append((u, v, int(EdgeKind.DROP), d))
             stats.drop_edges += 1
             if new:
