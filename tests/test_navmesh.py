@@ -10,7 +10,7 @@ import pytest
 from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M
 from decoy_cli.errors import WorldError
 from decoy_cli.waypoints.build import builtin_graph, default_seeds
-from decoy_cli.world import navmesh
+from decoy_cli.world import nav_geometry, navmesh
 from decoy_cli.world.navmesh import REGION_PLACES, NavMesh, load_navmesh, nav_world
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
@@ -79,9 +79,9 @@ def seam_mismatch(nav: NavMesh, contacts, zx: np.ndarray, zy: np.ndarray) -> np.
     out = np.zeros(len(contacts))
     for k, c in enumerate(contacts):
         for t in (0.0, 1.0):
-            x, y = navmesh._edge_point(c, t)
-            a = navmesh._height(nav, zx, zy, c.a, x, y)
-            b = navmesh._height(nav, zx, zy, c.b, x, y)
+            x, y = nav_geometry._edge_point(c, t)
+            a = nav_geometry._height(nav, zx, zy, c.a, x, y)
+            b = nav_geometry._height(nav, zx, zy, c.b, x, y)
             out[k] = max(out[k], abs(a - b))
     return out
 
@@ -89,13 +89,13 @@ def seam_mismatch(nav: NavMesh, contacts, zx: np.ndarray, zy: np.ndarray) -> np.
 def test_fit_corner_heights_closes_level_seams(nav: NavMesh) -> None:
     """Before the fit (each dropped corner at the mean of the two known ones) seams between
     level neighbours show steps (p90 about 11 u); after it they mostly meet."""
-    contacts = navmesh._find_contacts(nav)
+    contacts = nav_geometry._find_contacts(nav)
     assert len(contacts) > 2000
     mean = (nav.z_at_min + nav.z_at_max) / 2
     before = seam_mismatch(nav, contacts, mean, mean)
-    zx, zy = navmesh.fit_corner_heights(nav, contacts)
+    zx, zy = nav_geometry.fit_corner_heights(nav, contacts)
     after = seam_mismatch(nav, contacts, zx, zy)
-    level = before <= navmesh.SEAM_MATCH_U
+    level = before <= nav_geometry.SEAM_MATCH_U
     assert level.sum() > 1900
     med_b, p90_b = np.percentile(before[level], [50, 90])
     med_a, p90_a = np.percentile(after[level], [50, 90])
@@ -113,7 +113,7 @@ def test_nav_world_shape_and_bounds(nav: NavMesh, world: World) -> None:
     assert 9_000 <= world.num_triangles <= 12_000
     assert np.all(np.isfinite(world.triangles))
     low, high = world.bounds
-    push = (navmesh.WALL_PUSH_U + navmesh.TOUCH_TOL_U) * HAMMER_TO_M
+    push = (nav_geometry.WALL_PUSH_U + nav_geometry.TOUCH_TOL_U) * HAMMER_TO_M
     assert low[0] >= nav.x_min.min() * HAMMER_TO_M - push
     assert high[0] <= nav.x_max.max() * HAMMER_TO_M + push
     assert low[1] >= nav.y_min.min() * HAMMER_TO_M - push
@@ -121,7 +121,7 @@ def test_nav_world_shape_and_bounds(nav: NavMesh, world: World) -> None:
     z_low = min(nav.z_at_min.min(), nav.z_at_max.min()) * HAMMER_TO_M
     z_high = max(nav.z_at_min.max(), nav.z_at_max.max()) * HAMMER_TO_M
     assert low[2] >= z_low - 0.5
-    assert high[2] <= z_high + navmesh.WALL_HEIGHT_U * HAMMER_TO_M + 0.5
+    assert high[2] <= z_high + nav_geometry.WALL_HEIGHT_U * HAMMER_TO_M + 0.5
     # inside the radar picture (1024 px at `scale` units per pixel from the top-left corner)
     radar = nav.radar
     side = 1024 * radar["scale"] * HAMMER_TO_M
@@ -206,7 +206,7 @@ def wall_triangles(world: World, count: int) -> tuple[np.ndarray, np.ndarray]:
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     height = np.ptp(tri[:, :, 2], axis=1)
     walls = np.nonzero(
-        (np.abs(normal[:, 2]) < 1e-6) & (height >= navmesh.WALL_HEIGHT_U * HAMMER_TO_M - 1e-6)
+        (np.abs(normal[:, 2]) < 1e-6) & (height >= nav_geometry.WALL_HEIGHT_U * HAMMER_TO_M - 1e-6)
     )[0]
     assert len(walls) > 1000
     pick = np.random.default_rng(11).choice(walls, size=count, replace=False)

@@ -1,0 +1,130 @@
+"""The nav mesh of a built-in map as data: the areas, their places and links, the radar
+transform, and the boxes the nav mesh lacks (`world_patches.csv`), read from the map's assets.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
+from decoy_cli.errors import WorldError
+from decoy_cli.package_data import packaged_dir
+
+REGION_PLACES = {
+    "t_spawn": "TSpawn",
+    "ct_spawn": "CTSpawn",
+    "bombsite_a": "BombsiteA",
+    "bombsite_b": "BombsiteB",
+}
+"""Regions the simulator and the replay use, and the nav place that defines each."""
+
+
+@dataclass(frozen=True)
+class NavMesh:
+    """Nav areas as arrays (Hammer units): rectangle bounds, corner heights, places, links."""
+
+    area_id: np.ndarray  # (A,) int64
+    place: np.ndarray  # (A,) str
+    x_min: np.ndarray
+    y_min: np.ndarray
+    x_max: np.ndarray
+    y_max: np.ndarray
+    z_at_min: np.ndarray  # height at (x_min, y_min)
+    z_at_max: np.ndarray  # height at (x_max, y_max)
+    connections: np.ndarray  # (C, 2) area indices (not ids), directed
+    radar: dict[str, float]
+
+    @property
+    def num_areas(self) -> int:
+        return len(self.area_id)
+
+    @property
+    def places(self) -> list[str]:
+        """Sorted distinct place names (the empty name excluded)."""
+        return sorted({p for p in self.place.tolist() if p})
+
+    def contains(self, points_u: np.ndarray, z_tolerance_u: float, margin_u: float = 0.0):
+        """(M, A) mask of points inside each area's rectangle (grown by margin) near its height."""
+        x, y, z = points_u[:, 0:1], points_u[:, 1:2], points_u[:, 2:3]
+        inside = (
+            (x >= self.x_min - margin_u)
+            & (x <= self.x_max + margin_u)
+            & (y >= self.y_min - margin_u)
+            & (y <= self.y_max + margin_u)
+        )
+        low = np.minimum(self.z_at_min, self.z_at_max)
+        high = np.maximum(self.z_at_min, self.z_at_max)
+        return inside & (z >= low - z_tolerance_u) & (z <= high + z_tolerance_u)
+
+    def area_of(self, points_m: np.ndarray, max_distance_m: float = 1.0) -> np.ndarray:
+        """Index of the nav area under each point (metres), -1 where none is near.
+
+        A point inside several rectangles (two floors) takes the one closest in height; a point
+        just outside every rectangle (near a wall) takes the nearest rectangle on its floor.
+        """
+        pts = np.asarray(points_m, dtype=np.float64).reshape(-1, 3) / HAMMER_TO_M
+        out = np.full(len(pts), -1, dtype=np.int64)
+        centre_z = (self.z_at_min + self.z_at_max) / 2
+        for start in range(0, len(pts), 2048):
+            chunk = pts[start : start + 2048]
+            dx = np.maximum(0, np.maximum(self.x_min - chunk[:, :1], chunk[:, :1] - self.x_max))
+            dy = np.maximum(0, np.maximum(self.y_min - chunk[:, 1:2], chunk[:, 1:2] - self.y_max))
+            dz = np.abs(chunk[:, 2:3] - centre_z)
+            cost = np.hypot(dx, dy) + 0.25 * dz
+            best = np.argmin(cost, axis=1)
+            ok = cost[np.arange(len(chunk)), best] <= max_distance_m / HAMMER_TO_M
+            out[start : start + len(chunk)] = np.where(ok, best, -1)
+        return out
+
+
+def asset_dir(map_name: str = BUILTIN_MAP) -> Path:
+    """Folder of a built-in map's assets (top-level `assets/`, installed as decoy_cli.assets)."""
+    return packaged_dir("assets") / map_name
+
+
+@cache
+def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
+    """Read the nav areas, connections and radar transform shipped for a built-in map."""
+    folder = asset_dir(map_name)
+    if not (folder / "nav_areas.csv").is_file():
+        raise WorldError(f"no built-in map {map_name!r} (looked in {folder})")
+    with open(folder / "nav_areas.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    area_id = np.array([int(r["area_id"]) for r in rows], dtype=np.int64)
+    col = {
+        k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k not in ("area_id", "place")
+    }
+    index = {int(a): i for i, a in enumerate(area_id)}
+    with open(folder / "nav_connections.csv", newline="") as f:
+        pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in csv.DictReader(f)]
+    meta = json.loads((folder / "map.json").read_text())
+    return NavMesh(
+        area_id=area_id,
+        place=np.array([r["place"] for r in rows]),
+        x_min=col["x_min"],
+        y_min=col["y_min"],
+        x_max=col["x_max"],
+        y_max=col["y_max"],
+        z_at_min=col["z_at_min"],
+        z_at_max=col["z_at_max"],
+        connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
+        radar=meta["radar"],
+    )
+
+
+def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
+    """Boxes missing from a built-in map's nav mesh, (B, 6) Hammer units: x_min, y_min, x_max,
+    y_max, z_top, z_bottom (none when the map has no `world_patches.csv`)."""
+    path = asset_dir(map_name) / "world_patches.csv"
+    if not path.is_file():
+        return np.zeros((0, 6))
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    keys = ("x_min", "y_min", "x_max", "y_max", "z_top", "z_bottom")
+    return np.array([[float(r[k]) for k in keys] for r in rows]).reshape(-1, 6)
