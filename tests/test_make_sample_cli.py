@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from differences import json_difference
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
@@ -58,7 +59,8 @@ def test_the_shipped_sample_is_what_make_sample_writes(tmp_path: Path) -> None:
     args = ["--out", str(tmp_path), "--rounds", "8", "--seed", "0", "--models", "shipped"]
     result = runner.invoke(app, ["make-sample", *args], env=WIDE)
     assert result.exit_code == 0, result.output
-    assert (tmp_path / shipped.name).read_bytes() == shipped.read_bytes()
+    built = tmp_path / shipped.name
+    assert built.read_bytes() == shipped.read_bytes(), json_difference(built, shipped)
 
 
 @pytest.mark.parametrize(

@@ -1,5 +1,8 @@
 """The triangles of a nav mesh: fitted corner heights, floors, step faces, bridges, walls pushed
 out to the real walls, ledge faces and patch boxes (decoy_cli/world/navmesh.py says why each).
+
+One algorithm kept in one module: every face is decided from the same per-side view of the
+areas (what touches each side, at which height, within which reach), so the parts share it.
 """
 
 from __future__ import annotations
