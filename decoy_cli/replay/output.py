@@ -1,4 +1,4 @@
-"""What a replay produces for people and for other tools: metrics, files and pictures.
+"""What a replay produces for people and for other tools: files and pictures.
 
 * `write_replay`: the replay as open files in a folder: `replay.csv` (one row per data frame
   and player: time, position, yaw, HP, alive, and the original position beside it),
