@@ -6,11 +6,12 @@ needs a decision, for a few rounds; prints how each round ended and what it cost
 Combat: `--models shipped` (the default) shoots with the DIP and DOG damage models shipped with
 decoy (`models/`, trained by the project; see their cards), `--models none` turns shooting off
 (nobody dies), and `--models FOLDER` uses another model folder (e.g. from `decoy models
-import-decoy`). In code it is `DecoyParallelEnv(damage_model="shipped" | "none" | folder)`; the
-environment's own default is no combat.
+import-decoy`). In code the environment takes the model, or a function that loads it:
+`DecoyParallelEnv(damage_model=lambda: load_damage_model("shipped"))`; its own default is no
+combat.
 
 Random walkers stay near their spawns (in the seed-0 round the two sides never come closer than
-about 50 m): they rarely reach a bomb site, let alone STOP there for the 3.2 s plant, and rarely
+about 50 m): they rarely reach a bomb site, let alone STOP there for the whole plant, and rarely
 meet, so even with combat on most rounds end "TargetSaved" at 115 s.
 """
 
@@ -21,7 +22,8 @@ import time
 
 import numpy as np
 
-from decoy_cli.sim.env import DecoyParallelEnv
+from decoy_cli.damage import load_damage_model
+from decoy_cli.sim import DecoyParallelEnv
 
 
 def main() -> None:
@@ -46,7 +48,7 @@ def main() -> None:
     if args.rounds < 1:
         parser.error("--rounds must be at least 1")
 
-    env = DecoyParallelEnv(mover=args.mover, damage_model=args.models)
+    env = DecoyParallelEnv(mover=args.mover, damage_model=lambda: load_damage_model(args.models))
     rng = np.random.default_rng(args.seed)
     print(f"{'round':>5} {'winner':>6} {'reason':<14} {'ticks':>6} {'decisions':>9} {'wall s':>7}")
     try:
