@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import sys
+import traceback
+from pathlib import Path
 
+import click
 import typer
 from typer.core import TyperGroup
 
@@ -27,16 +30,45 @@ _debug = False
 
 
 class _Group(TyperGroup):
-    """Turns a `DecoyError` into one line on stderr and exit code 1 (a traceback with --debug)."""
+    """The one error boundary of every command: a `DecoyError` (bad input) or an `OSError` (a
+    path the system refuses, a full disk) is one `error:` line on stderr and exit code 1; any
+    other exception is a bug, reported in one line as such with exit code 2. `--debug` shows
+    the traceback instead. Typer's own exits and usage errors pass through."""
 
     def invoke(self, ctx: typer.Context):  # type: ignore[override]
         try:
             return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+            raise
         except DecoyError as error:
-            if _debug:
-                raise
-            typer.echo(f"error: {error}", err=True)
-            sys.exit(1)
+            _fail(str(error), 1)
+        except OSError as error:
+            _fail(_os_problem(error), 1)
+        except Exception as error:
+            _fail(_bug(error), 2)
+
+
+def _fail(message: str, code: int) -> None:
+    if _debug:
+        raise
+    typer.echo(f"error: {message}", err=True)
+    sys.exit(code)
+
+
+def _os_problem(error: OSError) -> str:
+    """An OSError as one line naming the path, e.g. "x/y.json: File name too long"."""
+    reason = error.strerror or str(error)
+    return f"{error.filename}: {reason}" if error.filename else reason
+
+
+def _bug(error: Exception) -> str:
+    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
+    where = f" at {Path(frame.filename).name}:{frame.lineno}" if frame else ""
+    text = str(error).splitlines()[0] if str(error) else ""
+    return (
+        f"internal error (a bug in decoy, please report it): {type(error).__name__}: "
+        f"{text}{where}; rerun with --debug for the traceback"
+    )
 
 
 app = typer.Typer(

@@ -157,8 +157,7 @@ def replay_round(
     raises EstaError: there is nothing to replay.
     """
     options = options if options is not None else ReplayOptions()
-    if len(round_.frame_seconds) == 0:
-        raise EstaError(f"round {round_.round_num} has no frames (events only): nothing to replay")
+    _check_replayable(round_)
     setup = options.setup(graph, round_)
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
@@ -197,6 +196,12 @@ def replay_round(
     if options.bomb and has_bomb.size:
         holders = [i for i in range(n) if has_bomb[i, first[i]] and agents.alive[i]]
         carrier = holders[0] if holders else -1
+        if carrier >= 0 and players[carrier].side != "T":
+            raise EstaError(
+                f"{round_.path}: round {round_.round_num}: {players[carrier].name} on the "
+                f"{players[carrier].side} side holds the bomb at frame {first[carrier]}: only a "
+                "T can carry it"
+            )
     plant_from = None
     if options.bomb and round_.bomb_plant_tick is not None and len(round_.frame_ticks):
         plant_s = float(np.interp(round_.bomb_plant_tick, round_.frame_ticks, round_.frame_seconds))
@@ -261,6 +266,24 @@ def replay_round(
         recoveries=recoveries,
         played_out_s=(sim.tick - played_from) / TICK_RATE,
     )
+
+
+def _check_replayable(round_: Round) -> None:
+    """An EstaError when the round cannot be replayed on one clock: no frames, no player in any
+    frame, or two frames that fall on the same simulator tick."""
+    where = f"{round_.path}: round {round_.round_num}"
+    if len(round_.frame_seconds) == 0:
+        raise EstaError(f"round {round_.round_num} has no frames (events only): nothing to replay")
+    if round_.num_players == 0:
+        raise EstaError(f"{where}: no player in any frame: nothing to replay")
+    ticks = np.array([tick_at(s) for s in round_.frame_seconds], dtype=np.int64)
+    repeated = np.flatnonzero(np.diff(ticks) <= 0)
+    if len(repeated):
+        k = int(repeated[0]) + 1
+        raise EstaError(
+            f"{where}: frame {k} ({float(round_.frame_seconds[k]):.3f} s) is not after frame "
+            f"{k - 1} on the simulator's {TICK_RATE} Hz clock: frames must be at distinct times"
+        )
 
 
 MAX_ZIGZAG = 1.3

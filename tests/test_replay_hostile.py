@@ -1,0 +1,96 @@
+"""Rounds the replay cannot play on one clock are one `error:` line, never a traceback; and an
+unexpected exception anywhere is reported in one line as a bug (issue 17's error boundary)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from esta_fixtures import make_match, write_match
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "220"}
+
+
+def _replay(file: Path, round_num: int, tmp_path: Path, *args: str):
+    address = f"{file}:{round_num}"
+    return runner.invoke(app, ["replay", address, "--out", str(tmp_path / "out"), *args], env=WIDE)
+
+
+def _frames(document: dict[str, Any], round_index: int) -> list[dict[str, Any]]:
+    return document["gameRounds"][round_index]["frames"]
+
+
+def _one_error_line(result) -> str:
+    assert result.exit_code == 1, result.output
+    assert "Traceback" not in result.output
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: ")
+    return result.stderr.strip()
+
+
+def test_a_round_with_no_player_in_any_frame(tmp_path: Path) -> None:
+    document = make_match()
+    for frame in _frames(document, 0):
+        frame["t"]["players"] = []
+        frame["ct"]["players"] = []
+    file = write_match(tmp_path / "empty.json", document)
+    line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
+    assert line == f"error: {file}: round 1: no player in any frame: nothing to replay"
+
+
+def test_frames_on_one_tick(tmp_path: Path) -> None:
+    document = make_match()
+    frames = _frames(document, 0)
+    for frame in frames:
+        frame["tick"] = frames[0]["tick"]
+        frame["seconds"] = frames[0]["seconds"]
+    file = write_match(tmp_path / "same.json", document)
+    line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
+    assert line.startswith(f"error: {file}: round 1: frame 1 (")
+    assert line.endswith("frames must be at distinct times")
+
+
+def test_the_bomb_carried_by_a_player_listed_as_ct(tmp_path: Path) -> None:
+    document = make_match()
+    for frame in _frames(document, 0):
+        for player in frame["t"]["players"]:
+            player["hasBomb"] = False
+        for player in frame["ct"]["players"]:
+            player["hasBomb"] = player["name"] == "ct1"
+    file = write_match(tmp_path / "swapped.json", document)
+    line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
+    assert line == (
+        f"error: {file}: round 1: ct1 on the CT side holds the bomb at frame 0: only a T can "
+        "carry it"
+    )
+    assert _replay(file, 1, tmp_path, "--models", "none", "--no-bomb").exit_code == 0
+
+
+@pytest.mark.parametrize("command", [["info"], ["evaluate", "--out", "{tmp}/out"]])
+def test_a_path_the_system_refuses_is_one_error_line(tmp_path: Path, command: list[str]) -> None:
+    too_long = tmp_path / ("a" * 300 + ".json.xz")
+    args = [part.replace("{tmp}", str(tmp_path)) for part in command]
+    result = runner.invoke(app, [*args[:1], str(too_long), *args[1:]], env=WIDE)
+    assert _one_error_line(result).endswith("File name too long")
+
+
+def test_an_unexpected_exception_is_reported_as_a_bug(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    file = write_match(tmp_path / "m.json")
+
+    def broken(*args: object, **kwargs: object) -> None:
+        raise ZeroDivisionError("division by zero")
+
+    monkeypatch.setattr("decoy_cli.replay.single.replay_round", broken)
+    result = _replay(file, 1, tmp_path, "--models", "none")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert result.stderr.startswith(
+        "error: internal error (a bug in decoy, please report it): "
+        "ZeroDivisionError: division by zero at test_replay_hostile.py:"
+    )
+    assert result.stderr.strip().endswith("rerun with --debug for the traceback")
