@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import lzma
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -41,22 +42,63 @@ class Document:
     rounds: list[RoundSource]
 
 
-def read_bytes(path: Path) -> bytes:
-    """The file's JSON bytes, decompressed when the file is xz."""
+MAX_MATCH_MB_DEFAULT = 512
+"""Largest match file, in MB of JSON after decompression, that the reader takes: many times the
+largest real ESTA file seen (the T-side files hold about 21 MB), and small enough that a
+hostile file cannot exhaust memory. The environment variable `DECOY_MAX_MATCH_MB` overrides it."""
+
+
+def max_match_bytes() -> int:
+    """The size limit of a match file's JSON, in bytes (`MAX_MATCH_MB_DEFAULT` or the
+    environment's `DECOY_MAX_MATCH_MB`)."""
+    text = os.environ.get("DECOY_MAX_MATCH_MB", "")
     try:
-        data = path.read_bytes()
+        megabytes = float(text) if text else float(MAX_MATCH_MB_DEFAULT)
+    except ValueError:
+        raise EstaError(f"DECOY_MAX_MATCH_MB must be a number of MB, not {text!r}") from None
+    if not megabytes > 0:
+        raise EstaError(f"DECOY_MAX_MATCH_MB must be positive, not {text!r}")
+    return int(megabytes * 1e6)
+
+
+def read_bytes(path: Path) -> bytes:
+    """The file's JSON bytes, decompressed when the file is xz; at most `max_match_bytes()`,
+    read and decompressed in bounded steps, so a huge or hostile file fails instead of filling
+    memory."""
+    limit = max_match_bytes()
+    too_big = (
+        f"{path}: larger than {limit / 1e6:g} MB of JSON (set DECOY_MAX_MATCH_MB to allow more)"
+    )
+    try:
+        with path.open("rb") as handle:
+            data = handle.read(limit + 1)
     except FileNotFoundError:
         raise EstaError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise EstaError(f"{path}: is a folder, not a match file") from None
     except OSError as error:
         raise EstaError(f"{path}: cannot read the file ({error.strerror})") from None
-    if data.startswith(XZ_MAGIC):
+    if not data.startswith(XZ_MAGIC):
+        if len(data) > limit:
+            raise EstaError(too_big)
+        return data
+    parts: list[bytes] = []
+    size = 0
+    rest = data
+    while rest:  # one xz stream after another (xz may concatenate them), within the limit
+        decompressor = lzma.LZMADecompressor()
         try:
-            data = lzma.decompress(data)
+            part = decompressor.decompress(rest, max_length=limit + 1 - size)
         except (lzma.LZMAError, EOFError) as error:
             raise EstaError(f"{path}: corrupt or truncated xz data ({error})") from None
-    return data
+        size += len(part)
+        if size > limit or (not decompressor.eof and not decompressor.needs_input):
+            raise EstaError(too_big)
+        if not decompressor.eof:
+            raise EstaError(f"{path}: corrupt or truncated xz data (the stream ends early)")
+        parts.append(part)
+        rest = decompressor.unused_data.lstrip(b"\0")  # xz allows zero padding between streams
+    return b"".join(parts)
 
 
 def parse(path: Path, data: bytes) -> Document:
