@@ -94,3 +94,31 @@ def test_an_unexpected_exception_is_reported_as_a_bug(
         "ZeroDivisionError: division by zero at test_replay_hostile.py:"
     )
     assert result.stderr.strip().endswith("rerun with --debug for the traceback")
+
+
+def test_the_data_never_chooses_the_output_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """matchIDs that climb out of the folder, hold a NUL, or share their first characters:
+    every default replay folder lies inside decoy-out/replay, one per input file."""
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    ids = ["../../escaped", "bad\x00id", "synthetic-dust2-seed0", "synthetic-dust2-seed1"]
+    folders = []
+    for k, match_id in enumerate(ids):
+        document = make_match()
+        document["matchID"] = match_id
+        file = write_match(tmp_path / f"m{k}.json", document)
+        result = runner.invoke(app, ["replay", f"{file}:1", "--models", "none"], env=WIDE)
+        if result.exit_code == 1:  # the reader may refuse such a matchID: a clean error then
+            _one_error_line(result)
+            continue
+        assert result.exit_code == 0, result.output
+        folders.append(result.stdout.strip().splitlines()[-1].removeprefix("replay written to "))
+    replay_root = (work / "decoy-out" / "replay").resolve()
+    resolved = [(work / folder).resolve() for folder in folders]
+    assert len(resolved) >= 3
+    assert all(folder.parent == replay_root for folder in resolved), folders
+    assert len(set(resolved)) == len(resolved)
+    assert not list(tmp_path.rglob("escaped"))

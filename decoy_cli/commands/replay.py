@@ -31,7 +31,9 @@ def replay(
         None, "--graph", help="Waypoint graph (.npz from build-waypoints; default: built-in)."
     ),
     out: Path | None = typer.Option(
-        None, "--out", help="Output folder (default decoy-out/replay/<match>_r<round>)."
+        None,
+        "--out",
+        help="Output folder (default decoy-out/replay/<file name>-<content hash>_r<round>).",
     ),
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),

@@ -7,6 +7,8 @@ into the output folder; the command only parses options and prints what this ret
 
 from __future__ import annotations
 
+import hashlib
+import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,6 +18,7 @@ import pandas as pd
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, load_round
+from decoy_cli.esta.reader import MATCH_SUFFIXES
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
@@ -61,14 +64,30 @@ def replay_address(
     seconds = time.perf_counter() - started
     players = player_metrics(round_, result.trace())
     summary = replay_summary(address, round_, options, models, result, players, seconds)
-    folder = out or DEFAULT_REPLAY_OUT / f"{round_.match_id[:8]}_r{round_.round_num}"
+    folder = out or DEFAULT_REPLAY_OUT / replay_folder_name(round_.path, round_.round_num)
     write_replay(folder, round_, result, players, summary)
     nav = load_navmesh()
-    title = f"{round_.match_id[:8]} round {round_.round_num}: original (dashed) vs replay"
+    shown = "".join(c if c.isprintable() else "?" for c in round_.match_id[:8])
+    title = f"{shown} round {round_.round_num}: original (dashed) vs replay"
     plot_paths(folder / "paths.png", round_, result, nav, title=title)
     if gif:
         animate(folder / "round.gif", round_, result, nav)
     return SingleReplay(round_, options, result, players, summary, folder, seconds)
+
+
+def replay_folder_name(file: Path, round_num: int) -> str:
+    """The default output folder of a round's replay: the match file's name (letters, digits,
+    `.`, `_` and `-` only) and the first 8 hex digits of its content's SHA-256, so the data never
+    chooses a path and two files never share a folder."""
+    name = file.name
+    for suffix in MATCH_SUFFIXES:
+        name = name.removesuffix(suffix)
+    safe = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:64] or "match"
+    digest = hashlib.sha256()
+    with file.open("rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return f"{safe}-{digest.hexdigest()[:8]}_r{round_num}"
 
 
 def replay_summary(
