@@ -70,3 +70,21 @@ def test_failure_from_keeps_a_bad_input_line_and_names_a_bug() -> None:
         bug = failure_from(error, "x.json", 3, "replay error")
     assert bug.kind == "internal error"
     assert bug.message.startswith("IndexError: list index out of range (at test_esta_batch.py:")
+
+
+def test_dangling_and_looping_links_are_failures_not_silence(tmp_path: Path) -> None:
+    good = write_match(tmp_path / "a.json.xz")
+    (tmp_path / "dangling.json.xz").symlink_to(tmp_path / "nowhere.json.xz")
+    (tmp_path / "loop.json").symlink_to(tmp_path / "loop.json")
+    files, ignored = collect_match_files([tmp_path])
+    assert [f.name for f in files] == ["a.json.xz", "dangling.json.xz", "loop.json"]
+    assert ignored == []
+    items = list(iter_rounds(files))
+    failures = [x for x in items if isinstance(x, RoundFailure)]
+    assert [(Path(f.file).name, f.kind) for f in failures] == [
+        ("dangling.json.xz", "unreadable file"),
+        ("loop.json", "unreadable file"),
+    ]
+    assert "no such file" in failures[0].message
+    assert "cannot read the file" in failures[1].message
+    assert len(items) - len(failures) == 3 and good.exists()

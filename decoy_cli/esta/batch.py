@@ -69,7 +69,9 @@ def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[
                 )
             )
         for file in iter_match_files(path):
-            resolved = file.resolve()  # workers may run elsewhere: absolute paths
+            # workers may run elsewhere: absolute paths; a dangling or looping link keeps its
+            # own name, and reading it says what is wrong
+            resolved = file.resolve() if file.exists() else file.absolute()
             if resolved not in seen:
                 seen.add(resolved)
                 files.append(resolved)

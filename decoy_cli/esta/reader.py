@@ -204,13 +204,15 @@ def parse_round_address(address: str) -> tuple[Path, int]:
 
 
 def iter_match_files(path: str | Path) -> list[Path]:
-    """The match file itself, or the `.json.xz` and `.json` files in a folder, sorted."""
+    """The match file itself, or the `.json.xz` and `.json` entries of a folder, sorted. An entry
+    with a match-file name that is not a readable file (a dangling or looping link) is listed
+    too, so that reading it fails with its reason instead of vanishing."""
     path = Path(path)
     if path.is_file():
         return [path]
     if not path.is_dir():
         raise EstaError(f"{path}: no such file or folder")
-    files = sorted(p for p in path.iterdir() if p.is_file() and p.name.endswith(MATCH_SUFFIXES))
+    files = sorted(p for p in path.iterdir() if p.name.endswith(MATCH_SUFFIXES) and not p.is_dir())
     if not files:
         raise EstaError(f"{path}: no .json.xz or .json match files in this folder")
     return files
