@@ -122,3 +122,27 @@ def test_the_data_never_chooses_the_output_path(
     assert all(folder.parent == replay_root for folder in resolved), folders
     assert len(set(resolved)) == len(resolved)
     assert not list(tmp_path.rglob("escaped"))
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        ("scale", "frame time 60000 s is not within 600 s of freeze-time end"),
+        ("back", "s is before the previous frame's"),
+    ],
+)
+def test_a_broken_frame_clock_is_the_round_failure(
+    tmp_path: Path, change: str, expected: str
+) -> None:
+    """Frame times 1000 times too large (a replay of hours) or running backwards: the reader
+    refuses the round, naming the frame, before anything is simulated."""
+    document = make_match()
+    frames = _frames(document, 0)
+    if change == "scale":
+        for k, frame in enumerate(frames):
+            frame["seconds"] = 1000.0 * (60.0 + k)
+    else:
+        frames[2]["seconds"], frames[1]["seconds"] = frames[1]["seconds"], frames[2]["seconds"]
+    file = write_match(tmp_path / "clock.json", document)
+    line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
+    assert line.startswith(f"error: {file}: round 1: frame ") and expected in line

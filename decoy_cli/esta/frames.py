@@ -73,6 +73,7 @@ def build_frames(
     """Turn one round's frames into arrays; a bad frame raises Invalid naming frame and player."""
     ticks = _ticks(frames)
     seconds = _seconds(frames, ticks, tick_rate, freeze_end_tick, start_tick)
+    _check_clock(seconds, ticks)
     bomb_position = _bomb_position(frames, ticks)
     players, arrays = _players(frames, ticks)
     return FrameArrays(
@@ -136,6 +137,30 @@ def _seconds(
         reference = float(ticks[0])
     seconds[missing] = (ticks[missing] - reference) / tick_rate
     return seconds
+
+
+MAX_ROUND_S = 600.0
+"""Largest frame time accepted, seconds from freeze-time end: over three times the longest real
+round measured in the data (183 s in the T-side rounds; the game's rules give 115 s of round
+time plus the 40 s bomb timer), so frame times far beyond it are a broken clock, not a round."""
+
+
+def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
+    """Frame times must be finite, non-decreasing and within `MAX_ROUND_S` of freeze-time end."""
+    bad = ~np.isfinite(seconds) | (np.abs(seconds) > MAX_ROUND_S)
+    if bad.any():
+        f = int(np.flatnonzero(bad)[0])
+        raise Invalid(
+            f"{_where(ticks, f)}: frame time {seconds[f]:g} s is not within {MAX_ROUND_S:g} s "
+            "of freeze-time end (a round lasts at most 115 s plus the 40 s bomb timer)"
+        )
+    back = np.flatnonzero(np.diff(seconds) < 0)
+    if len(back):
+        f = int(back[0]) + 1
+        raise Invalid(
+            f"{_where(ticks, f)}: frame time {seconds[f]:g} s is before the previous frame's "
+            f"{seconds[f - 1]:g} s"
+        )
 
 
 def _bomb_position(frames: list[FrameState], ticks: np.ndarray) -> np.ndarray:
