@@ -146,3 +146,28 @@ def test_a_broken_frame_clock_is_the_round_failure(
     file = write_match(tmp_path / "clock.json", document)
     line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
     assert line.startswith(f"error: {file}: round 1: frame ") and expected in line
+
+
+def test_a_round_over_its_time_limit_is_a_timeout_failure(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A hung round cannot hang the batch: the job interrupts it at the task's limit."""
+    import time
+
+    from decoy_cli.evaluate import job
+    from decoy_cli.evaluate.job import RoundTask, evaluate_round
+    from decoy_cli.evaluate.runner import make_settings
+
+    def hang(task: RoundTask) -> None:
+        time.sleep(30)
+
+    monkeypatch.setattr(job, "_evaluate", hang)
+    settings = make_settings(
+        map_name="dust2", combat=False, bomb=False, models="none", mover="kinematic", seed=0
+    )
+    task = RoundTask("m.json", "0" * 64, 3, "key", settings, timeout_s=0.2)
+    started = time.perf_counter()
+    failure = evaluate_round(task)
+    assert time.perf_counter() - started < 5
+    assert (failure.file, failure.round_num, failure.kind) == ("m.json", 3, "timeout")
+    assert failure.message == "the round took longer than its time limit of 0.2 s"

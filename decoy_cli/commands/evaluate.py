@@ -35,6 +35,7 @@ from decoy_cli.evaluate.report import (
     table_groups,
 )
 from decoy_cli.evaluate.runner import (
+    DEFAULT_ROUND_TIMEOUT_S,
     Evaluation,
     ProgressEvent,
     default_inputs,
@@ -86,6 +87,13 @@ def evaluate(
         help="Output folder: tables, figures, report.md, and the cache that lets an "
         "interrupted run resume.",
     ),
+    round_timeout: float = typer.Option(
+        DEFAULT_ROUND_TIMEOUT_S,
+        "--round-timeout",
+        min=0,
+        help="Wall-clock seconds one round may take before it is recorded as a timeout "
+        "failure (0: no limit; local workers only).",
+    ),
     workers: int | None = typer.Option(
         None,
         "--workers",
@@ -133,7 +141,13 @@ def evaluate(
     try:
         with backend, _ProgressDisplay() as on_progress:
             evaluation = run_evaluation(
-                inputs, settings, out, backend, sample=sample, on_progress=on_progress
+                inputs,
+                settings,
+                out,
+                backend,
+                sample=sample,
+                on_progress=on_progress,
+                round_timeout_s=round_timeout or None,
             )
     except KeyboardInterrupt:
         console.print(

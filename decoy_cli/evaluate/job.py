@@ -14,9 +14,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import signal
 import threading
 import time
 from collections import OrderedDict
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -35,6 +38,7 @@ if TYPE_CHECKING:
 
 WORKER_CRASH = "worker crash"
 REPLAY_ERROR = "replay error"
+TIMEOUT = "timeout"
 CRASH_MESSAGE = (
     "the worker process died while evaluating this (a crash, a kill or running out of memory)"
 )
@@ -61,6 +65,8 @@ class RoundTask:
     round_num: int
     key: str
     settings: EvalSettings
+    timeout_s: float | None = None
+    """Wall-clock seconds the round may take (None: no limit); not part of the cache key."""
 
 
 class FileIndex(msgspec.Struct, frozen=True):
@@ -160,18 +166,51 @@ def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     )
 
 
-def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
-    """Replay one round with the task's settings and measure it (never raises)."""
+class RoundTimeout(DecoyError):
+    """A round that took longer than its task's time limit."""
+
+
+@contextmanager
+def time_limit(seconds: float | None) -> Iterator[None]:
+    """Raise RoundTimeout in this block after `seconds` of wall-clock time. Only a process's
+    main thread can be interrupted (a local worker process is one); elsewhere, such as on a
+    multi-threaded Dask worker, the block runs without a limit."""
+    if seconds is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expire(signum: int, frame: object) -> None:
+        raise RoundTimeout(f"the round took longer than its time limit of {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
-        state = worker_state(task.settings.map_name)
-        round_ = state.match(task.file, task.file_sha).round(task.round_num)
-        settings = task.settings
-        model = state.damage_model(settings.models) if settings.combat else None
-        started = time.perf_counter()
-        result = _replay(state, round_, settings, model, task)
-        return build_record(task, round_, result, state.places, time.perf_counter() - started)
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
+    """Replay one round with the task's settings and measure it (never raises); a round over
+    the task's time limit is a TIMEOUT failure."""
+    try:
+        with time_limit(task.timeout_s):
+            return _evaluate(task)
+    except RoundTimeout as error:
+        return RoundFailure(task.file, task.round_num, TIMEOUT, str(error))
     except Exception as error:
         return failure_from(error, task.file, task.round_num, REPLAY_ERROR)
+
+
+def _evaluate(task: RoundTask) -> RoundRecord:
+    state = worker_state(task.settings.map_name)
+    round_ = state.match(task.file, task.file_sha).round(task.round_num)
+    settings = task.settings
+    model = state.damage_model(settings.models) if settings.combat else None
+    started = time.perf_counter()
+    result = _replay(state, round_, settings, model, task)
+    return build_record(task, round_, result, state.places, time.perf_counter() - started)
 
 
 def _replay(

@@ -130,6 +130,11 @@ def make_settings(
     )
 
 
+DEFAULT_ROUND_TIMEOUT_S = 300.0
+"""Default wall-clock limit of one round in `decoy evaluate`: hundreds of times what a real round
+takes to replay, so only a broken or hostile round reaches it."""
+
+
 def default_inputs() -> list[Path]:
     """The inputs of a run given none: the shipped synthetic sample (an error without it)."""
     from decoy_cli.synth.sample import SAMPLE_DIR
@@ -151,8 +156,12 @@ def run_evaluation(
     sample: int | None = None,
     on_progress: Callable[[ProgressEvent], None] | None = None,
     job: Callable[[RoundTask], Any] = evaluate_round,
+    round_timeout_s: float | None = None,
 ) -> Evaluation:
     """Evaluate every round (or a sample) of the inputs; see the module docstring.
+
+    `round_timeout_s` limits the wall-clock time of each round (a round over it is a recorded
+    "timeout" failure; None: no limit).
 
     `job` is the per-round function the workers run (a test can wrap it to inject a crash).
     An OutputError while caching (a full disk) stops the run; what was cached stays.
@@ -185,7 +194,7 @@ def run_evaluation(
         evaluation.files.append(MatchFile(path, sha))
 
     evaluation.files = _index(evaluation.files, settings, cache, backend, failures, on_progress)
-    tasks = _round_tasks(evaluation, sample)
+    tasks = _round_tasks(evaluation, sample, round_timeout_s)
     evaluation.rounds_planned = len(tasks)
     pending: list[RoundTask] = []
     for task in tasks:
@@ -263,7 +272,9 @@ def _index(
     return [MatchFile(f.path, f.sha, indexes.get(f.sha)) for f in files]
 
 
-def _round_tasks(evaluation: Evaluation, sample: int | None) -> list[RoundTask]:
+def _round_tasks(
+    evaluation: Evaluation, sample: int | None, timeout_s: float | None
+) -> list[RoundTask]:
     """The rounds to evaluate; other maps and rejected rounds go to the failures."""
     settings = evaluation.settings
     population: list[tuple[str, int, MatchFile, str | None]] = []
@@ -296,5 +307,5 @@ def _round_tasks(evaluation: Evaluation, sample: int | None) -> list[RoundTask]:
             evaluation.failures.append(RoundFailure(str(file.path), num, BROKEN_ROUND, error))
         else:
             key = round_key(settings, sha, num)
-            tasks.append(RoundTask(str(file.path), sha, num, key, settings))
+            tasks.append(RoundTask(str(file.path), sha, num, key, settings, timeout_s))
     return tasks
