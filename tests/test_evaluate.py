@@ -580,3 +580,35 @@ def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
     assert "damage model: shipped" in report
     for figure in sorted((out / "figures").glob("*.png")):
         assert f"figures/{figure.name}" in report
+
+
+def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path) -> None:
+    """One writer per output folder: a live run's lock refuses a second run with one error
+    line; a lock left by a run that no longer exists is taken over, and released at the end."""
+    import subprocess
+
+    from decoy_cli.evaluate.outputs import LOCK_FILE
+
+    out = tmp_path / "out"
+    out.mkdir()
+    holder = subprocess.Popen(["sleep", "60"])
+    try:
+        (out / LOCK_FILE).write_text(f"{holder.pid}\n")
+        refused = _invoke(
+            str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out)
+        )
+        assert refused.exit_code == 1
+        assert refused.stderr == (
+            f"error: {out}: another decoy evaluate (process {holder.pid}) is writing to this "
+            "folder; wait for it or choose another --out\n"
+        )
+        assert sorted(p.name for p in out.iterdir()) == [LOCK_FILE]
+    finally:
+        holder.kill()
+        holder.wait()
+    (out / LOCK_FILE).write_text(f"{holder.pid}\n")  # its run is gone: a stale lock
+    done = _invoke(str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
+    assert done.exit_code == 0, done.output
+    names = sorted(p.name for p in out.iterdir())
+    assert LOCK_FILE not in names and not [n for n in names if n.startswith(".staging")]
+    assert {"players.csv", "report.md", "summary.json", "tables", "figures"} <= set(names)

@@ -24,7 +24,7 @@ from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
-from decoy_cli.evaluate.outputs import write_outputs
+from decoy_cli.evaluate.outputs import output_lock, write_outputs
 from decoy_cli.evaluate.report import (
     RunInfo,
     combat_caveats,
@@ -138,26 +138,27 @@ def evaluate(
         where = f"{count} local worker process{'es' if count > 1 else ''}"
     info = RunInfo(command=command, backend=where, sample=sample, machine=machine_line())
     console.print(f"evaluating with {where}: {mechanics(settings)}", highlight=False)
-    try:
-        with backend, _ProgressDisplay() as on_progress:
-            evaluation = run_evaluation(
-                inputs,
-                settings,
-                out,
-                backend,
-                sample=sample,
-                on_progress=on_progress,
-                round_timeout_s=round_timeout or None,
+    with output_lock(out):
+        try:
+            with backend, _ProgressDisplay() as on_progress:
+                evaluation = run_evaluation(
+                    inputs,
+                    settings,
+                    out,
+                    backend,
+                    sample=sample,
+                    on_progress=on_progress,
+                    round_timeout_s=round_timeout or None,
+                )
+        except KeyboardInterrupt:
+            console.print(
+                f"[yellow]interrupted: the finished rounds are cached in {out / 'cache'}; run the "
+                "same command again to resume[/yellow]"
             )
-    except KeyboardInterrupt:
-        console.print(
-            f"[yellow]interrupted: the finished rounds are cached in {out / 'cache'}; run the "
-            "same command again to resume[/yellow]"
-        )
-        raise typer.Exit(130) from None
-    started = time.perf_counter()
-    tables = build_tables(evaluation.accumulator)
-    write_outputs(evaluation, tables, out, info)
+            raise typer.Exit(130) from None
+        started = time.perf_counter()
+        tables = build_tables(evaluation.accumulator)
+        write_outputs(evaluation, tables, out, info)
     _show(console, evaluation, tables)
     console.print(
         f"outputs written to {out} (report: {out / 'report.md'}) in "

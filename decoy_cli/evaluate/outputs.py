@@ -18,12 +18,17 @@ Layout of the output folder:
 
 from __future__ import annotations
 
+import os
+import shutil
 from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from decoy_cli.errors import OutputError
 from decoy_cli.evaluate.figures import draw_figures
 from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
 from decoy_cli.evaluate.runner import Evaluation
@@ -33,8 +38,91 @@ from decoy_cli.files import json_ready, write_atomic, write_json
 FAILURE_COLUMNS = ("file", "round", "kind", "message")
 
 
+LOCK_FILE = ".decoy-evaluate.lock"
+"""The lock of an output folder: the process id of the run writing to it."""
+
+
+@contextmanager
+def output_lock(out: Path) -> Iterator[None]:
+    """Hold the output folder for this run: a second run into the same folder (while this one
+    lives) is one clear error instead of two runs overwriting each other's results. A lock left
+    by a run that no longer exists is taken over."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"cannot create {out}: {error.strerror or error}") from None
+    lock = out / LOCK_FILE
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            owner = _lock_owner(lock)
+            if owner is not None and _alive(owner):
+                raise OutputError(
+                    f"{out}: another decoy evaluate (process {owner}) is writing to this folder; "
+                    "wait for it or choose another --out"
+                ) from None
+            lock.unlink(missing_ok=True)  # left by a run that ended without cleaning up
+            continue
+        except OSError as error:
+            raise OutputError(f"cannot write {lock}: {error.strerror or error}") from None
+        with os.fdopen(fd, "w") as handle:
+            handle.write(f"{os.getpid()}\n")
+        break
+    else:
+        raise OutputError(f"{out}: cannot take the folder's lock {lock}")
+    try:
+        yield
+    finally:
+        lock.unlink(missing_ok=True)
+
+
+def _lock_owner(lock: Path) -> int | None:
+    try:
+        return int(lock.read_text().strip())
+    except (OSError, ValueError):
+        return None
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
-    """Write every output (see the module docstring); returns the paths written."""
+    """Write every output (see the module docstring) as one set: into a staging folder first,
+    then moved into `out` together, so an interrupt never leaves new tables beside an old
+    report. Returns the paths written."""
+    stage = out / f".staging-{os.getpid()}"
+    shutil.rmtree(stage, ignore_errors=True)
+    try:
+        written = _write_outputs(evaluation, tables, stage, info)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    published = []
+    try:
+        for entry in sorted(stage.iterdir()):
+            target = out / entry.name
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            os.replace(entry, target)
+        stage.rmdir()
+    except OSError as error:
+        raise OutputError(
+            f"cannot move the outputs into {out}: {error.strerror or error}"
+        ) from None
+    for path in written:
+        published.append(out / path.relative_to(stage))
+    return published
+
+
+def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
     from decoy_cli.world.navmesh import load_navmesh
 
     written = [
