@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 import typer
 from typer.core import TyperGroup
+from typer.exceptions import TyperException
 
 from decoy_cli import __version__
 from decoy_cli.commands import (
@@ -38,8 +39,14 @@ class _Group(TyperGroup):
     def invoke(self, ctx: typer.Context):  # type: ignore[override]
         try:
             return super().invoke(ctx)
-        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
-            raise
+        except (
+            typer.Exit,
+            typer.Abort,
+            TyperException,
+            click.ClickException,
+            click.exceptions.Exit,
+        ):
+            raise  # Typer's (and click's) own exits, aborts and usage errors
         except DecoyError as error:
             _fail(str(error), 1)
         except OSError as error:

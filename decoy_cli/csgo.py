@@ -52,6 +52,9 @@ JUMP_HEIGHT_M = 64 * HAMMER_TO_M
 MAX_DROP_M = 210 * HAMMER_TO_M
 """Deepest drop the waypoint builder links: the safe fall (580 u/s at 800 u/s² gravity, ~210 u)."""
 
+MAX_VELOCITY_M_S = 3500 * HAMMER_TO_M
+"""The engine's velocity cap (sv_maxvelocity 3500 u/s): no player moves faster, falling included."""
+
 TICK_RATE = 60
 """Physics ticks per second of the simulator."""
 

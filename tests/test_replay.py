@@ -13,6 +13,7 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
@@ -138,7 +139,9 @@ def make_round(
     present = np.isfinite(position).all(axis=2)
     return SimpleNamespace(
         map_name="de_dust2",
+        path=Path("made-up.json"),
         round_num=1,
+        num_players=n,
         players=[Player(t.name, t.side) for t in tracks],
         frame_ticks=ticks,
         frame_seconds=(ticks - FREEZE_END) / DATA_TICK_RATE,

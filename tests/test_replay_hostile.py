@@ -3,6 +3,7 @@ unexpected exception anywhere is reported in one line as a bug (issue 17's error
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Any
 
@@ -171,3 +172,47 @@ def test_a_round_over_its_time_limit_is_a_timeout_failure(
     assert time.perf_counter() - started < 5
     assert (failure.file, failure.round_num, failure.kind) == ("m.json", 3, "timeout")
     assert failure.message == "the round took longer than its time limit of 0.2 s"
+
+
+def _first_frame_player(document: dict[str, Any], name: str) -> dict[str, Any]:
+    frame = _frames(document, 0)[1]
+    return next(p for p in frame["t"]["players"] + frame["ct"]["players"] if p["name"] == name)
+
+
+@pytest.mark.parametrize(
+    ("case", "expected"),
+    [
+        ("hp", "frame 1 (tick 1064): ct1 has HP 250 (at most 100)"),
+        ("teleport", "frame 1 (tick 1064): ct1 moved "),
+        ("crowd", "frame 0 (tick 1000): 6 CT players (a side has at most 5)"),
+        ("no_x", "no player has a position (x, y and z) in any frame"),
+        ("off_map", "frame 0: ct1 at "),
+    ],
+)
+def test_implausible_data_is_the_round_failure(tmp_path: Path, case: str, expected: str) -> None:
+    """Silent garbage no more: impossible data fails the round by name."""
+    document = make_match()
+    if case == "hp":
+        _first_frame_player(document, "ct1")["hp"] = 250
+    elif case == "teleport":
+        _first_frame_player(document, "ct1")["x"] += 95 / 0.01905  # 95 m in half a second
+    elif case == "crowd":
+        for frame in _frames(document, 0):
+            extra = copy.deepcopy(frame["ct"]["players"][0])
+            extra["name"], extra["steamID"] = "ct9", 76561198000000019
+            frame["ct"]["players"].append(extra)
+            extra2 = copy.deepcopy(extra)
+            extra2["name"], extra2["steamID"] = "ct8", 76561198000000018
+            frame["ct"]["players"].append(extra2)
+    elif case == "no_x":
+        for frame in _frames(document, 0):
+            for player in frame["t"]["players"] + frame["ct"]["players"]:
+                player["x"] = None
+    else:
+        for frame in _frames(document, 0):
+            for player in frame["ct"]["players"]:
+                if player["name"] == "ct1":
+                    player["z"] += 57 / 0.01905
+    file = write_match(tmp_path / f"{case}.json", document)
+    line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
+    assert expected in line, line

@@ -38,6 +38,7 @@ import pandas as pd
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import PlayerInfo, Side, build_frames
+from decoy_cli.esta.plausibility import check_frames
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
     DAMAGE_COLUMNS,
@@ -236,6 +237,7 @@ def _build_round(
         _optional_int(state.freezeTimeEndTick, "freezeTimeEndTick"),
         start_tick,
     )
+    check_frames(arrays)
     ticks = arrays.ticks
     if ticks.size:
         start_tick = int(ticks[0]) if start_tick is None else start_tick

@@ -158,6 +158,7 @@ def replay_round(
     """
     options = options if options is not None else ReplayOptions()
     _check_replayable(round_)
+    _check_on_map(round_, graph)
     setup = options.setup(graph, round_)
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
@@ -283,6 +284,28 @@ def _check_replayable(round_: Round) -> None:
         raise EstaError(
             f"{where}: frame {k} ({float(round_.frame_seconds[k]):.3f} s) is not after frame "
             f"{k - 1} on the simulator's {TICK_RATE} Hz clock: frames must be at distinct times"
+        )
+
+
+OFF_MAP_M = 10.0
+"""How far outside the waypoints' bounding box an alive player may stand: six times the farthest
+measured in the real rounds (1.7 m, a jump above the highest waypoint)."""
+
+
+def _check_on_map(round_: Round, graph: WaypointGraph) -> None:
+    """An EstaError naming the first alive player far outside the map (module `OFF_MAP_M`)."""
+    low = graph.positions.min(axis=0) - OFF_MAP_M
+    high = graph.positions.max(axis=0) + OFF_MAP_M
+    position = np.asarray(round_.position, dtype=np.float64)
+    usable = np.asarray(round_.alive, bool) & np.isfinite(position).all(axis=2)
+    outside = usable & ((position < low) | (position > high)).any(axis=2)
+    if outside.any():
+        f = int(np.flatnonzero(outside.any(axis=0))[0])
+        p = int(np.flatnonzero(outside[:, f])[0])
+        x, y, z = position[p, f]
+        raise EstaError(
+            f"{round_.path}: round {round_.round_num}: frame {f}: {round_.players[p].name} at "
+            f"({x:.1f}, {y:.1f}, {z:.1f}) m is more than {OFF_MAP_M:g} m outside the map"
         )
 
 
