@@ -61,3 +61,11 @@ def test_concatenated_and_truncated_xz_streams(tmp_path: Path) -> None:
     cut.write_bytes(lzma.compress(text)[:-20])
     with pytest.raises(EstaError, match="corrupt or truncated xz data"):
         read_bytes(cut)
+
+
+def test_a_malformed_file_keeps_the_acronym(tmp_path: Path) -> None:
+    file = tmp_path / "mal.json"
+    file.write_text('{"gameRounds": [}')
+    with pytest.raises(EstaError) as raised:
+        read_match(file)
+    assert str(raised.value).startswith(f"{file}: invalid JSON (JSON is malformed: ")

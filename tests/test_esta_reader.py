@@ -535,8 +535,24 @@ def test_info_folder_with_a_bad_file_fails(tmp_path: Path) -> None:
     (tmp_path / "bad.json").write_text("not json")
     result = runner.invoke(app, ["info", str(tmp_path)], env={"COLUMNS": "200"})
     assert result.exit_code == 1
-    assert result.stderr.strip() == f"error: {tmp_path}: 1 of 2 match files are unreadable"
+    assert result.stderr.strip() == (
+        f"error: {tmp_path}: 1 of 2 match files are unreadable, 0 rounds failed "
+        "(`decoy info FILE` says why)"
+    )
     assert "good.json.xz" in result.stdout
+
+
+def test_info_folder_with_a_failed_round_fails_as_for_one_file(tmp_path: Path) -> None:
+    document = make_match()
+    document["gameRounds"][1]["frames"] = "not a list"
+    write_match(tmp_path / "broken.json", document)
+    write_match(tmp_path / "good.json.xz")
+    result = runner.invoke(app, ["info", str(tmp_path)], env={"COLUMNS": "200"})
+    assert result.exit_code == 1
+    assert result.stderr.strip() == (
+        f"error: {tmp_path}: 0 of 2 match files are unreadable, 1 rounds failed "
+        "(`decoy info FILE` says why)"
+    )
 
 
 def test_info_match_with_a_bad_round_fails(tmp_path: Path) -> None:

@@ -37,12 +37,14 @@ def info(
 
 
 def _show_folder(console: Console, folder: Path) -> None:
-    """One row per match file: map, rounds read and failed; unreadable files fail the command."""
+    """One row per match file: map, rounds read and failed; unreadable files and failed rounds
+    fail the command, as they do for one file."""
     files = iter_match_files(folder)
     table = Table(title=f"{folder}: {len(files)} match files")
     for column in ("file", "map", "rounds", "failed rounds"):
         table.add_column(column, justify="right" if "rounds" in column else "left", overflow="fold")
     unreadable: list[str] = []
+    failed_rounds = 0
     progress = Progress(
         TextColumn("reading"),
         BarColumn(),
@@ -58,6 +60,7 @@ def _show_folder(console: Console, folder: Path) -> None:
                 unreadable.append(str(error))
                 table.add_row(file.name, "[red]unreadable[/red]", "", "")
                 continue
+            failed_rounds += len(match.round_errors)
             table.add_row(
                 file.name,
                 match.map_name,
@@ -67,8 +70,11 @@ def _show_folder(console: Console, folder: Path) -> None:
     console.print(table)
     for message in unreadable:
         console.print(f"[red]{message}[/red]", highlight=False)
-    if unreadable:
-        raise EstaError(f"{folder}: {len(unreadable)} of {len(files)} match files are unreadable")
+    if unreadable or failed_rounds:
+        raise EstaError(
+            f"{folder}: {len(unreadable)} of {len(files)} match files are unreadable, "
+            f"{failed_rounds} rounds failed (`decoy info FILE` says why)"
+        )
 
 
 def _show_match(console: Console, match: Match) -> None:

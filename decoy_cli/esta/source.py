@@ -128,7 +128,7 @@ def _parse_lenient(path: Path, data: bytes, strict_error: Exception) -> Document
         document = json.loads(data)
     except (ValueError, RecursionError):
         message = str(strict_error)
-        message = message[:1].lower() + message[1:]
+        message = _lower_first(message)
         raise EstaError(f"{path}: invalid JSON ({message})") from None
     if not isinstance(document, dict):
         raise EstaError(f"{path}: not an ESTA match file (the JSON is not an object)")
@@ -163,4 +163,11 @@ def round_number_hint(source: RoundSource) -> float | None:
 def _describe(error: Exception) -> str:
     """msgspec's message with the JSON path made relative to the round."""
     message = str(error).replace(" - at `$.", " at `").replace(" - at `$", " at `")
+    return _lower_first(message)
+
+
+def _lower_first(message: str) -> str:
+    """The message with its first word in lower case, unless it is an acronym ("JSON")."""
+    if message[1:2].isupper():
+        return message
     return message[:1].lower() + message[1:]
