@@ -111,6 +111,27 @@ def test_evaluate_the_test_part_again(trained: Path, data: Path, tmp_path: Path)
     assert len(list(out.glob("*.png"))) == 5
 
 
+def test_evaluate_with_an_unreadable_file_fails_after_writing(
+    trained: Path, data: Path, tmp_path: Path
+) -> None:
+    """A corrupt file among the data: the metrics of the rest are written, then one error line
+    and a non-zero exit, as `decoy evaluate` does."""
+    folder = tmp_path / "data"
+    folder.mkdir()
+    for file in data.iterdir() if data.is_dir() else [data]:
+        (folder / file.name).write_bytes(file.read_bytes())
+    (folder / "corrupt.json.xz").write_bytes(b"\xfd7zXZ\x00 not xz")
+    out = tmp_path / "evaluation"
+    result = runner.invoke(
+        app, ["models", "evaluate", str(trained), str(folder), "--out", str(out)], env=WIDE
+    )
+    assert result.exit_code == 1, result.output
+    assert result.stderr == (
+        "error: 1 input failed and is left out of the metrics (listed above)\n"
+    )
+    assert "corrupt.json.xz" in result.stdout and (out / "metrics.json").is_file()
+
+
 @pytest.mark.skipif(
     not (CHECKPOINTS / "dip_best_model.pth").is_file(),
     reason="../shared/data/decoy_checkpoints (the paper's weights) is absent",

@@ -37,6 +37,7 @@ from decoy_cli.damage.split import (
     DEFAULT_TEST_FRACTION,
     DEFAULT_VAL_FRACTION,
 )
+from decoy_cli.errors import DecoyError
 
 DEFAULT_IMPORT_OUT = Path("decoy-out") / "models" / "paper"
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
@@ -118,7 +119,8 @@ def evaluate(
 
     Prints DIP's and DOG's metrics beside the paper's and writes metrics.json with the figures:
     ROC and precision-recall curves, reconstructed vs real damage, the error histogram, the
-    hit-group confusion matrix, generated vs real damage per weapon and hit group."""
+    hit-group confusion matrix, generated vs real damage per weapon and hit group. Exits
+    non-zero, after writing them, when a file or round failed."""
     choice = SampleChoice(
         data=data,
         mode=mode,
@@ -150,3 +152,9 @@ def evaluate(
         if result.dog.metrics["cells"]:
             console.print(cells_table(result.dog.metrics["cells"]))
     console.print(f"metrics and {len(result.figures)} figures written to {result.out}")
+    failed = len(result.stats.failures)
+    if failed:
+        raise DecoyError(
+            f"{failed} input{'s' if failed > 1 else ''} failed and "
+            f"{'are' if failed > 1 else 'is'} left out of the metrics (listed above)"
+        )
