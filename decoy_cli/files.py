@@ -76,3 +76,20 @@ def json_text(data: Any, *, sort_keys: bool = True) -> str:
 def write_json(path: str | Path, data: Any, *, sort_keys: bool = True) -> Path:
     """Write `data` as pretty strict JSON, atomically: the one JSON writer of every output."""
     return write_atomic(path, json_text(data, sort_keys=sort_keys).encode())
+
+
+def check_writable(path: str | Path) -> Path:
+    """An OutputError now, before any long work, when `path` (a file to write later) cannot be
+    written: its folder cannot be made, or a file cannot be created there."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError(f"cannot write {path}: it is a directory")
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".check", dir=parent)
+    except OSError as error:
+        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
+    os.close(fd)
+    Path(name).unlink(missing_ok=True)
+    return path

@@ -159,6 +159,15 @@ def test_bad_options_are_one_line(tmp_path: Path) -> None:
     mover = runner.invoke(app, ["bench", "--quick", "--mover", "warp"], env=WIDE)
     assert mover.exit_code == 1
     assert mover.stderr.strip() == "error: unknown mover 'warp' (use kinematic or physics)"
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    unwritable = runner.invoke(
+        app, ["bench", "--quick", "--out", str(blocker / "bench.json")], env=WIDE
+    )
+    assert unwritable.exit_code == 1 and unwritable.stderr.startswith(
+        f"error: cannot write {blocker / 'bench.json'}: "
+    )
+    assert "Table 1" not in unwritable.stdout  # refused before any section ran
     folder = runner.invoke(app, ["bench", "--quick", "--out", str(tmp_path)], env=WIDE)
     assert folder.exit_code == 1 and "is a folder" in folder.stderr
     data = runner.invoke(app, ["bench", "--quick", "--data", str(tmp_path)], env=WIDE)

@@ -197,6 +197,7 @@ def test_check_esta_missing_path(tmp_path: Path, small_obj: Path) -> None:
         "--no-plot", "--check-esta", str(tmp_path / "absent.json.xz"),
     )  # fmt: skip
     assert_one_error_line(result, "absent.json.xz", "no such file")
+    assert not (tmp_path / "g.npz").exists()  # refused before the build, not after it
 
 
 # ---- bad input: one error line ----------------------------------------------------------------

@@ -23,7 +23,7 @@ from decoy_cli.bench import (
 )
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import OutputError
-from decoy_cli.files import write_json
+from decoy_cli.files import check_writable, write_json
 
 DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
 
@@ -80,6 +80,7 @@ def bench(
     console = Console()
     if out.is_dir():
         raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
+    check_writable(out)  # before minutes of measuring
     config = BenchConfig.create(
         quick=quick, models=models, mover=mover, combat=combat, bomb=bomb, seed=seed
     )

@@ -12,6 +12,8 @@ from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedCo
 from rich.table import Table
 
 from decoy_cli.errors import GraphError
+from decoy_cli.esta import collect_match_files
+from decoy_cli.files import check_writable
 from decoy_cli.waypoints.build import build_graph, canonical_map, read_manual_waypoints
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.waypoints.plot import plot_graph
@@ -86,6 +88,9 @@ def build_waypoints(
     seed_points = np.array([_parse_point(s, "--seed") for s in seeds]) if seeds else None
     manual_points = read_manual_waypoints(manual) if manual is not None else None
     out = out or DEFAULT_OUT / f"{name}.npz"
+    check_writable(out)  # before the build's minutes
+    if check_esta is not None:
+        collect_match_files([check_esta])  # a missing or empty input fails now, not after
     params = LatticeParams(spacing=spacing, wall_nodes=wall_nodes)
 
     started = time.perf_counter()
