@@ -23,15 +23,7 @@ from decoy_cli.errors import OutputError
 def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> Path:
     """Write `payload` (bytes, or a function that writes the given temporary path) to `path`."""
     path = Path(path)
-    if path.is_dir():
-        raise OutputError(f"cannot write {path}: it is a directory")
-    parent = path.parent if str(path.parent) else Path(".")
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=parent)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    tmp = Path(name)
+    fd, tmp = _temporary_beside(path, ".tmp")
     try:
         if callable(payload):
             os.close(fd)
@@ -82,14 +74,20 @@ def check_writable(path: str | Path) -> Path:
     """An OutputError now, before any long work, when `path` (a file to write later) cannot be
     written: its folder cannot be made, or a file cannot be created there."""
     path = Path(path)
+    fd, tmp = _temporary_beside(path, ".check")
+    os.close(fd)
+    tmp.unlink(missing_ok=True)
+    return path
+
+
+def _temporary_beside(path: Path, suffix: str) -> tuple[int, Path]:
+    """A new private file in `path`'s folder (made if needed): (descriptor, its path)."""
     if path.is_dir():
         raise OutputError(f"cannot write {path}: it is a directory")
     parent = path.parent if str(path.parent) else Path(".")
     try:
         parent.mkdir(parents=True, exist_ok=True)
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".check", dir=parent)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=parent)
     except OSError as error:
         raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
-    os.close(fd)
-    Path(name).unlink(missing_ok=True)
-    return path
+    return fd, Path(name)
