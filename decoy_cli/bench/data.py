@@ -167,7 +167,7 @@ def replay_throughput(
     result: dict[str, Any] = {
         "rounds": len(per_round),
         "failed": len(failures),
-        "failures": [_failure_line(f) for f in failures[:MAX_FAILURES_KEPT]],
+        "failures": [f"{f.where}: {f.message}" for f in failures[:MAX_FAILURES_KEPT]],
         "options": {
             "combat": options.combat,
             "bomb": options.bomb,
@@ -187,9 +187,3 @@ def replay_throughput(
         "s_per_round_median": statistics.median(per_round),
         "time_scale": game_s / wall,
     }
-
-
-def _failure_line(failure: RoundFailure) -> str:
-    where = Path(failure.file).name
-    where += "" if failure.round_num is None else f":{failure.round_num}"
-    return f"{where}: {failure.message}"

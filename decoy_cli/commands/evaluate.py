@@ -290,7 +290,7 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         )
     console.print(places)
     for failure in evaluation.failures[:10]:
-        where = failure.file if failure.round_num is None else f"{failure.file}:{failure.round_num}"
+        where = failure.where
         console.print(f"[red]{failure.kind}[/red] {where}: {failure.message}", highlight=False)
     if len(evaluation.failures) > 10:
         console.print(f"… {len(evaluation.failures) - 10} more in failures.csv")

@@ -182,10 +182,7 @@ class SampleStats:
             "realigned_hits": self.realigned,
             "positives": self.positives,
             "negatives": self.negatives,
-            "failures": [
-                {"file": f.file, "round": f.round_num, "kind": f.kind, "message": f.message}
-                for f in self.failures
-            ],
+            "failures": [f.row() for f in self.failures],
         }
 
 

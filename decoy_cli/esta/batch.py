@@ -37,6 +37,20 @@ class RoundFailure:
     kind: str
     message: str
 
+    @property
+    def where(self) -> str:
+        """ "FILE" for a whole file, "FILE:ROUND" for a round."""
+        return self.file if self.round_num is None else f"{self.file}:{self.round_num}"
+
+    def row(self) -> dict[str, str | int | None]:
+        """The failure as a table row: file, round, kind, message."""
+        return {
+            "file": self.file,
+            "round": self.round_num,
+            "kind": self.kind,
+            "message": self.message,
+        }
+
 
 def failure_from(
     error: BaseException, file: str | Path, round_num: int | None, kind: str
@@ -78,17 +92,18 @@ def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[
     return files, ignored
 
 
-def map_failure(match: Match, map_name: str | None) -> RoundFailure | None:
-    """The failure of a whole match played on another map than `map_name` (None: any map)."""
-    if map_name is None or not match.map_name or match.map_name == map_name:
+def map_failure(
+    file: str | Path, file_map: str, rounds: int, map_name: str | None
+) -> RoundFailure | None:
+    """The failure of a whole file of `rounds` rounds played on `file_map` when the work is on
+    `map_name` (None, or a file that names no map: no failure)."""
+    if map_name is None or not file_map or file_map == map_name:
         return None
-    count = len(match.round_numbers)
     return RoundFailure(
-        str(match.path),
+        str(file),
         None,
         OTHER_MAP,
-        f"{match.path}: a {match.map_name} match ({count} rounds skipped); "
-        f"this work is on {map_name}",
+        f"{file}: a {file_map} match ({rounds} rounds skipped); this work is on {map_name}",
     )
 
 
@@ -113,7 +128,7 @@ def iter_matches(
         except DecoyError as error:
             yield failure_from(error, file, None, UNREADABLE_FILE)
             continue
-        other = map_failure(match, map_name)
+        other = map_failure(match.path, match.map_name, len(match.round_numbers), map_name)
         yield match if other is None else other
 
 

@@ -39,7 +39,7 @@ def check_frames(arrays: FrameArrays) -> None:
     known = present & (arrays.hp >= 0)
     contradiction = known & (arrays.alive != (arrays.hp > 0))
     if contradiction.any():
-        p, f = _first(contradiction)
+        p, f = first_offender(contradiction)
         state = "alive with 0 HP" if arrays.alive[p, f] else f"dead with {arrays.hp[p, f]} HP"
         raise Invalid(f"{_at(arrays, f)}: {arrays.players[p].name} is {state}")
     for side in ("T", "CT"):
@@ -60,7 +60,7 @@ def check_frames(arrays: FrameArrays) -> None:
 def _check_range(arrays: FrameArrays, values: np.ndarray, top: int, what: str) -> None:
     bad = arrays.present & (values > top)
     if bad.any():
-        p, f = _first(bad)
+        p, f = first_offender(bad)
         raise Invalid(
             f"{_at(arrays, f)}: {arrays.players[p].name} has {what} {values[p, f]} (at most {top})"
         )
@@ -75,7 +75,7 @@ def _check_speed(arrays: FrameArrays, usable: np.ndarray) -> None:
     both = usable[:, 1:] & usable[:, :-1] & (dt > 0)[None, :]
     speed = np.where(both, step / np.where(dt > 0, dt, 1.0)[None, :], 0.0)
     if speed.max(initial=0.0) > MAX_SPEED_M_S:
-        p, k = _first(speed > MAX_SPEED_M_S)
+        p, k = first_offender(speed > MAX_SPEED_M_S)
         raise Invalid(
             f"{_at(arrays, k + 1)}: {arrays.players[p].name} moved {step[p, k]:.1f} m in "
             f"{dt[k]:.2f} s ({speed[p, k]:.0f} m/s; the engine caps every player at "
@@ -83,8 +83,9 @@ def _check_speed(arrays: FrameArrays, usable: np.ndarray) -> None:
         )
 
 
-def _first(mask: np.ndarray) -> tuple[int, int]:
-    """(player, frame) of the earliest frame, then the lowest player row, where `mask` holds."""
+def first_offender(mask: np.ndarray) -> tuple[int, int]:
+    """(player, frame) of the earliest frame, then the lowest player row, where the (P, F)
+    `mask` holds: the cell an error message names."""
     frame = int(np.flatnonzero(mask.any(axis=0))[0])
     player = int(np.flatnonzero(mask[:, frame])[0])
     return player, frame

@@ -155,10 +155,7 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
 
 
 def failures_frame(evaluation: Evaluation) -> pd.DataFrame:
-    rows = [
-        {"file": f.file, "round": f.round_num, "kind": f.kind, "message": f.message}
-        for f in evaluation.failures
-    ]
+    rows = [f.row() for f in evaluation.failures]
     return pd.DataFrame(rows, columns=list(FAILURE_COLUMNS)).astype({"round": "Int64"})
 
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import RoundFailure, collect_match_files
-from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, OTHER_MAP, UNREADABLE_FILE
+from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.job import (
     FileIndex,
@@ -279,17 +279,10 @@ def _round_tasks(
     settings = evaluation.settings
     population: list[tuple[str, int, MatchFile, str | None]] = []
     for file, index in ((f, f.index) for f in evaluation.files if f.index is not None):
-        if index.map_name and index.map_name != settings.map_name:
-            count = len(index.rounds) + len(index.round_errors)
-            evaluation.failures.append(
-                RoundFailure(
-                    str(file.path),
-                    None,
-                    OTHER_MAP,
-                    f"{file.path}: a {index.map_name} match ({count} rounds skipped); "
-                    f"this evaluation is of {settings.map_name}",
-                )
-            )
+        count = len(index.rounds) + len(index.round_errors)
+        other = map_failure(file.path, index.map_name, count, settings.map_name)
+        if other is not None:
+            evaluation.failures.append(other)
             continue
         population.extend((file.sha, num, file, None) for num in index.rounds)
         population.extend((file.sha, num, file, msg) for num, msg in index.round_errors.items())

@@ -22,6 +22,7 @@ import pandas as pd
 from decoy_cli.csgo import TICK_RATE, tick_at
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
+from decoy_cli.esta.plausibility import first_offender
 from decoy_cli.metrics.players import ReplayTrace
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
@@ -157,7 +158,7 @@ def replay_round(
     raises EstaError: there is nothing to replay.
     """
     options = options if options is not None else ReplayOptions()
-    _check_replayable(round_)
+    frame_ticks = _frame_ticks(round_)
     _check_on_map(round_, graph)
     setup = options.setup(graph, round_)
     if physics is None:  # snapping finds frames in the air with the world's rays
@@ -209,7 +210,6 @@ def replay_round(
         plant_from = tick_at(plant_s - rules_config.plant_s - PLANT_TOLERANCE_S)
     defuse_from = _defuse_starts(round_, players)
 
-    frame_ticks = np.array([tick_at(s) for s in round_.frame_seconds], dtype=np.int64)
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
     policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant_from, defuse_from, caps)
     start_tick = int(frame_ticks[0])
@@ -269,9 +269,9 @@ def replay_round(
     )
 
 
-def _check_replayable(round_: Round) -> None:
-    """An EstaError when the round cannot be replayed on one clock: no frames, no player in any
-    frame, or two frames that fall on the same simulator tick."""
+def _frame_ticks(round_: Round) -> np.ndarray:
+    """(F,) simulator tick of each data frame; an EstaError when the round cannot be replayed
+    on one clock: no frames, no player in any frame, or two frames on the same tick."""
     where = f"{round_.path}: round {round_.round_num}"
     if len(round_.frame_seconds) == 0:
         raise EstaError(f"round {round_.round_num} has no frames (events only): nothing to replay")
@@ -285,6 +285,7 @@ def _check_replayable(round_: Round) -> None:
             f"{where}: frame {k} ({float(round_.frame_seconds[k]):.3f} s) is not after frame "
             f"{k - 1} on the simulator's {TICK_RATE} Hz clock: frames must be at distinct times"
         )
+    return ticks
 
 
 OFF_MAP_M = 10.0
@@ -300,8 +301,7 @@ def _check_on_map(round_: Round, graph: WaypointGraph) -> None:
     usable = np.asarray(round_.alive, bool) & np.isfinite(position).all(axis=2)
     outside = usable & ((position < low) | (position > high)).any(axis=2)
     if outside.any():
-        f = int(np.flatnonzero(outside.any(axis=0))[0])
-        p = int(np.flatnonzero(outside[:, f])[0])
+        p, f = first_offender(outside)
         x, y, z = position[p, f]
         raise EstaError(
             f"{round_.path}: round {round_.round_num}: frame {f}: {round_.players[p].name} at "

@@ -31,7 +31,6 @@ import pandas as pd
 
 from decoy_cli.errors import DecoyError, EstaError, OutputError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, iter_matches, match_rounds
-from decoy_cli.esta.batch import OTHER_MAP
 from decoy_cli.metrics import METRIC_NAMES, MetricSummary, PlayerRound, summarize
 from decoy_cli.metrics.trajectory import trajectory_metrics_frame
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -244,16 +243,12 @@ def study_files(
     """
     studies: list[RoundStudy] = []
     failures: list[RoundFailure] = []
-    for i, item in enumerate(iter_matches(files)):
+    graph_map = str(graph.meta.get("map", "")) or None
+    for i, item in enumerate(iter_matches(files, map_name=graph_map)):
         if isinstance(item, RoundFailure):
             failures.append(item)
         else:
-            try:
-                check_map(item, graph)
-            except DecoyError as error:
-                failures.append(failure_from(error, item.path, None, OTHER_MAP))
-            else:
-                _study_match(item, graph, metrics, max_distance, studies, failures, i, on_progress)
+            _study_match(item, graph, metrics, max_distance, studies, failures, i, on_progress)
         if on_progress is not None:
             on_progress(i + 1.0, len(studies))
     return combine(studies, failures, metrics=metrics)
