@@ -3,10 +3,7 @@
 from __future__ import annotations
 
 import sys
-import traceback
-from pathlib import Path
 
-import click
 import typer
 from typer.core import TyperGroup
 from typer.exceptions import TyperException
@@ -25,7 +22,7 @@ from decoy_cli.commands import (
     train,
 )
 from decoy_cli.commands.help_text import reflow_help
-from decoy_cli.errors import DecoyError
+from decoy_cli.errors import DecoyError, describe_bug
 
 _debug = False
 
@@ -39,14 +36,8 @@ class _Group(TyperGroup):
     def invoke(self, ctx: typer.Context):  # type: ignore[override]
         try:
             return super().invoke(ctx)
-        except (
-            typer.Exit,
-            typer.Abort,
-            TyperException,
-            click.ClickException,
-            click.exceptions.Exit,
-        ):
-            raise  # Typer's (and click's) own exits, aborts and usage errors
+        except (typer.Exit, typer.Abort, TyperException):
+            raise  # Typer's own exits, aborts and usage errors
         except DecoyError as error:
             _fail(str(error), 1)
         except OSError as error:
@@ -69,12 +60,11 @@ def _os_problem(error: OSError) -> str:
 
 
 def _bug(error: Exception) -> str:
-    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
-    where = f" at {Path(frame.filename).name}:{frame.lineno}" if frame else ""
-    text = str(error).splitlines()[0] if str(error) else ""
+    summary, where = describe_bug(error)
+    at = f" at {where}" if where else ""
     return (
-        f"internal error (a bug in decoy, please report it): {type(error).__name__}: "
-        f"{text}{where}; rerun with --debug for the traceback"
+        f"internal error (a bug in decoy, please report it): {summary}{at}; rerun with --debug "
+        "for the traceback"
     )
 
 

@@ -30,3 +30,15 @@ class ModelError(DecoyError):
 
 class DownloadError(DecoyError):
     """A file that cannot be fetched or fails verification: HTTP error, timeout, short body."""
+
+
+def describe_bug(error: BaseException) -> tuple[str, str]:
+    """An unexpected exception in one line: ("Type: first line of its message", "file.py:line"
+    where it was raised, or "" when unknown), for reports that must not show a traceback."""
+    import traceback
+    from pathlib import Path
+
+    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
+    where = f"{Path(frame.filename).name}:{frame.lineno}" if frame else ""
+    text = str(error).splitlines()[0] if str(error) else ""
+    return f"{type(error).__name__}: {text}", where

@@ -129,3 +129,21 @@ def test_reflow_joins_paragraph_lines_and_keeps_paragraphs_and_items() -> None:
         "* an item continued\n* another\n1. numbered\f\n    kept\n    as is"
     )
     assert reflow("\b\nkeep\nthese lines") == "\b\nkeep\nthese lines"
+
+
+def test_the_cli_needs_no_click() -> None:
+    """`pip install -e .` does not install click (Typer ships its own): the CLI must start and
+    report errors without it (the README's first command)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; sys.modules['click'] = None\n"
+        "from typer.testing import CliRunner\n"
+        "from decoy_cli.cli import app\n"
+        "result = CliRunner().invoke(app, ['info', '/no/such/file.json'])\n"
+        "print(result.exit_code, result.stderr.strip())\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "1 error: /no/such/file.json: no such file or folder"

@@ -10,12 +10,11 @@ with the place it was raised.
 
 from __future__ import annotations
 
-import traceback
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.errors import DecoyError, EstaError, describe_bug
 from decoy_cli.esta.reader import MATCH_SUFFIXES, Match, Round, iter_match_files, read_match
 
 UNREADABLE_FILE = "unreadable file"
@@ -58,12 +57,9 @@ def failure_from(
     """The failure of work that raised `error`: its own line for a `DecoyError`, else a bug."""
     if isinstance(error, DecoyError):
         return RoundFailure(str(file), round_num, kind, str(error))
-    frame = traceback.extract_tb(error.__traceback__)[-1] if error.__traceback__ else None
-    where = f" (at {Path(frame.filename).name}:{frame.lineno})" if frame else ""
-    text = str(error).splitlines()[0] if str(error) else ""
-    return RoundFailure(
-        str(file), round_num, INTERNAL_ERROR, f"{type(error).__name__}: {text}{where}"
-    )
+    summary, where = describe_bug(error)
+    at = f" (at {where})" if where else ""
+    return RoundFailure(str(file), round_num, INTERNAL_ERROR, summary + at)
 
 
 def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[Path]]:

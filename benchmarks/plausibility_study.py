@@ -1,0 +1,77 @@
+"""The real data behind the reader's and the replay's plausibility limits (README, "What the
+reader and the replay refuse").
+
+    python benchmarks/plausibility_study.py ../shared/data/esta_dust2_tside
+
+Prints, over every round of the folder: the largest JSON of a file after decompression, the
+latest frame time, the fastest movement of an alive player between two frames, the largest HP
+and armor, alive flags that contradict HP, the most players of a side in one frame, and how far
+an alive player stood outside the built-in graph's bounding box; next to the limits in force.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.esta.frames import MAX_ROUND_S
+from decoy_cli.esta.plausibility import MAX_ARMOR, MAX_HP, MAX_PER_SIDE, MAX_SPEED_M_S
+from decoy_cli.esta.source import max_match_bytes, read_bytes
+from decoy_cli.replay.replayer import OFF_MAP_M
+from decoy_cli.waypoints.build import builtin_graph
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("folder", type=Path)
+    args = parser.parse_args()
+    files, _ = collect_match_files([args.folder])
+    graph = builtin_graph()
+    low, high = graph.positions.min(axis=0), graph.positions.max(axis=0)
+    json_mb = max(len(read_bytes(file)) for file in files) / 1e6
+    last_s = speed = outside = 0.0
+    hp = armor = contradictions = per_side = rounds = failures = 0
+    for item in iter_rounds(files):
+        if isinstance(item, RoundFailure):
+            failures += 1
+            continue
+        if item.num_frames == 0:
+            continue
+        rounds += 1
+        last_s = max(last_s, float(item.frame_seconds[-1]))
+        usable = item.present & item.alive & np.isfinite(item.position).all(axis=2)
+        step = np.linalg.norm(np.diff(item.position, axis=1), axis=2)
+        dt = np.diff(item.frame_seconds)
+        both = usable[:, 1:] & usable[:, :-1] & (dt > 0)[None, :]
+        if both.any():
+            speed = max(speed, float((step / np.where(dt > 0, dt, 1.0))[both].max()))
+        hp, armor = max(hp, int(item.hp.max())), max(armor, int(item.armor.max()))
+        known = item.present & (item.hp >= 0)
+        contradictions += int((known & (item.alive != (item.hp > 0))).sum())
+        for side in ("T", "CT"):
+            rows = item.side_indices(side)
+            if len(rows):
+                per_side = max(per_side, int(item.present[rows].sum(axis=0).max()))
+        points = item.position[usable]
+        if len(points):
+            outside = max(outside, float(np.maximum(low - points, points - high).max()))
+    print(f"{len(files)} files, {rounds} rounds with frames, {failures} failures")
+    rows = [
+        ("largest JSON of a file (MB)", f"{json_mb:.1f}", f"{max_match_bytes() / 1e6:g}"),
+        ("latest frame time (s)", f"{last_s:.1f}", f"{MAX_ROUND_S:g}"),
+        ("fastest alive movement between frames (m/s)", f"{speed:.1f}", f"{MAX_SPEED_M_S:.1f}"),
+        ("largest HP / armor", f"{hp} / {armor}", f"{MAX_HP} / {MAX_ARMOR}"),
+        ("alive flags contradicting HP", str(contradictions), "0"),
+        ("most players of a side in a frame", str(per_side), str(MAX_PER_SIDE)),
+        ("farthest alive position outside the graph's box (m)", f"{outside:.2f}", f"{OFF_MAP_M:g}"),
+    ]
+    print(f"{'measure':<54}{'data':>12}{'limit':>10}")
+    for name, value, limit in rows:
+        print(f"{name:<54}{value:>12}{limit:>10}")
+
+
+if __name__ == "__main__":
+    main()
