@@ -30,9 +30,8 @@ from decoy_cli.world.physics import PhysicsWorld
 PROJECT_ROOT = Path(__file__).resolve().parents[2]
 REAL_DATA = PROJECT_ROOT.parent / "shared" / "data" / "esta_dust2_tside"
 """The real T-side ESTA rounds of a development checkout (never part of the project)."""
-SAMPLE_DATA = SAMPLE_DIR
 
-DATA_CANDIDATES = (("real", REAL_DATA), ("synthetic sample", SAMPLE_DATA))
+DATA_CANDIDATES = (("real", REAL_DATA), ("synthetic sample", SAMPLE_DIR))
 
 MAX_FAILURES_KEPT = 5
 

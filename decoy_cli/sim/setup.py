@@ -39,7 +39,7 @@ and "physics" (pybullet capsules that block each other)."""
 
 
 class SetupError(DecoyError, ValueError):
-    """A round setup that cannot be played (an unknown mover, combat without a world)."""
+    """A round setup that cannot be played (an unknown mover, a combat cadence below one tick)."""
 
 
 def check_mover(mover: str) -> str:
