@@ -40,6 +40,8 @@ class _Group(TyperGroup):
             raise  # Typer's own exits, aborts and usage errors
         except DecoyError as error:
             _fail(str(error), 1)
+        except BrokenPipeError:
+            _reader_gone()
         except OSError as error:
             _fail(_os_problem(error), 1)
         except Exception as error:
@@ -51,6 +53,17 @@ def _fail(message: str, code: int) -> None:
         raise
     typer.echo(f"error: {message}", err=True)
     sys.exit(code)
+
+
+def _reader_gone() -> None:
+    """The program reading the output went away (`decoy info x | head`): stop quietly, as a
+    Unix tool does, with nothing more written to the closed pipe."""
+    import contextlib
+    import os
+
+    with contextlib.suppress(OSError, ValueError):  # stdout is not a file (captured in a test)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    sys.exit(1)
 
 
 def _os_problem(error: OSError) -> str:

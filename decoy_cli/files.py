@@ -7,6 +7,7 @@ under the real name; every failure is one OutputError line.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -78,6 +79,22 @@ def check_writable(path: str | Path) -> Path:
     os.close(fd)
     tmp.unlink(missing_ok=True)
     return path
+
+
+def check_folder_writable(folder: str | Path) -> Path:
+    """An OutputError now, before any long work, when files cannot be written in `folder`: it
+    is a file, or it (or a missing parent) cannot be made, or a file cannot be created in it."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"cannot write into {folder}: it is a file, not a folder")
+    made = [part for part in (folder, *folder.parents) if not part.exists()]
+    try:
+        check_writable(folder / "check")
+    finally:  # the check leaves no folder behind: a failing command writes nothing
+        for part in made:
+            with contextlib.suppress(OSError):
+                part.rmdir()
+    return folder
 
 
 def _temporary_beside(path: Path, suffix: str) -> tuple[int, Path]:

@@ -1,5 +1,6 @@
-"""The reader's size limit: a match file's JSON is read and decompressed in bounded steps, so a
-huge or hostile file is one clear error instead of exhausted memory."""
+"""The reader's limits: a match file's JSON is read and decompressed in bounded steps, and the
+rounds, frames and players it may hold are bounded, so a huge or hostile file is one clear error
+instead of exhausted memory (benchmarks/hostile_memory.py measures the memory)."""
 
 from __future__ import annotations
 
@@ -69,3 +70,60 @@ def test_a_malformed_file_keeps_the_acronym(tmp_path: Path) -> None:
     with pytest.raises(EstaError) as raised:
         read_match(file)
     assert str(raised.value).startswith(f"{file}: invalid JSON (JSON is malformed: ")
+
+
+def test_too_many_rounds_is_a_file_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from decoy_cli.esta import source
+
+    monkeypatch.setattr(source, "MAX_ROUNDS", 2)
+    file = write_match(tmp_path / "m.json", make_match())
+    with pytest.raises(EstaError) as raised:
+        read_match(file)
+    assert str(raised.value) == f"{file}: 3 rounds in gameRounds (a match file holds at most 2)"
+
+
+@pytest.mark.parametrize(
+    ("limit", "value", "expected"),
+    [
+        ("MAX_FRAMES", 3, "round 1: 4 frames (a round holds at most 3)"),
+        ("MAX_PLAYERS", 8, "round 1: 9 distinct players in the frames (a server has at most 8)"),
+    ],
+)
+def test_a_round_over_a_limit_is_that_round_failure(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, limit: str, value: int, expected: str
+) -> None:
+    from decoy_cli.esta import frames
+
+    monkeypatch.setattr(frames, limit, value)
+    file = write_match(tmp_path / "m.json", make_match())
+    match = read_match(file)
+    assert str(match.round_errors[1]) == f"{file}: {expected}"
+    assert [r.round_num for r in match.rounds] == [3]  # round 2 is over the limit too
+
+
+def test_too_many_player_frames_is_a_file_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from decoy_cli.esta import reader
+
+    monkeypatch.setattr(reader, "MAX_MATCH_PLAYER_FRAMES", 40)  # round 1: 9 x 4 = 36
+    file = write_match(tmp_path / "m.json", make_match())
+    with pytest.raises(EstaError) as raised:
+        read_match(file)
+    assert str(raised.value).startswith(f"{file}: more than 40 player-frames by round 2 ")
+
+
+def test_only_small_documents_take_the_lenient_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A NaN (as awpy may write) is read by the json fallback, but only up to its size limit."""
+    from decoy_cli.esta import source
+
+    text = encode(make_match()).replace(b'"bombPlantTick": null', b'"bombPlantTick": NaN', 1)
+    assert b"NaN" in text
+    file = tmp_path / "nan.json"
+    file.write_bytes(text)
+    assert read_match(file).match_id == "fixture-0001"
+    monkeypatch.setattr(source, "LENIENT_MAX_MB", 0)
+    with pytest.raises(EstaError, match="must be strict JSON"):
+        read_match(file)

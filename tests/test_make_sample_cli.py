@@ -92,5 +92,5 @@ def test_unwritable_output_is_one_error_line(tmp_path: Path) -> None:
         app, ["make-sample", "--out", str(blocker), "--rounds", "1", "--models", "none"]
     )
     assert result.exit_code == 1
-    assert result.stderr.startswith(f"error: cannot write to {blocker}: ")
+    assert result.stderr == f"error: cannot write into {blocker}: it is a file, not a folder\n"
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.output

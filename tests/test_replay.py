@@ -157,6 +157,7 @@ def make_round(
         has_bomb=has_bomb,
         bomb_plant_tick=None if plant_frame is None else int(ticks[plant_frame]) - 10,
         bomb_events=pd.DataFrame(),
+        warnings=(),
     )
 
 

@@ -112,7 +112,14 @@ def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_pat
     assert events[["kind", "agent"]].values.tolist() == [["death", "t3"]]
 
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["options"] == {"combat": False, "bomb": True, "mover": "kinematic", "seed": 0}
+    assert summary["options"] == {
+        "combat": False,
+        "bomb": True,
+        "mover": "kinematic",
+        "seed": 0,
+        "implausible": "fail",
+    }
+    assert summary["warnings"] == []
     assert summary["frames"] == frames and summary["round_num"] == 1
     assert summary["outcome_original"] == {"winner": "T", "reason": "TerroristsWin"}
     assert summary["outcome_replay"] == {"winner": None, "reason": None}

@@ -4,6 +4,7 @@ unexpected exception anywhere is reported in one line as a bug (issue 17's error
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 from typing import Any
 
@@ -179,19 +180,17 @@ def _first_frame_player(document: dict[str, Any], name: str) -> dict[str, Any]:
     return next(p for p in frame["t"]["players"] + frame["ct"]["players"] if p["name"] == name)
 
 
-@pytest.mark.parametrize(
-    ("case", "expected"),
-    [
-        ("hp", "frame 1 (tick 1064): ct1 has HP 250 (at most 100)"),
-        ("teleport", "frame 1 (tick 1064): ct1 moved "),
-        ("crowd", "frame 0 (tick 1000): 6 CT players (a side has at most 5)"),
-        ("no_x", "no player has a position (x, y and z) in any frame"),
-        ("off_map", "frame 0: ct1 at "),
-    ],
-)
-def test_implausible_data_is_the_round_failure(tmp_path: Path, case: str, expected: str) -> None:
-    """Silent garbage no more: impossible data fails the round by name."""
-    document = make_match()
+IMPLAUSIBLE = [
+    ("hp", "frame 1 (tick 1064): ct1 has HP 250 (at most 100)"),
+    ("teleport", "frame 1 (tick 1064): ct1 moved "),
+    ("crowd", "frame 0 (tick 1000): 6 CT players (a side has at most 5)"),
+    ("no_x", "no player has a position (x, y and z) in any frame"),
+    ("off_map", "frame 0: ct1 at "),
+]
+
+
+def _make_implausible(document: dict[str, Any], case: str) -> None:
+    """Break round 1 of `document` in the way `case` names."""
     if case == "hp":
         _first_frame_player(document, "ct1")["hp"] = 250
     elif case == "teleport":
@@ -213,6 +212,42 @@ def test_implausible_data_is_the_round_failure(tmp_path: Path, case: str, expect
             for player in frame["ct"]["players"]:
                 if player["name"] == "ct1":
                     player["z"] += 57 / 0.01905
+
+
+@pytest.mark.parametrize(("case", "expected"), IMPLAUSIBLE)
+def test_implausible_data_is_the_round_failure(tmp_path: Path, case: str, expected: str) -> None:
+    """Silent garbage no more: impossible data fails the round by name."""
+    document = make_match()
+    _make_implausible(document, case)
     file = write_match(tmp_path / f"{case}.json", document)
     line = _one_error_line(_replay(file, 1, tmp_path, "--models", "none"))
     assert expected in line, line
+
+
+@pytest.mark.parametrize(("case", "expected"), IMPLAUSIBLE[:-2] + IMPLAUSIBLE[-1:])
+def test_implausible_data_replayed_with_a_warning(tmp_path: Path, case: str, expected: str) -> None:
+    """--implausible warn replays such a round and says what is wrong with it, in the terminal
+    and in summary.json; a round with no position at all still fails (nothing to replay)."""
+    document = make_match()
+    _make_implausible(document, case)
+    file = write_match(tmp_path / f"{case}.json", document)
+    result = _replay(file, 1, tmp_path, "--models", "none", "--implausible", "warn")
+    assert result.exit_code == 0, result.output
+    assert f"warning: implausible data replayed anyway: {expected}" in result.stdout
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["options"]["implausible"] == "warn"
+    assert any(expected in warning for warning in summary["warnings"]), summary["warnings"]
+
+
+def test_a_round_without_positions_fails_under_either_policy(tmp_path: Path) -> None:
+    document = make_match()
+    _make_implausible(document, "no_x")
+    file = write_match(tmp_path / "no_x.json", document)
+    result = _replay(file, 1, tmp_path, "--models", "none", "--implausible", "warn")
+    assert _one_error_line(result).endswith("no player has a position (x, y and z) in any frame")
+
+
+def test_an_unknown_policy_is_one_error_line(tmp_path: Path) -> None:
+    file = write_match(tmp_path / "m.json", make_match())
+    result = _replay(file, 1, tmp_path, "--implausible", "ignore")
+    assert _one_error_line(result) == "error: --implausible 'ignore': use fail or warn"

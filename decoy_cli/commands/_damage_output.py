@@ -20,6 +20,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG
 from decoy_cli.damage.sample_set import SampleStats
 
@@ -51,7 +52,7 @@ def progress_bars() -> tuple[
     """Progress bars on stderr, drawn only on a terminal (no stray lines in pipes): one over the
     data files and, once training starts, one over all batches of all epochs; and the two
     callbacks that drive them (`on_file` for reading, `progress` for training)."""
-    errors = Console(stderr=True)
+    errors = make_console(stderr=True)
     bars = Progress(
         TextColumn("{task.description}"),
         BarColumn(),

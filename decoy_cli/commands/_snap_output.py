@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from decoy_cli.esta import Round
 from decoy_cli.metrics import GROUPS, METRIC_NAMES, METRIC_NAMES_CLOCK
@@ -274,9 +275,11 @@ def show_actions(
         plan = study.plan.plans[p]
         total = len(plan.action)
         console.print(
-            f"[bold]{round_.players[p].name}[/bold] ({total:,} actions, "
-            f"{plan.stop_seconds:.1f} s of STOP): {_format_actions(plan, limit)}"
-            + (" …" if total > limit else ""),
+            Text.assemble(
+                (round_.players[p].name, "bold"),
+                f" ({total:,} actions, {plan.stop_seconds:.1f} s of STOP): "
+                f"{_format_actions(plan, limit)}" + (" …" if total > limit else ""),
+            ),
             highlight=False,
         )
 

@@ -6,10 +6,9 @@ from pathlib import Path
 from typing import Any
 
 import typer
-from rich.console import Console
-from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
+from rich.text import Text
 
 from decoy_cli.bench import (
     SECTIONS,
@@ -21,6 +20,7 @@ from decoy_cli.bench import (
     report,
     run_isolated,
 )
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import OutputError
 from decoy_cli.files import check_writable, write_json
@@ -77,7 +77,7 @@ def bench(
     Sections: Table 1, a 5v5 combat step, replay, metrics and reader throughput, each in its
     own process; prints tables and writes a JSON report with the machine. Exits non-zero when a
     section failed."""
-    console = Console()
+    console = make_console()
     if out.is_dir():
         raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
     check_writable(out)  # before minutes of measuring
@@ -90,14 +90,15 @@ def bench(
     status = check_damage_model(models)
     if status.error:
         console.print(
-            f"[yellow]damage model {escape(models)!r} could not be loaded: {escape(status.error)}"
-            "\nfalling back to line of sight without inference (labelled in the tables)[/yellow]"
+            f"damage model {models!r} could not be loaded: {status.error}"
+            "\nfalling back to line of sight without inference (labelled in the tables)",
+            style="yellow",
         )
-    console.print(f"damage model: {escape(status.label)}", highlight=False)
+    console.print(f"damage model: {status.label}", highlight=False)
     console.print(
         "data: "
         + (
-            f"{bench_data.kind}, {len(bench_data.files)} files in {escape(str(bench_data.folder))}"
+            f"{bench_data.kind}, {len(bench_data.files)} files in {bench_data.folder}"
             if bench_data
             else "none found (replay and reader sections skipped)"
         ),
@@ -105,7 +106,7 @@ def bench(
     )
     sections: dict[str, dict[str, Any]] = {}
     with Progress(
-        TextColumn("{task.description}"),
+        TextColumn("{task.description}", markup=False),
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
@@ -123,12 +124,12 @@ def bench(
     console.print(
         f"peak memory of this process {document['peak_rss_mb_main']:.0f} MB; load average at "
         f"the end {_load(document['load_average_end'])}; "
-        f"report written to {escape(str(out))}",
+        f"report written to {out}",
         highlight=False,
     )
     failed = failed_sections(sections)
     if failed:
-        Console(stderr=True).print(
+        make_console(stderr=True).print(
             f"error: {len(failed)} section(s) failed: {', '.join(failed)}", highlight=False
         )
         raise typer.Exit(1)
@@ -151,13 +152,13 @@ def _load(load: list[float] | None) -> str:
     return f"{load[0]:.2f} (1 min)" if load else "unknown"
 
 
-def _render(name: str, result: dict[str, Any]) -> Table | str:
+def _render(name: str, result: dict[str, Any]) -> Table | Text:
     """The section's table, or one line when it was skipped or failed."""
     title = TITLES[name]
     if "skipped" in result:
-        return f"[yellow]{title}: skipped ({escape(result['skipped'])})[/yellow]"
+        return Text(f"{title}: skipped ({result['skipped']})", style="yellow")
     if "error" in result:
-        return f"[red]{title}: failed: {escape(result['error'])}[/red]"
+        return Text(f"{title}: failed: {result['error']}", style="red")
     return {
         "table1": _table1,
         "combat_step": _combat_table,

@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.errors import GraphError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.files import check_writable
@@ -74,7 +75,7 @@ def build_waypoints(
     ),
 ) -> None:
     """Build a waypoint graph: BFS lattice, drop pass, verification, pruning, manual points."""
-    console = Console()
+    console = make_console()
     map_id = canonical_map(map_name)
     if mesh is None:
         world = nav_world(map_id)

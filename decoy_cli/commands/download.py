@@ -5,8 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
-from rich.markup import escape
 from rich.progress import (
     BarColumn,
     DownloadColumn,
@@ -17,6 +15,7 @@ from rich.progress import (
     TransferSpeedColumn,
 )
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.errors import DecoyError, DownloadError
 from decoy_cli.esta.download import (
     DEFAULT_DEST,
@@ -26,6 +25,7 @@ from decoy_cli.esta.download import (
     parse_match_id,
     parse_sha256,
 )
+from decoy_cli.files import check_folder_writable
 
 
 def download(
@@ -62,12 +62,13 @@ def download(
     Each file is verified (complete, xz, readable as ESTA, on de_dust2) before it is renamed
     into the folder; a verified file already there is kept. A failure is one line per id, the
     other ids go on, and the exit code is 1 if any failed."""
-    console = Console()
-    errors = Console(stderr=True)
+    console = make_console()
+    errors = make_console(stderr=True)
     expected = _parse_checksums(sha256, ids)
+    check_folder_writable(dest)  # one error line, not one per id
     failed = 0
     with Progress(
-        TextColumn("{task.description}"),
+        TextColumn("{task.description}", markup=False),
         BarColumn(),
         DownloadColumn(),
         TransferSpeedColumn(),
@@ -76,7 +77,7 @@ def download(
         transient=True,
     ) as progress:
         for match_id in dict.fromkeys(ids):
-            task = progress.add_task(escape(match_id), total=None)
+            task = progress.add_task(match_id, total=None)
 
             def advance(done: int, total: int | None, task: TaskID = task) -> None:
                 progress.update(task, completed=done, total=total)
@@ -92,9 +93,7 @@ def download(
                 )
             except DecoyError as error:
                 failed += 1
-                errors.print(
-                    f"[red]error:[/red] {escape(str(error))}", highlight=False, soft_wrap=True
-                )
+                errors.print(f"error: {error}", highlight=False, soft_wrap=True)
             else:
                 console.print(_describe(result), highlight=False, soft_wrap=True)
             finally:
@@ -122,9 +121,9 @@ def _describe(result: Downloaded) -> str:
     """One line: what happened, the file, its size, rounds and sha256."""
     verb = {"downloaded": "downloaded", "present": "already present", "replaced": "replaced"}
     text = (
-        f"{escape(result.match_id)}: {verb[result.status]} {escape(str(result.path))} "
+        f"{result.match_id}: {verb[result.status]} {result.path} "
         f"({result.size / 1e6:.2f} MB, {result.rounds} rounds, sha256 {result.sha256})"
     )
     if result.note:
-        text += f"; {escape(result.note)}"
+        text += f"; {result.note}"
     return text

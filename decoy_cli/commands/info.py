@@ -9,7 +9,9 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 from rich.table import Table
+from rich.text import Text
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, iter_match_files, parse_round_address, read_match
 
@@ -22,7 +24,7 @@ def info(
     ),
 ) -> None:
     """Show the rounds of a match file, the players of one round, or the matches in a folder."""
-    console = Console()
+    console = make_console()
     path = Path(target)
     if path.is_dir():
         _show_folder(console, path)
@@ -49,7 +51,7 @@ def _show_folder(console: Console, folder: Path) -> None:
         TextColumn("reading"),
         BarColumn(),
         MofNCompleteColumn(),
-        console=Console(stderr=True),
+        console=make_console(stderr=True),
         transient=True,
     )
     with progress:
@@ -58,7 +60,7 @@ def _show_folder(console: Console, folder: Path) -> None:
                 match = read_match(file)
             except EstaError as error:
                 unreadable.append(str(error))
-                table.add_row(file.name, "[red]unreadable[/red]", "", "")
+                table.add_row(file.name, Text("unreadable", style="red"), "", "")
                 continue
             failed_rounds += len(match.round_errors)
             table.add_row(
@@ -69,7 +71,7 @@ def _show_folder(console: Console, folder: Path) -> None:
             )
     console.print(table)
     for message in unreadable:
-        console.print(f"[red]{message}[/red]", highlight=False)
+        console.print(message, style="red", highlight=False)
     if unreadable or failed_rounds:
         raise EstaError(
             f"{folder}: {len(unreadable)} of {len(files)} match files are unreadable, "
@@ -98,7 +100,7 @@ def _show_match(console: Console, match: Match) -> None:
         )
     console.print(table)
     for error in match.round_errors.values():
-        console.print(f"[red]{error}[/red]", highlight=False)
+        console.print(str(error), style="red", highlight=False)
     if match.round_errors:
         failed = len(match.round_errors)
         raise EstaError(

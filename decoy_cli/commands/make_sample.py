@@ -7,12 +7,13 @@ import time
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.damage import CHOICES_HELP, load_damage_model
-from decoy_cli.errors import DecoyError, OutputError
+from decoy_cli.errors import DecoyError
+from decoy_cli.files import check_folder_writable
 from decoy_cli.synth import PlayedRound, write_sample
 from decoy_cli.synth.sample import MAX_ROUNDS
 
@@ -38,15 +39,14 @@ def make_sample(
         raise DecoyError(f"--rounds must be between 1 and {MAX_ROUNDS}, not {rounds}")
     if seed < 0:
         raise DecoyError(f"--seed must be >= 0, not {seed}")
-    console = Console()
+    console = make_console()
     damage_model = load_damage_model(models)
     if damage_model is None:
-        console.print("[yellow]no damage models: combat is off (rounds end by bomb or time)[/]")
-    try:  # fail before playing, not after
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"cannot write to {out}: {error.strerror or error}") from None
-    status = Console(stderr=True)
+        console.print(
+            "no damage models: combat is off (rounds end by bomb or time)", style="yellow"
+        )
+    check_folder_writable(out)  # fail before playing, not after
+    status = make_console(stderr=True)
     progress = Progress(
         TextColumn("playing rounds"),
         BarColumn(),

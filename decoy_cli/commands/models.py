@@ -6,9 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.commands._damage_output import (
     BALANCE_HELP,
     DATA_HELP,
@@ -38,6 +38,7 @@ from decoy_cli.damage.split import (
     DEFAULT_VAL_FRACTION,
 )
 from decoy_cli.errors import DecoyError
+from decoy_cli.files import check_folder_writable
 
 DEFAULT_IMPORT_OUT = Path("decoy-out") / "models" / "paper"
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
@@ -67,8 +68,9 @@ def import_decoy(
     """
     from decoy_cli.damage.paper import import_paper
 
+    check_folder_writable(out)  # before the checkpoints are read and converted
     result = import_paper(path, out)
-    console = Console()
+    console = make_console()
     table = Table(title="imported DECOY checkpoints")
     for column in ("model", "file", "epoch", "best val loss", "parameters"):
         table.add_column(column, justify="right" if column in ("epoch", "parameters") else "left")
@@ -130,6 +132,7 @@ def evaluate(
         val_fraction=val_fraction,
         test_fraction=test_fraction,
     )
+    check_folder_writable(out)  # before minutes of reading and sampling
     bars, on_file, _ = progress_bars()
     with bars:
         result = evaluate_model_folder(
@@ -143,7 +146,7 @@ def evaluate(
             min_cell=min_cell,
             on_file=on_file,
         )
-    console = Console()
+    console = make_console()
     print_samples(console, result.samples, result.stats)
     if result.dip is not None:
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))

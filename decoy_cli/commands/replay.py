@@ -6,10 +6,11 @@ from pathlib import Path
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.damage import load_damage_model
+from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
@@ -44,15 +45,22 @@ def replay(
         "deaths in the data are scripted) or a model folder (e.g. from `decoy models "
         "import-decoy`).",
     ),
+    implausible: str = typer.Option(
+        "fail",
+        "--implausible",
+        help="Implausible data (README: what the reader and the replay refuse): fail, or warn "
+        "and replay it anyway.",
+    ),
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
-    console = Console()
+    console = make_console()
     check_mover(mover)
+    policy = check_policy(implausible)
     damage_model = load_damage_model(models) if combat else None
     if combat and damage_model is None:
         console.print(
-            "[yellow]--models none: replaying without shooting (deaths in the data are "
-            "scripted)[/yellow]"
+            "--models none: replaying without shooting (deaths in the data are scripted)",
+            style="yellow",
         )
     options = ReplayOptions(
         combat=damage_model is not None,
@@ -60,6 +68,7 @@ def replay(
         mover=mover,
         damage_model=damage_model,
         seed=seed,
+        implausible=policy,
     )
     run = replay_address(address, options, models=models, graph_file=graph_file, out=out, gif=gif)
     round_, result, players = run.round_, run.result, run.players
@@ -84,6 +93,8 @@ def replay(
         replayed = simulated
     outcome.add_row("replay", *map(str, replayed))
     console.print(outcome)
+    for warning in result.warnings:
+        console.print(f"warning: implausible data replayed anyway: {warning}", style="yellow")
     for title, names in (
         ("clock protocol", METRIC_NAMES_CLOCK),
         ("paper protocol", METRIC_NAMES_PAPER),

@@ -8,6 +8,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.commands._snap_output import (
     show_actions,
     show_places,
@@ -80,7 +81,7 @@ def snap(
 
     With --metrics, the metrics of the snapped trajectory against the original (the bound a
     replay can reach). Exits non-zero when a file or round failed."""
-    console = Console()
+    console = make_console()
     graph = WaypointGraph.load(graph_file) if graph_file is not None else builtin_graph()
     path = Path(target)
     if path.exists():
@@ -138,7 +139,7 @@ def _snap_batch(
 ) -> None:
     """Every round of a file or folder: aggregate table, worst intervals, metrics, failures."""
     files = iter_match_files(path)
-    stderr = Console(stderr=True)
+    stderr = make_console(stderr=True)
     progress = Progress(
         TextColumn("snapping"),
         BarColumn(),
@@ -171,7 +172,7 @@ def _snap_batch(
         write_csv(study.rows, csv)
         console.print(f"{len(study.rows)} player-round rows written to {csv}")
     for failure in study.failures:
-        console.print(f"[red]{failure.message}[/red]", highlight=False)
+        console.print(failure.message, style="red", highlight=False)
     if study.failures:
         files_failed = sum(f.round_num is None for f in study.failures)
         rounds_failed = len(study.failures) - files_failed

@@ -12,6 +12,7 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
+from decoy_cli.commands._console import console as make_console
 from decoy_cli.commands._damage_output import (
     DATA_HELP,
     DRAWS_HELP,
@@ -54,6 +55,7 @@ from decoy_cli.damage.train_options import (
     TrainOptions,
 )
 from decoy_cli.damage.training_run import TrainingResult, train_dip_model, train_dog_model
+from decoy_cli.files import check_folder_writable
 
 DEFAULT_OUT = Path("decoy-out") / "models" / "trained"
 
@@ -125,6 +127,7 @@ def dip(
         val_fraction=val_fraction,
         test_fraction=test_fraction,
     )
+    _check_outputs(out, report)
     bars, on_file, on_step = progress_bars()
     with bars:
         result = train_dip_model(
@@ -136,7 +139,7 @@ def dip(
             on_file=on_file,
             progress=on_step,
         )
-    console = Console()
+    console = make_console()
     _print_start(console, result, choice)
     run = result.run
     console.print(
@@ -199,6 +202,7 @@ def dog(
         val_fraction=val_fraction,
         test_fraction=test_fraction,
     )
+    _check_outputs(out, report)
     bars, on_file, on_step = progress_bars()
     with bars:
         result = train_dog_model(
@@ -212,7 +216,7 @@ def dog(
             on_file=on_file,
             progress=on_step,
         )
-    console = Console()
+    console = make_console()
     _print_start(console, result, choice)
     run = result.run
     console.print(f"best epoch {run.trained.best_epoch} of {len(run.trained.history)}")
@@ -220,3 +224,10 @@ def dog(
     if run.test.metrics["cells"]:
         console.print(cells_table(run.test.metrics["cells"]))
     console.print(f"model written to {result.model_folder}, report to {result.report_folder}")
+
+
+def _check_outputs(out: Path, report: Path | None) -> None:
+    """Fail before training when the model or report folder cannot be written."""
+    check_folder_writable(out)
+    if report is not None:
+        check_folder_writable(report)

@@ -71,6 +71,8 @@ def build_frames(
     start_tick: int | None,
 ) -> FrameArrays:
     """Turn one round's frames into arrays; a bad frame raises Invalid naming frame and player."""
+    if len(frames) > MAX_FRAMES:
+        raise Invalid(f"{len(frames):,} frames (a round holds at most {MAX_FRAMES:,})")
     ticks = _ticks(frames)
     seconds = _seconds(frames, ticks, tick_rate, freeze_end_tick, start_tick)
     _check_clock(seconds, ticks)
@@ -143,6 +145,14 @@ MAX_ROUND_S = 600.0
 """Largest frame time accepted, seconds from freeze-time end: over three times the longest real
 round measured in the data (183 s in the T-side rounds; the game's rules give 115 s of round
 time plus the 40 s bomb timer), so frame times far beyond it are a broken clock, not a round."""
+
+MAX_FRAMES = int(MAX_ROUND_S * 128)
+"""Most frames a round may hold: one per tick at 128 ticks/s for `MAX_ROUND_S` (real rounds
+have about two frames per second). Bounds the memory of a hostile round."""
+
+MAX_PLAYERS = 64
+"""Most distinct players a round's frames may hold: a CS:GO server has at most 64 player slots
+(real rounds have 10, or 5 in the T-side files). Bounds the (players, frames) arrays."""
 
 
 def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
@@ -220,6 +230,10 @@ def _players(
             raise Invalid(f"{_where(ticks, frame_of[e])}: player {key} appears on both sides")
         player_of[e] = i
 
+    if len(infos) > MAX_PLAYERS:
+        raise Invalid(
+            f"{len(infos):,} distinct players in the frames (a server has at most {MAX_PLAYERS})"
+        )
     # T before CT, each by key: a stable order whatever the order inside the frames.
     order = sorted(range(len(infos)), key=lambda i: (infos[i].side != "T", infos[i].key))
     rank = np.empty(len(infos), dtype=np.int64)

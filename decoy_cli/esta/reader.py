@@ -38,7 +38,7 @@ import pandas as pd
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import PlayerInfo, Side, build_frames
-from decoy_cli.esta.plausibility import check_frames
+from decoy_cli.esta.plausibility import Implausible, check_frames
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
     DAMAGE_COLUMNS,
@@ -48,6 +48,11 @@ from decoy_cli.esta.schema import (
     RoundState,
 )
 from decoy_cli.esta.source import decode_round, parse, read_bytes, round_number_hint
+
+MAX_MATCH_PLAYER_FRAMES = 4_000_000
+"""Most player-frames (players × frames, summed over rounds) a match file may hold: over 30 times
+a full real match (30 rounds of 10 players at two frames per second). With the per-round limits
+of decoy_cli/esta/frames.py it bounds the memory a hostile file can take."""
 
 MATCH_SUFFIXES = (".json.xz", ".json")
 """File names `iter_match_files` picks up in a folder."""
@@ -96,6 +101,8 @@ class Round:
     bomb_plant_tick: int | None
     start_tick: int | None
     end_tick: int | None
+    warnings: tuple[str, ...] = ()
+    """Implausible data kept under the "warn" policy (decoy_cli/esta/plausibility.py)."""
 
     @property
     def num_frames(self) -> int:
@@ -145,8 +152,10 @@ class Match:
         raise EstaError(f"{self.path}: no round {num} ({_describe_numbers(self.round_numbers)})")
 
 
-def read_match(path: str | Path) -> Match:
-    """Read and validate one match file; file-level problems raise EstaError (module doc)."""
+def read_match(path: str | Path, *, implausible: Implausible = "fail") -> Match:
+    """Read and validate one match file; file-level problems raise EstaError (module doc).
+    `implausible` says whether a round with implausible data fails or keeps warnings
+    (decoy_cli/esta/plausibility.py)."""
     path = Path(path)
     document = parse(path, read_bytes(path))
     top = document.top
@@ -159,6 +168,7 @@ def read_match(path: str | Path) -> Match:
     rounds: list[Round] = []
     errors: dict[int, EstaError] = {}
     position_of: dict[int, int] = {}
+    player_frames = 0
     for i, source in enumerate(document.rounds):
         try:
             state = decode_round(source)
@@ -178,10 +188,18 @@ def read_match(path: str | Path) -> Match:
                     path=path,
                     map_name=map_name or "",
                     tick_rate=tick_rate,
+                    implausible=implausible,
                 )
             )
         except Invalid as problem:
             errors[num] = EstaError(f"{path}: round {num}: {problem}")
+            continue
+        player_frames += rounds[-1].num_players * rounds[-1].num_frames
+        if player_frames > MAX_MATCH_PLAYER_FRAMES:
+            raise EstaError(
+                f"{path}: more than {MAX_MATCH_PLAYER_FRAMES:,} player-frames by round {num} "
+                "(not a real match; the limit bounds the reader's memory)"
+            )
     rounds.sort(key=lambda r: r.round_num)
     return Match(
         match_id=match_id,
@@ -219,14 +237,21 @@ def iter_match_files(path: str | Path) -> list[Path]:
     return files
 
 
-def load_round(address: str) -> Round:
+def load_round(address: str, *, implausible: Implausible = "fail") -> Round:
     """The round at "FILE:ROUND" (reads the whole file: for many rounds, read_match once)."""
     file, num = parse_round_address(address)
-    return read_match(file).round(num)
+    return read_match(file, implausible=implausible).round(num)
 
 
 def _build_round(
-    state: RoundState, num: int, *, match_id: str, path: Path, map_name: str, tick_rate: int
+    state: RoundState,
+    num: int,
+    *,
+    match_id: str,
+    path: Path,
+    map_name: str,
+    tick_rate: int,
+    implausible: Implausible,
 ) -> Round:
     """One decoded round as arrays and tables; a problem raises Invalid."""
     start_tick = _optional_int(state.startTick, "startTick")
@@ -237,7 +262,7 @@ def _build_round(
         _optional_int(state.freezeTimeEndTick, "freezeTimeEndTick"),
         start_tick,
     )
-    check_frames(arrays)
+    warnings = check_frames(arrays, implausible)
     ticks = arrays.ticks
     if ticks.size:
         start_tick = int(ticks[0]) if start_tick is None else start_tick
@@ -277,6 +302,7 @@ def _build_round(
         bomb_plant_tick=_optional_int(state.bombPlantTick, "bombPlantTick"),
         start_tick=start_tick,
         end_tick=end_tick,
+        warnings=warnings,
     )
 
 

@@ -48,6 +48,17 @@ largest real ESTA file seen (the T-side files hold about 21 MB), and small enoug
 hostile file cannot exhaust memory. The environment variable `DECOY_MAX_MATCH_MB` overrides it."""
 
 
+LENIENT_MAX_MB = 64
+"""Largest document, in MB of JSON, read by the `json` fallback that accepts NaN and Infinity:
+three times the largest real ESTA file seen; Python's objects take several times their JSON's
+size, so a larger document must be strict JSON (decoded by msgspec, round by round)."""
+
+MAX_ROUNDS = 200
+"""Most rounds a match file may hold: regulation is 30 rounds and each overtime 6, so 200 is
+beyond any real match (the files in ../shared/data hold at most 30). Bounds the memory of a
+hostile file of empty rounds."""
+
+
 def max_match_bytes() -> int:
     """The size limit of a match file's JSON, in bytes (`MAX_MATCH_MB_DEFAULT` or the
     environment's `DECOY_MAX_MATCH_MB`)."""
@@ -119,11 +130,19 @@ def parse(path: Path, data: bytes) -> Document:
         top = {key: msgspec.json.decode(raw) for key, raw in parts.items()}
     except _DECODE_ERRORS as error:
         raise EstaError(f"{path}: unreadable top-level metadata ({_describe(error)})") from None
-    return Document(top=top, rounds=list(rounds))
+    return Document(top=top, rounds=_check_count(path, list(rounds)))
 
 
 def _parse_lenient(path: Path, data: bytes, strict_error: Exception) -> Document:
-    """Parse with Python's json, which accepts NaN and Infinity; still invalid: EstaError."""
+    """Parse with Python's json, which accepts NaN and Infinity; still invalid: EstaError. Python
+    objects take many times their JSON's size, so only documents up to `LENIENT_MAX_MB` take
+    this path."""
+    if len(data) > LENIENT_MAX_MB * 1_000_000:
+        message = _lower_first(str(strict_error))
+        raise EstaError(
+            f"{path}: invalid JSON ({message}); a file over {LENIENT_MAX_MB} MB of JSON must be "
+            "strict JSON (no NaN or Infinity)"
+        )
     try:
         document = json.loads(data)
     except (ValueError, RecursionError):
@@ -137,7 +156,16 @@ def _parse_lenient(path: Path, data: bytes, strict_error: Exception) -> Document
     rounds = document.pop("gameRounds")
     if not isinstance(rounds, list):
         raise EstaError(f"{path}: not an ESTA match file (gameRounds is not a list)")
-    return Document(top=document, rounds=rounds)
+    return Document(top=document, rounds=_check_count(path, rounds))
+
+
+def _check_count(path: Path, rounds: list[RoundSource]) -> list[RoundSource]:
+    if len(rounds) > MAX_ROUNDS:
+        raise EstaError(
+            f"{path}: {len(rounds):,} rounds in gameRounds (a match file holds at most "
+            f"{MAX_ROUNDS})"
+        )
+    return rounds
 
 
 def decode_round(source: RoundSource) -> RoundState:

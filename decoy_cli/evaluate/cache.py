@@ -4,7 +4,8 @@ Every file is written atomically (decoy_cli/files.write_atomic) as soon as its r
 so an interrupted run keeps every finished round, and a rerun loads them instead of computing
 them again. Keys come from decoy_cli/evaluate/settings.py (file content, round, options, code),
 so a changed option or a new version never reuses a stale result. A cache file that cannot be
-decoded (written by another format version, or damaged) counts as missing.
+decoded (written by another format version, or damaged), or that holds another key's result,
+counts as missing.
 """
 
 from __future__ import annotations
@@ -48,15 +49,20 @@ class RunCache:
         return self.index / f"{key}.msgpack"
 
     def load_round(self, key: str) -> RoundRecord | None:
-        """The cached record, or None when missing or unreadable."""
-        return _load(self.round_path(key), _ROUND_DECODER)
+        """The cached record, or None when missing, unreadable or not the record of `key` (a
+        file copied or renamed within the cache)."""
+        record = _load(self.round_path(key), _ROUND_DECODER)
+        return record if record is not None and record.key == key else None
 
     def store_round(self, record: RoundRecord) -> None:
         """Write a record atomically; a full disk raises OutputError."""
         write_atomic(self.round_path(record.key), _ENCODER.encode(record))
 
-    def load_index(self, key: str) -> FileIndex | None:
-        return _load(self.index_path(key), _INDEX_DECODER)
+    def load_index(self, key: str, file_sha: str) -> FileIndex | None:
+        """The cached index of the file with content `file_sha`, or None when missing,
+        unreadable or another file's."""
+        index = _load(self.index_path(key), _INDEX_DECODER)
+        return index if index is not None and index.file_sha == file_sha else None
 
     def store_index(self, key: str, index: FileIndex) -> None:
         write_atomic(self.index_path(key), _ENCODER.encode(index))

@@ -95,7 +95,7 @@ class _WorkerState:
         self.places = PlaceFinder(self.graph)
         self.physics = PhysicsWorld(nav_world(map_name))
         self.models: dict[str, DamageModel | None] = {}
-        self.matches: OrderedDict[tuple[str, str], Match] = OrderedDict()
+        self.matches: OrderedDict[tuple[str, str, str], Match] = OrderedDict()
 
     def damage_model(self, choice: str) -> DamageModel | None:
         """The damage model of a `--models` choice, loaded once (torch on one thread)."""
@@ -110,9 +110,10 @@ class _WorkerState:
             self.models[choice] = model
         return self.models[choice]
 
-    def match(self, file: str, file_sha: str) -> Match:
-        """The match read from `file`, checked to be the content the run hashed."""
-        key = (file, file_sha)
+    def match(self, file: str, file_sha: str, settings: EvalSettings) -> Match:
+        """The match read from `file` under the run's policy for implausible rounds, checked to
+        be the content the run hashed."""
+        key = (file, file_sha, settings.implausible)
         if key in self.matches:
             self.matches.move_to_end(key)
             return self.matches[key]
@@ -123,7 +124,7 @@ class _WorkerState:
             raise DecoyError(f"{file}: cannot read the file ({error.strerror or error})") from None
         if hashlib.sha256(data).hexdigest() != file_sha:
             raise DecoyError(f"{file}: the file changed while the evaluation ran")
-        match = read_match(path)
+        match = read_match(path, implausible=settings.implausible)
         self.matches[key] = match
         while len(self.matches) > _MATCHES_KEPT:
             self.matches.popitem(last=False)
@@ -151,7 +152,7 @@ def is_synthetic(match_id: str, provenance: Any) -> bool:
 def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     """Read a match file and list its rounds; the worker keeps the match for its rounds."""
     try:
-        match = worker_state(task.settings.map_name).match(task.file, task.file_sha)
+        match = worker_state(task.settings.map_name).match(task.file, task.file_sha, task.settings)
     except Exception as error:
         return failure_from(error, task.file, None, UNREADABLE_FILE)
     provenance = match.meta.get("provenance")
@@ -205,7 +206,7 @@ def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
 
 def _evaluate(task: RoundTask) -> RoundRecord:
     state = worker_state(task.settings.map_name)
-    round_ = state.match(task.file, task.file_sha).round(task.round_num)
+    round_ = state.match(task.file, task.file_sha, task.settings).round(task.round_num)
     settings = task.settings
     model = state.damage_model(settings.models) if settings.combat else None
     started = time.perf_counter()
@@ -228,5 +229,6 @@ def _replay(
         mover=settings.mover,
         damage_model=model,
         seed=round_seed(settings, task.file_sha, task.round_num),
+        implausible=settings.implausible,
     )
     return replay_round(round_, state.graph, options, physics=state.physics)

@@ -113,9 +113,13 @@ ROUND_COLUMNS = (
     "stuck",
     "recoveries",
     "relocations",
+    "warnings",
     "wall_seconds",
 )
-"""Columns of a round row (rounds.csv)."""
+"""Columns of a round row (rounds.csv); `warnings` holds the implausible data a round was
+replayed with under `--implausible warn`, joined by `WARNING_SEPARATOR` ("" when none)."""
+
+WARNING_SEPARATOR = " | "
 
 
 def build_record(
@@ -180,6 +184,7 @@ def build_record(
         "stuck": int(metrics["stuck"].sum()),
         "recoveries": int(metrics["recoveries"].sum()),
         "relocations": int(metrics["relocations"].sum()),
+        "warnings": WARNING_SEPARATOR.join(result.warnings),
         "wall_seconds": round(seconds, 4),
     }
     replayed = rec.position.transpose(1, 0, 2)  # (P, F, 3) like the original

@@ -67,7 +67,8 @@ def command_line(
     words += ["--bomb" if settings.bomb else "--no-bomb"]
     if settings.combat:
         words += ["--models", settings.models]
-    words += ["--mover", settings.mover, "--out", str(out)]
+    words += ["--mover", settings.mover, "--implausible", settings.implausible]
+    words += ["--out", str(out)]
     return shlex.join(words)
 
 
@@ -85,6 +86,7 @@ def run_counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
         "rounds_with_winner": tables.rounds_with_winner,
         "player_rounds": len(tables.players),
         "failures": len(evaluation.failures),
+        "rounds_with_warnings": tables.rounds_with_warnings,
     }
 
 
@@ -199,6 +201,12 @@ def report_markdown(
         ],
         ["computed / from cache", f"{computed}, {evaluation.cached} from the cache"],
         ["failures", f"{counts['failures']} (see below and `failures.csv`)"],
+        [
+            "implausible data",
+            f"rounds {'replayed with warnings' if settings.implausible == 'warn' else 'fail'} "
+            f"(`--implausible {settings.implausible}`): "
+            f"{counts['rounds_with_warnings']} rounds with warnings",
+        ],
         ["mechanics", mechanics(evaluation.settings)],
         ["mover, seed", f"{settings.mover}, {settings.seed}"],
         ["ran on", f"{info.backend}; {info.machine}"],
@@ -214,6 +222,8 @@ def report_markdown(
     parts.append(_combat_section(tables, settings.combat))
     parts.append(_figures_section(tables, figures))
     parts.append(_failures_section(evaluation))
+    if counts["rounds_with_warnings"]:
+        parts.append(_warnings_section(tables))
     return "\n\n".join(parts) + "\n"
 
 
@@ -354,4 +364,23 @@ def _failures_section(evaluation: Evaluation) -> str:
     text.append(_table(["file", "round", "kind", "reason"], rows))
     if len(failures) > REPORT_FAILURES_SHOWN:
         text.append(f"… and {len(failures) - REPORT_FAILURES_SHOWN} more in `failures.csv`.")
+    return "\n\n".join(text)
+
+
+def _warnings_section(tables: Tables) -> str:
+    """The rounds replayed with implausible data (`--implausible warn`) and their warnings."""
+    rounds = tables.rounds[tables.rounds["warnings"] != ""]
+    text = [
+        "## Implausible data replayed anyway",
+        f"{len(rounds)} rounds were replayed although their data is implausible "
+        "(`--implausible warn`); their numbers are in every table above. Each round's warnings "
+        "are in the `warnings` column of `rounds.csv`.",
+    ]
+    rows = [
+        [Path(str(row.file)).name, str(row.round), str(row.warnings)]
+        for row in rounds.head(REPORT_FAILURES_SHOWN).itertuples()
+    ]
+    text.append(_table(["file", "round", "warnings"], rows))
+    if len(rounds) > REPORT_FAILURES_SHOWN:
+        text.append(f"… and {len(rounds) - REPORT_FAILURES_SHOWN} more in `rounds.csv`.")
     return "\n\n".join(text)

@@ -30,6 +30,7 @@ import numpy as np
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.job import (
     FileIndex,
@@ -99,7 +100,14 @@ class Evaluation:
 
 
 def make_settings(
-    *, map_name: str, combat: bool, bomb: bool, models: str, mover: str, seed: int
+    *,
+    map_name: str,
+    combat: bool,
+    bomb: bool,
+    models: str,
+    mover: str,
+    seed: int,
+    implausible: Implausible = "fail",
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round."""
@@ -127,6 +135,7 @@ def make_settings(
         grid=HeatGrid.for_map(name),
         code=code_fingerprint(name),
         models_fingerprint=models_fingerprint,
+        implausible=implausible,
     )
 
 
@@ -254,7 +263,7 @@ def _index(
     indexes: dict[str, FileIndex] = {}
     pending: list[IndexTask] = []
     for file in files:
-        found = cache.load_index(index_key(settings, file.sha))
+        found = cache.load_index(index_key(settings, file.sha), file.sha)
         if found is None:
             pending.append(IndexTask(str(file.path), file.sha, settings))
         else:

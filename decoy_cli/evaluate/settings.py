@@ -16,9 +16,10 @@ from functools import cache
 from pathlib import Path
 
 from decoy_cli.errors import EstaError
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.world.navmesh import asset_dir, load_navmesh
 
-RECORD_VERSION = 1
+RECORD_VERSION = 2
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HEAT_CELL_M = 0.5
@@ -90,7 +91,8 @@ class EvalSettings:
 
     `combat` switches shooting and `bomb` the bomb rules, independently (both off: movement
     only, as in the paper's Table 2); `models` is the damage-model choice a worker loads (only
-    used with combat).
+    used with combat); `implausible` says whether a round with implausible data fails or is
+    replayed with warnings (decoy_cli/esta/plausibility.py).
     """
 
     map_name: str
@@ -104,6 +106,7 @@ class EvalSettings:
     """Fingerprint of the result-deciding code and the map's assets (`code_fingerprint`)."""
     models_fingerprint: str
     """Fingerprint of the damage model files ("" without combat or with no model)."""
+    implausible: Implausible = "fail"
     hp_bin_s: float = HP_BIN_S
     hp_bins: int = HP_BINS
 
@@ -118,8 +121,9 @@ def round_key(settings: EvalSettings, file_sha: str, round_num: int) -> str:
 
 
 def index_key(settings: EvalSettings, file_sha: str) -> str:
-    """The cache key of a file's index (its rounds, map and provenance); depends on the code."""
-    text = f"index|{RECORD_VERSION}|{settings.code}|{file_sha}"
+    """The cache key of a file's index (its rounds, map and provenance); depends on the code and
+    on the policy for implausible rounds (which decides the rounds that failed)."""
+    text = f"index|{RECORD_VERSION}|{settings.code}|{settings.implausible}|{file_sha}"
     return hashlib.sha256(text.encode()).hexdigest()
 
 

@@ -198,6 +198,8 @@ class Tables:
     sample counts."""
     rounds_both_teams: int
     rounds_with_winner: int
+    rounds_with_warnings: int
+    """Rounds replayed with implausible data (`--implausible warn`)."""
 
 
 def build_tables(acc: Accumulator) -> Tables:
@@ -240,6 +242,7 @@ def build_tables(acc: Accumulator) -> Tables:
         places=_places(acc),
         rounds_both_teams=both,
         rounds_with_winner=len(known),
+        rounds_with_warnings=int((rounds["warnings"] != "").sum()) if len(rounds) else 0,
     )
 
 

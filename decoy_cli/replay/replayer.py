@@ -22,7 +22,7 @@ import pandas as pd
 from decoy_cli.csgo import TICK_RATE, tick_at
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
-from decoy_cli.esta.plausibility import first_offender
+from decoy_cli.esta.plausibility import Implausible, first_offender
 from decoy_cli.metrics.players import ReplayTrace
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
@@ -51,6 +51,7 @@ class ReplayResult:
     stuck: np.ndarray | None = None  # (P,) stuck episodes
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
     played_out_s: float = 0.0  # game seconds simulated after the data's last frame (play_out)
+    warnings: tuple[str, ...] = ()  # implausible data replayed anyway (ReplayOptions.implausible)
 
     def trace(self) -> ReplayTrace:
         """What the fidelity metrics need from this replay (`decoy_cli.metrics.player_metrics`)."""
@@ -113,6 +114,9 @@ class ReplayOptions:
     # which outcomes were decided after the data (`ReplayResult.played_out_s`).
     play_out: bool = True
     seed: int = 0
+    implausible: Implausible = "fail"
+    """Whether a player far off the map fails the round or is a warning (as the reader's
+    policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
 
     def __post_init__(self) -> None:
         check_mover(self.mover)
@@ -159,7 +163,7 @@ def replay_round(
     """
     options = options if options is not None else ReplayOptions()
     frame_ticks = _frame_ticks(round_)
-    _check_on_map(round_, graph)
+    warnings = round_.warnings + _check_on_map(round_, graph, options.implausible)
     setup = options.setup(graph, round_)
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
@@ -266,6 +270,7 @@ def replay_round(
         stuck=stuck,
         recoveries=recoveries,
         played_out_s=(sim.tick - played_from) / TICK_RATE,
+        warnings=warnings,
     )
 
 
@@ -293,20 +298,25 @@ OFF_MAP_M = 10.0
 measured in the real rounds (1.7 m, a jump above the highest waypoint)."""
 
 
-def _check_on_map(round_: Round, graph: WaypointGraph) -> None:
-    """An EstaError naming the first alive player far outside the map (module `OFF_MAP_M`)."""
+def _check_on_map(round_: Round, graph: WaypointGraph, policy: Implausible) -> tuple[str, ...]:
+    """The first alive player far outside the map (module `OFF_MAP_M`) as a warning, or with
+    the "fail" policy as an EstaError."""
     low = graph.positions.min(axis=0) - OFF_MAP_M
     high = graph.positions.max(axis=0) + OFF_MAP_M
     position = np.asarray(round_.position, dtype=np.float64)
     usable = np.asarray(round_.alive, bool) & np.isfinite(position).all(axis=2)
     outside = usable & ((position < low) | (position > high)).any(axis=2)
-    if outside.any():
-        p, f = first_offender(outside)
-        x, y, z = position[p, f]
-        raise EstaError(
-            f"{round_.path}: round {round_.round_num}: frame {f}: {round_.players[p].name} at "
-            f"({x:.1f}, {y:.1f}, {z:.1f}) m is more than {OFF_MAP_M:g} m outside the map"
-        )
+    if not outside.any():
+        return ()
+    p, f = first_offender(outside)
+    x, y, z = position[p, f]
+    problem = (
+        f"frame {f}: {round_.players[p].name} at ({x:.1f}, {y:.1f}, {z:.1f}) m is more than "
+        f"{OFF_MAP_M:g} m outside the map"
+    )
+    if policy == "fail":
+        raise EstaError(f"{round_.path}: round {round_.round_num}: {problem}")
+    return (problem,)
 
 
 MAX_ZIGZAG = 1.3

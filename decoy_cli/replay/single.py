@@ -55,7 +55,7 @@ def replay_address(
 
     `models` names the damage models in the summary (None: no shooting).
     """
-    round_ = load_round(address)
+    round_ = load_round(address, implausible=options.implausible)
     if round_.map_name and round_.map_name != BUILTIN_MAP:
         raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
     graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
@@ -110,6 +110,7 @@ def replay_summary(
             "bomb": options.bomb,
             "mover": options.mover,
             "seed": options.seed,
+            "implausible": options.implausible,
         },
         "damage_models": models if options.combat else None,
         "played_out_s": round(result.played_out_s, 3),
@@ -123,4 +124,5 @@ def replay_summary(
         "stuck_episodes": int(players["stuck"].sum()),
         "recoveries": int(players["recoveries"].sum()),
         "relocations": int(players["relocations"].sum()),
+        "warnings": list(result.warnings),
     }
