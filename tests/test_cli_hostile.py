@@ -203,3 +203,36 @@ def test_any_mutated_file_ends_in_results_or_one_error_line(
         if result.exit_code == 0:
             written = {path.name for path in out.iterdir()}
             assert {"replay.csv", "players.csv", "summary.json", "paths.png"} <= written
+
+
+# ---- the data never chooses where files go -----------------------------------------------------
+
+
+def test_hostile_ids_and_names_write_only_into_the_output_folders(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A matchID and player names that look like paths: replay, snap and evaluate write only
+    into their output folders."""
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    document = make_match()
+    document["matchID"] = "../../../escaped"
+    for game_round in document["gameRounds"]:
+        for frame in game_round.get("frames") or []:
+            for player in frame["t"]["players"]:
+                if player["name"] == "t1":
+                    player["name"] = "../../escaped/t1"
+    file = _write(tmp_path / "in" / "m.json", document)
+    before = set(tmp_path.rglob("*"))
+    for args in (
+        ["replay", f"{file}:1", "--models", "none"],
+        ["replay", f"{file}:2", "--models", "none", "--gif", "--out", "r2"],
+        ["snap", str(file), "--metrics"],
+        ["evaluate", str(file), "--no-combat", "--out", "ev"],
+    ):
+        _clean_end(_invoke(*args))
+    created = set(tmp_path.rglob("*")) - before
+    allowed = (work / "decoy-out", work / "r2", work / "ev")
+    outside = [p for p in created if not any(p == a or a in p.parents for a in allowed)]
+    assert created and not outside, outside

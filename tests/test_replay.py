@@ -86,7 +86,7 @@ class Track:
     nodes: list[int]
     weapons: list[str] | str = "AK-47"
     dead_from: int | None = None  # first frame recorded dead (hp 0, lying where it died)
-    bomb: bool = False
+    bomb: bool | list[bool] = False  # holds the bomb: in every frame, or frame by frame
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)  # added to the waypoint position
 
 
@@ -135,7 +135,7 @@ def make_round(
             alive[p, track.dead_from :] = False
         names = [track.weapons] * frames if isinstance(track.weapons, str) else track.weapons
         weapon[p, alive[p]] = np.asarray(names, dtype=object)[alive[p]]
-        has_bomb[p] = alive[p] & track.bomb
+        has_bomb[p] = alive[p] & np.asarray(track.bomb, dtype=bool)
     present = np.isfinite(position).all(axis=2)
     return SimpleNamespace(
         map_name="de_dust2",
@@ -451,6 +451,33 @@ def test_the_carrier_plants_in_site_a_before_the_data_does(
     without = replay(round_, physics, mover, bomb=False)
     assert without.events == []
     assert np.array_equal(without.recording.position, result.recording.position)
+
+
+@pytest.mark.parametrize("mover", MOVERS)
+def test_the_bomb_changes_hands_and_is_planted_when_the_data_says(
+    physics: PhysicsWorld, mover: str
+) -> None:
+    """The data's carrier changes (a pass in site A): the replay hands the bomb over, and the
+    new carrier begins planting at the data's plant start (plant tick minus the 3.0 s the rules
+    take) and holds still until the plant completes."""
+    spot, carrier_spot = site_a_nodes()
+    first = [k < 2 for k in range(BOMB_FRAMES)]
+    round_ = make_round(
+        [
+            Track("first", "T", [spot] * BOMB_FRAMES, bomb=first),
+            Track("second", "T", [carrier_spot] * BOMB_FRAMES, bomb=[not k for k in first]),
+        ],
+        plant_frame=PLANT_FRAME,
+    )
+    result = replay(round_, physics, mover)
+    bomb = [(e.kind, e.agent) for e in result.events if e.kind in (*BOMB_KINDS, "bomb_pickup")]
+    assert bomb == [("bomb_pickup", 1), ("plant_begin", 1), ("plant", 1)]
+    pickup, begin, plant = (e.tick for e in result.events if e.kind in (*BOMB_KINDS, "bomb_pickup"))
+    assert pickup == result.frame_ticks[2]  # the first frame that shows the second holding it
+    data_plant_s = (round_.bomb_plant_tick - FREEZE_END) / DATA_TICK_RATE
+    rules = RulesConfig()
+    assert abs(begin - sim_tick(data_plant_s - rules.plant_s)) <= 1
+    assert plant - begin == rules.plant_ticks
 
 
 def test_a_carrier_outside_the_sites_does_not_plant_and_drops_the_bomb(

@@ -100,12 +100,12 @@ def planted_round(
 
 def test_durations_become_whole_ticks() -> None:
     cfg = RulesConfig()
-    assert (cfg.round_ticks, cfg.plant_ticks, cfg.bomb_ticks) == (6900, 192, 2400)
+    assert (cfg.round_ticks, cfg.plant_ticks, cfg.bomb_ticks) == (6900, 180, 2400)
     assert (cfg.defuse_ticks, cfg.defuse_kit_ticks) == (600, 300)
     assert 8.3 * 60 > 498  # float noise that must not add a tick
     assert seconds_to_ticks(8.3, 60) == 498
     assert seconds_to_ticks(3.21, 60) == 193  # rounded up, never shorter than the game
-    assert RulesConfig(tick_rate=128).plant_ticks == 410
+    assert RulesConfig(tick_rate=128, plant_s=3.2).plant_ticks == 410  # 409.6, rounded up
 
 
 @pytest.mark.parametrize(
@@ -220,16 +220,16 @@ def test_no_bomb_in_the_round() -> None:
 # ---- plant -----------------------------------------------------------------------------------
 
 
-def test_plant_takes_exactly_192_ticks() -> None:
+def test_plant_takes_exactly_180_ticks() -> None:
     rnd = Round(make_agents(["T", "CT"], [IN_A, OUTSIDE]), carrier=0)
     rnd.plant[0] = True
     assert kinds(rnd.step()) == ["plant_begin"]
     assert rnd.events[0].data == {"site": "A"}
     begin = rnd.tick
-    assert rnd.step(191) == []
-    assert rnd.bomb.status == BombStatus.CARRIED and rnd.bomb.plant_ticks == 191
+    assert rnd.step(179) == []
+    assert rnd.bomb.status == BombStatus.CARRIED and rnd.bomb.plant_ticks == 179
     (plant,) = rnd.step()
-    assert (plant.kind, plant.agent, plant.tick - begin) == ("plant", 0, 192)
+    assert (plant.kind, plant.agent, plant.tick - begin) == ("plant", 0, 180)
     bomb = rnd.bomb
     assert (bomb.status, bomb.site, bomb.planted_tick) == (BombStatus.PLANTED, "A", plant.tick)
     assert (bomb.carrier, bomb.planter) == (-1, -1)
@@ -263,9 +263,9 @@ def test_plant_aborted_by_moving_restarts_from_zero() -> None:
     rnd.moving[0] = False
     assert kinds(rnd.step()) == ["plant_begin"]
     begin = rnd.tick
-    rnd.step(191)
+    rnd.step(179)
     assert rnd.bomb.status == BombStatus.CARRIED
-    assert kinds(rnd.step()) == ["plant"] and rnd.tick - begin == 192
+    assert kinds(rnd.step()) == ["plant"] and rnd.tick - begin == 180
 
 
 def test_plant_aborted_by_stopping_and_by_leaving_the_zone() -> None:
@@ -298,7 +298,7 @@ def test_planter_death_aborts_and_drops_the_bomb() -> None:
 def test_bomb_explodes_exactly_40_s_after_the_plant() -> None:
     rnd = Round(make_agents(["T", "CT"], [IN_A, OUTSIDE]), carrier=0)
     rnd.plant[0] = True
-    rnd.step(193)
+    rnd.step(181)
     planted = rnd.bomb.planted_tick
     rnd.plant[0] = False
     rnd.step(2399)
@@ -457,13 +457,13 @@ def test_a_plant_stops_the_round_clock() -> None:
     rnd = Round(make_agents(["T", "CT"], [IN_A, OUTSIDE]), carrier=0)
     rnd.tick = 6700
     rnd.plant[0] = True
-    rnd.step(193)  # planted at tick 6893
+    rnd.step(181)  # planted at tick 6881
     assert rnd.bomb.status == BombStatus.PLANTED
     rnd.step(2000)  # well past 115 s
     assert rnd.outcome() is None
-    assert rnd.bomb.planted_tick == 6893
+    assert rnd.bomb.planted_tick == 6881
     rnd.step(400)
-    assert rnd.outcome().reason == "TargetBombed" and rnd.tick == 6893 + 2400
+    assert rnd.outcome().reason == "TargetBombed" and rnd.tick == 6881 + 2400
 
 
 def test_elimination_before_a_plant() -> None:
@@ -510,7 +510,7 @@ def test_t_only_round() -> None:
     assert rnd.outcome().reason == "TargetSaved"
     rnd = Round(make_agents(["T", "T"], [IN_A, OUTSIDE]), carrier=0)
     rnd.plant[0] = True
-    rnd.step(193)
+    rnd.step(181)
     rnd.kill(0)
     rnd.kill(1)
     assert rnd.outcome() is None  # planted: on to the detonation

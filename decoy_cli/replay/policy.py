@@ -10,7 +10,7 @@ at every target is logged against its deadline in an `AgentLog` (the lateness).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -96,6 +96,25 @@ class PlanPolicy:
         now = sim.tick
         plant = self.plant_from_tick is not None and now >= self.plant_from_tick
         defuse = agent in self.defuse_from_tick and now >= self.defuse_from_tick[agent]
+        if plant and sim.bomb.planter == agent:
+            # planting, as the real player did: hold still until the plant completes, then
+            # the plan resumes and catches up
+            left = sim.rules.config.plant_ticks - sim.bomb.plant_ticks
+            return Decision(STOP_ACTION, hold_ticks=max(1, left), plant=True)
+        decision = self._follow_plan(sim, agent, plan, now, plant, defuse)
+        wake = self.plant_from_tick
+        if (
+            decision.action == STOP_ACTION
+            and wake is not None
+            and now < wake < now + decision.hold_ticks
+        ):
+            # wake at the data's plant start, so the wish to plant starts on time
+            decision = replace(decision, hold_ticks=wake - now)
+        return decision
+
+    def _follow_plan(
+        self, sim: Simulator, agent: int, plan: PlayerPlan, now: int, plant: bool, defuse: bool
+    ) -> Decision:
         first_deadline = self.logs[agent].deadline_tick[0] if len(plan.target_node) else 0
         if now < first_deadline:  # not on stage yet
             return Decision(STOP_ACTION, hold_ticks=int(first_deadline - now), plant=plant)

@@ -141,9 +141,20 @@ class ReplayOptions:
         )
 
 
-PLANT_TOLERANCE_S = 1.0
-"""How early, before the data's plant start, the carrier may begin planting: the replay's
-timing tolerance."""
+def data_plant_start_s(round_: Round, plant_s: float) -> float | None:
+    """When the real carrier began the plant that completed (seconds on the round's clock): its
+    `plant_begin` event, else the plant tick minus the plant's duration `plant_s` (the T-side
+    files record only `bombPlantTick`); None when the data shows no completed plant."""
+    if round_.bomb_plant_tick is None or not len(round_.frame_ticks):
+        return None
+    plant_at = float(np.interp(round_.bomb_plant_tick, round_.frame_ticks, round_.frame_seconds))
+    events = round_.bomb_events
+    if len(events) and "bombAction" in events and "seconds" in events:
+        begins = events.loc[events["bombAction"] == "plant_begin", "seconds"].to_numpy(float)
+        begins = begins[np.isfinite(begins) & (begins <= plant_at) & (begins >= plant_at - 10)]
+        if len(begins):
+            return float(begins.max())  # the attempt that completed
+    return plant_at - plant_s
 
 
 def replay_round(
@@ -209,9 +220,9 @@ def replay_round(
                 "T can carry it"
             )
     plant_from = None
-    if options.bomb and round_.bomb_plant_tick is not None and len(round_.frame_ticks):
-        plant_s = float(np.interp(round_.bomb_plant_tick, round_.frame_ticks, round_.frame_seconds))
-        plant_from = tick_at(plant_s - rules_config.plant_s - PLANT_TOLERANCE_S)
+    if options.bomb:
+        start_s = data_plant_start_s(round_, rules_config.plant_s)
+        plant_from = None if start_s is None else tick_at(start_s)
     defuse_from = _defuse_starts(round_, players)
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
@@ -245,6 +256,10 @@ def replay_round(
                     scripted[i] = True
             sim.step()
             f = frame_of_tick.get(sim.tick)
+            if f is not None and options.bomb:  # the bomb changes hands as in the data
+                holding = has_bomb[:, f] & agents.alive if has_bomb.size else np.zeros(n, bool)
+                if holding.any() and sim.bomb.carrier != int(np.argmax(holding)):
+                    sim.hand_bomb(int(np.argmax(holding)))
             if f is not None:  # follow the weapon in hand, as the data shows it
                 for alive in np.nonzero(agents.alive)[0]:
                     i = int(alive)

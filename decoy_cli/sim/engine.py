@@ -213,6 +213,11 @@ class Simulator:
             self.waiting[agent] = bool(self.agents.alive[agent])
         self.events.append(SimEvent(self.tick, "relocate", agent, data={"node": int(node)}))
 
+    def hand_bomb(self, agent: int) -> None:
+        """Give the bomb to an alive T from outside the rules (a replay following the data's
+        carrier); see `BombRules.hand_over`."""
+        self.events += self.rules.hand_over(self.tick, self.agents, self.bomb, agent)
+
     def kill(self, agent: int, reason: str) -> None:
         """Kill an agent from outside the combat step (a scripted death in a replay)."""
         if self.agents.alive[agent]:

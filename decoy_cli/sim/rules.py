@@ -3,7 +3,7 @@
 Durations are whole tick counts (`RulesConfig`), so every rule fires on an exact tick:
 
 * plant: the carrier, alive, inside a bomb-site zone and not moving, wants to plant at tick t0
-  ("plant_begin"); the plant completes at t0 + plant_ticks (3.2 s = 192 ticks at 60 Hz) if at
+  ("plant_begin"); the plant completes at t0 + plant_ticks (3.0 s = 180 ticks at 60 Hz) if at
   every tick in between it is still alive, still, in the zone and still wants to; otherwise
   "plant_abort" (data "reason": died, stopped, moved or left_zone);
 * detonation: at planted_tick + bomb_ticks (40 s = 2400 ticks), checked before any defuse
@@ -82,7 +82,9 @@ class RulesConfig:
 
     tick_rate: int = TICK_RATE
     round_time_s: float = 115.0
-    plant_s: float = 3.2
+    plant_s: float = 3.0
+    """CS:GO's C4 arm time; real plants measure 3.05 s from `plant_begin` to `plant` (14 of 14
+    in ../shared/data/esta_dust2_events)."""
     bomb_timer_s: float = 40.0
     defuse_s: float = 10.0
     defuse_kit_s: float = 5.0
@@ -148,6 +150,30 @@ class BombRules:
             carrier=int(bomb_carrier),
             position=agents.position[bomb_carrier].copy(),
         )
+
+    def hand_over(self, tick: int, agents: Agents, bomb: Bomb, agent: int) -> list[SimEvent]:
+        """Give the bomb to `agent`, an alive T, from whoever holds it or wherever it lies (a
+        replay following the data's carrier); a plant in progress by another stops. Nothing
+        happens once the bomb is planted, or without the bomb rules."""
+        if not self.config.bomb_enabled or bomb.status not in (
+            BombStatus.CARRIED,
+            BombStatus.DROPPED,
+        ):
+            return []
+        if agents.side[agent] != "T" or not agents.alive[agent] or bomb.carrier == agent:
+            return []
+        events = []
+        if bomb.planter >= 0:
+            events.append(self._abort_plant(tick, bomb, "handed_over"))
+        bomb.status = BombStatus.CARRIED
+        bomb.carrier = int(agent)
+        bomb.position = agents.position[agent].copy()
+        events.append(
+            SimEvent(
+                tick, "bomb_pickup", agent, data={"position": bomb.position.tolist(), "data": True}
+            )
+        )
+        return events
 
     # ---- one tick -----------------------------------------------------------------------------
 
