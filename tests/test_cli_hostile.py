@@ -73,10 +73,7 @@ def _markup_match(tmp_path: Path) -> Path:
 )
 def test_names_from_the_data_are_printed_as_they_are(tmp_path: Path, command: list[str]) -> None:
     file = _markup_match(tmp_path)
-    args = [
-        part.format(file=file, folder=file.parent, tmp=tmp_path).replace("{tmp}", str(tmp_path))
-        for part in command
-    ]
+    args = [part.format(file=file, folder=file.parent, tmp=tmp_path) for part in command]
     result = _invoke(*args)
     _clean_end(result)
     assert MARKUP in result.output

@@ -10,6 +10,6 @@ from __future__ import annotations
 from rich.console import Console
 
 
-def console(*, stderr: bool = False) -> Console:
+def make_console(*, stderr: bool = False) -> Console:
     """A console on stdout (or stderr) that prints text literally (module doc)."""
     return Console(stderr=stderr, markup=False)

@@ -20,7 +20,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG
 from decoy_cli.damage.sample_set import SampleStats
 

@@ -20,7 +20,7 @@ from decoy_cli.bench import (
     report,
     run_isolated,
 )
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import OutputError
 from decoy_cli.files import check_writable, write_json

@@ -15,7 +15,7 @@ from rich.progress import (
     TransferSpeedColumn,
 )
 
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.errors import DecoyError, DownloadError
 from decoy_cli.esta.download import (
     DEFAULT_DEST,

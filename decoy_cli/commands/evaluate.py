@@ -22,7 +22,7 @@ from rich.table import Table
 from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files

@@ -10,7 +10,7 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.damage import CHOICES_HELP, load_damage_model
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 from rich.table import Table
 
-from decoy_cli.commands._console import console as make_console
+from decoy_cli.commands._console import make_console
 from decoy_cli.commands._damage_output import (
     BALANCE_HELP,
     DATA_HELP,

@@ -148,11 +148,12 @@ time plus the 40 s bomb timer), so frame times far beyond it are a broken clock,
 
 MAX_FRAMES = int(MAX_ROUND_S * 128)
 """Most frames a round may hold: one per tick at 128 ticks/s for `MAX_ROUND_S` (real rounds
-have about two frames per second). Bounds the memory of a hostile round."""
+in ../shared/data have a frame every 0.50 s, median). Bounds the memory of a hostile round."""
 
 MAX_PLAYERS = 64
 """Most distinct players a round's frames may hold: a CS:GO server has at most 64 player slots
-(real rounds have 10, or 5 in the T-side files). Bounds the (players, frames) arrays."""
+(a competitive round has 10; the T-side files in ../shared/data hold 5). Bounds the (players,
+frames) arrays."""
 
 
 def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:

@@ -23,7 +23,7 @@ ever has a position fails under both: there is nothing to replay or measure.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Literal, get_args
+from typing import Literal, cast, get_args
 
 import numpy as np
 
@@ -44,11 +44,9 @@ IMPLAUSIBLE_CHOICES: tuple[str, ...] = get_args(Implausible)
 
 def check_policy(value: str) -> Implausible:
     """`value` as a policy if it is one of `IMPLAUSIBLE_CHOICES`, else an EstaError naming them."""
-    if value == "fail":
-        return "fail"
-    if value == "warn":
-        return "warn"
-    raise EstaError(f"--implausible {value!r}: use {' or '.join(IMPLAUSIBLE_CHOICES)}")
+    if value not in IMPLAUSIBLE_CHOICES:
+        raise EstaError(f"--implausible {value!r}: use {' or '.join(IMPLAUSIBLE_CHOICES)}")
+    return cast(Implausible, value)
 
 
 def check_frames(arrays: FrameArrays, policy: Implausible = "fail") -> tuple[str, ...]:

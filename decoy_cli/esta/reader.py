@@ -50,9 +50,10 @@ from decoy_cli.esta.schema import (
 from decoy_cli.esta.source import decode_round, parse, read_bytes, round_number_hint
 
 MAX_MATCH_PLAYER_FRAMES = 4_000_000
-"""Most player-frames (players × frames, summed over rounds) a match file may hold: over 30 times
-a full real match (30 rounds of 10 players at two frames per second). With the per-round limits
-of decoy_cli/esta/frames.py it bounds the memory a hostile file can take."""
+"""Most player-frames (players × frames, summed over rounds) a match file may hold: about 140
+times the most in a real file in ../shared/data (28,365, T side only; twice that with both
+teams). With the per-round limits of decoy_cli/esta/frames.py it bounds the memory a hostile
+file can take."""
 
 MATCH_SUFFIXES = (".json.xz", ".json")
 """File names `iter_match_files` picks up in a folder."""

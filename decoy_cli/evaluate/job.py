@@ -29,6 +29,7 @@ import msgspec
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
 from decoy_cli.esta.batch import UNREADABLE_FILE
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import PlaceFinder, RoundRecord, build_record
 from decoy_cli.evaluate.settings import EvalSettings, round_seed
 
@@ -110,10 +111,10 @@ class _WorkerState:
             self.models[choice] = model
         return self.models[choice]
 
-    def match(self, file: str, file_sha: str, settings: EvalSettings) -> Match:
+    def match(self, file: str, file_sha: str, implausible: Implausible) -> Match:
         """The match read from `file` under the run's policy for implausible rounds, checked to
         be the content the run hashed."""
-        key = (file, file_sha, settings.implausible)
+        key = (file, file_sha, implausible)
         if key in self.matches:
             self.matches.move_to_end(key)
             return self.matches[key]
@@ -124,7 +125,7 @@ class _WorkerState:
             raise DecoyError(f"{file}: cannot read the file ({error.strerror or error})") from None
         if hashlib.sha256(data).hexdigest() != file_sha:
             raise DecoyError(f"{file}: the file changed while the evaluation ran")
-        match = read_match(path, implausible=settings.implausible)
+        match = read_match(path, implausible=implausible)
         self.matches[key] = match
         while len(self.matches) > _MATCHES_KEPT:
             self.matches.popitem(last=False)
@@ -152,7 +153,9 @@ def is_synthetic(match_id: str, provenance: Any) -> bool:
 def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     """Read a match file and list its rounds; the worker keeps the match for its rounds."""
     try:
-        match = worker_state(task.settings.map_name).match(task.file, task.file_sha, task.settings)
+        match = worker_state(task.settings.map_name).match(
+            task.file, task.file_sha, task.settings.implausible
+        )
     except Exception as error:
         return failure_from(error, task.file, None, UNREADABLE_FILE)
     provenance = match.meta.get("provenance")
@@ -206,7 +209,7 @@ def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
 
 def _evaluate(task: RoundTask) -> RoundRecord:
     state = worker_state(task.settings.map_name)
-    round_ = state.match(task.file, task.file_sha, task.settings).round(task.round_num)
+    round_ = state.match(task.file, task.file_sha, task.settings.implausible).round(task.round_num)
     settings = task.settings
     model = state.damage_model(settings.models) if settings.combat else None
     started = time.perf_counter()

@@ -20,7 +20,8 @@ from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
 
-REPORT_FAILURES_SHOWN = 20
+REPORT_ROWS_SHOWN = 20
+"""Rows of a failure or warning list shown in the report; the CSVs hold them all."""
 
 
 @dataclass(frozen=True)
@@ -359,11 +360,9 @@ def _failures_section(evaluation: Evaluation) -> str:
     ]
     rows = [
         [Path(f.file).name, "" if f.round_num is None else str(f.round_num), f.kind, f.message]
-        for f in failures[:REPORT_FAILURES_SHOWN]
+        for f in failures
     ]
-    text.append(_table(["file", "round", "kind", "reason"], rows))
-    if len(failures) > REPORT_FAILURES_SHOWN:
-        text.append(f"… and {len(failures) - REPORT_FAILURES_SHOWN} more in `failures.csv`.")
+    text.append(_first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))
     return "\n\n".join(text)
 
 
@@ -377,10 +376,15 @@ def _warnings_section(tables: Tables) -> str:
         "are in the `warnings` column of `rounds.csv`.",
     ]
     rows = [
-        [Path(str(row.file)).name, str(row.round), str(row.warnings)]
-        for row in rounds.head(REPORT_FAILURES_SHOWN).itertuples()
+        [Path(str(row.file)).name, str(row.round), str(row.warnings)] for row in rounds.itertuples()
     ]
-    text.append(_table(["file", "round", "warnings"], rows))
-    if len(rounds) > REPORT_FAILURES_SHOWN:
-        text.append(f"… and {len(rounds) - REPORT_FAILURES_SHOWN} more in `rounds.csv`.")
+    text.append(_first_rows(["file", "round", "warnings"], rows, "rounds.csv"))
     return "\n\n".join(text)
+
+
+def _first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:
+    """A table of the first `REPORT_ROWS_SHOWN` rows, and where the others are."""
+    text = _table(header, rows[:REPORT_ROWS_SHOWN])
+    if len(rows) > REPORT_ROWS_SHOWN:
+        text += f"\n\n… and {len(rows) - REPORT_ROWS_SHOWN} more in `{csv_name}`."
+    return text

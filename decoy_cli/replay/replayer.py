@@ -21,9 +21,10 @@ import pandas as pd
 
 from decoy_cli.csgo import TICK_RATE, tick_at
 from decoy_cli.errors import EstaError
-from decoy_cli.esta import PlayerInfo, Round
+from decoy_cli.esta import Round
 from decoy_cli.esta.plausibility import Implausible, first_offender
 from decoy_cli.metrics.players import ReplayTrace
+from decoy_cli.replay.bomb import data_carriers, data_defuse_starts, data_plant_start_s
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -141,22 +142,6 @@ class ReplayOptions:
         )
 
 
-def data_plant_start_s(round_: Round, plant_s: float) -> float | None:
-    """When the real carrier began the plant that completed (seconds on the round's clock): its
-    `plant_begin` event, else the plant tick minus the plant's duration `plant_s` (the T-side
-    files record only `bombPlantTick`); None when the data shows no completed plant."""
-    if round_.bomb_plant_tick is None or not len(round_.frame_ticks):
-        return None
-    plant_at = float(np.interp(round_.bomb_plant_tick, round_.frame_ticks, round_.frame_seconds))
-    events = round_.bomb_events
-    if len(events) and "bombAction" in events and "seconds" in events:
-        begins = events.loc[events["bombAction"] == "plant_begin", "seconds"].to_numpy(float)
-        begins = begins[np.isfinite(begins) & (begins <= plant_at) & (begins >= plant_at - 10)]
-        if len(begins):
-            return float(begins.max())  # the attempt that completed
-    return plant_at - plant_s
-
-
 def replay_round(
     round_: Round,
     graph: WaypointGraph,
@@ -208,22 +193,15 @@ def replay_round(
     agents.hp[never] = 0
 
     rules_config = setup.rules_config()
-    carrier = -1
-    has_bomb = np.asarray(round_.has_bomb)
-    if options.bomb and has_bomb.size:
-        holders = [i for i in range(n) if has_bomb[i, first[i]] and agents.alive[i]]
-        carrier = holders[0] if holders else -1
-        if carrier >= 0 and players[carrier].side != "T":
-            raise EstaError(
-                f"{round_.path}: round {round_.round_num}: {players[carrier].name} on the "
-                f"{players[carrier].side} side holds the bomb at frame {first[carrier]}: only a "
-                "T can carry it"
-            )
+    carriers = data_carriers(round_) if options.bomb else np.full(len(frame_ticks), -1)
+    carrier = int(carriers[0])  # the data's carrier at the first frame, if the replay has him
+    if carrier >= 0 and not agents.alive[carrier]:
+        carrier = -1
     plant_from = None
     if options.bomb:
         start_s = data_plant_start_s(round_, rules_config.plant_s)
         plant_from = None if start_s is None else tick_at(start_s)
-    defuse_from = _defuse_starts(round_, players)
+    defuse_from = data_defuse_starts(round_, players)
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
     policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant_from, defuse_from, caps)
@@ -256,10 +234,8 @@ def replay_round(
                     scripted[i] = True
             sim.step()
             f = frame_of_tick.get(sim.tick)
-            if f is not None and options.bomb:  # the bomb changes hands as in the data
-                holding = has_bomb[:, f] & agents.alive if has_bomb.size else np.zeros(n, bool)
-                if holding.any() and sim.bomb.carrier != int(np.argmax(holding)):
-                    sim.hand_bomb(int(np.argmax(holding)))
+            if f is not None and carriers[f] >= 0 and sim.bomb.carrier != carriers[f]:
+                sim.hand_bomb(int(carriers[f]))  # the bomb changes hands as in the data
             if f is not None:  # follow the weapon in hand, as the data shows it
                 for alive in np.nonzero(agents.alive)[0]:
                     i = int(alive)
@@ -364,22 +340,3 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     )
     ran = np.where(np.isfinite(ran), ran, 0.0)
     return np.maximum(plan.interval_max_speed_m_s, ran) * zigzag
-
-
-def _defuse_starts(round_: Round, players: list[PlayerInfo]) -> dict[int, int]:
-    """Agent -> tick from which it wants to defuse: its `defuse_start` events in the data."""
-    events = round_.bomb_events
-    if len(events) == 0 or "bombAction" not in events:
-        return {}
-    starts = events[events["bombAction"] == "defuse_start"]
-    out: dict[int, int] = {}
-    for i, player in enumerate(players):
-        mine = starts[
-            (starts.get("playerName") == player.name)
-            | (starts.get("playerSteamID") == player.steam_id)
-        ]
-        if len(mine):
-            seconds = float(np.nanmin(mine["seconds"])) if "seconds" in mine else np.nan
-            if np.isfinite(seconds):
-                out[i] = tick_at(seconds) - TICK_RATE
-    return out
