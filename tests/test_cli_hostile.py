@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shutil
 from pathlib import Path
 from typing import Any
@@ -179,7 +180,11 @@ def fuzz_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("cli-fuzz")
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+FUZZ_EXAMPLES = int(os.environ.get("DECOY_FUZZ_EXAMPLES", "40"))
+"""Mutated files per run (CI's default; set DECOY_FUZZ_EXAMPLES for a longer search)."""
+
+
+@settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(changes=mutations, damage=byte_damage, xz_fraction=compression)
 def test_any_mutated_file_ends_in_results_or_one_error_line(
     fuzz_dir: Path,
