@@ -40,12 +40,8 @@ def study_file(file: Path) -> list[tuple]:
     for item in iter_rounds([file]):
         if isinstance(item, RoundFailure):
             continue
-        planted = item.bomb_plant_tick is not None and len(item.frame_ticks) > 1
-        data_s = (
-            float(np.interp(item.bomb_plant_tick, item.frame_ticks, item.frame_seconds))
-            if planted
-            else np.nan
-        )
+        planted = item.bomb_plant_tick is not None and item.clock is not None
+        data_s = float(item.clock.seconds(item.bomb_plant_tick)) if planted else np.nan
         result = replay_round(item, graph, ReplayOptions(combat=False, bomb=True, play_out=False))
         plants = [e for e in result.events if e.kind == "plant"]
         aborts = ",".join(

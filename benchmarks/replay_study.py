@@ -3,11 +3,11 @@
     python benchmarks/replay_study.py ../shared/data/esta_dust2_tside --mover physics \
         --csv decoy-out/replay_study.csv
 
-Prints the clock and paper metrics aggregated by side (mean, std, median, p90), the paper's
-T-side values beside them, lateness and stuck/recovery counts per round, the worst rounds, and
-the wall time. It runs the rounds through `decoy evaluate`'s runner (one worker process by
-default, so rounds/s is per core), with a throw-away cache; `decoy evaluate` adds the figures
-and the report.
+The bomb is off too, unless `--bomb` (then it follows the data). Prints the clock and paper
+metrics aggregated by side (mean, std, median, p90), the paper's T-side values beside them,
+lateness and stuck/recovery counts per round, the worst rounds, and the wall time. It runs the
+rounds through `decoy evaluate`'s runner (one worker process by default, so rounds/s is per
+core), with a throw-away cache; `decoy evaluate` adds the figures and the report.
 """
 
 from __future__ import annotations
@@ -38,12 +38,20 @@ def main() -> None:
     parser.add_argument("--limit", type=int, default=0, help="only the first N files")
     parser.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
     parser.add_argument("--csv", type=Path, default=None)
+    parser.add_argument(
+        "--bomb", action="store_true", help="the bomb follows the data (default: off)"
+    )
     args = parser.parse_args()
     files = iter_match_files(args.folder)
     if args.limit:
         files = files[: args.limit]
     settings = make_settings(
-        map_name="de_dust2", combat=False, bomb=False, models="none", mover=args.mover, seed=0
+        map_name="de_dust2",
+        combat=False,
+        bomb=args.bomb,
+        models="none",
+        mover=args.mover,
+        seed=0,
     )
     with tempfile.TemporaryDirectory() as out, LocalBackend(args.workers) as backend:
         evaluation = run_evaluation(files, settings, Path(out), backend)
@@ -54,7 +62,7 @@ def main() -> None:
     print(
         f"{n_rounds} rounds, {len(players)} player-rounds, {len(evaluation.failures)} failures, "
         f"{wall:.1f} s ({n_rounds / wall:.2f} rounds/s on {args.workers} worker processes, "
-        f"mover {args.mover}, combat and bomb off)"
+        f"mover {args.mover}, combat off, bomb {'on' if args.bomb else 'off'})"
     )
     for failure in evaluation.failures:
         print(f"  failed: {failure.file}:{failure.round_num}: {failure.message}")

@@ -23,6 +23,7 @@ import pytest
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import EstaError
+from decoy_cli.esta import RoundClock
 from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK, player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
 from decoy_cli.replay.snapping import SnapStatus
@@ -144,7 +145,8 @@ def make_round(
         num_players=n,
         players=[Player(t.name, t.side) for t in tracks],
         frame_ticks=ticks,
-        frame_seconds=(ticks - FREEZE_END) / DATA_TICK_RATE,
+        frame_seconds=RoundClock(FREEZE_END, DATA_TICK_RATE).seconds(ticks),
+        clock=RoundClock(FREEZE_END, DATA_TICK_RATE),
         position=position,
         yaw=np.where(present, 90.0, np.nan),
         alive=alive,

@@ -11,7 +11,7 @@ from decoy_cli.esta.batch import (
     iter_rounds,
     match_rounds,
 )
-from decoy_cli.esta.frames import MISSING, PlayerInfo
+from decoy_cli.esta.frames import MISSING, PlayerInfo, RoundClock
 from decoy_cli.esta.reader import (
     Match,
     Round,
@@ -26,6 +26,7 @@ __all__ = [
     "Match",
     "PlayerInfo",
     "Round",
+    "RoundClock",
     "RoundFailure",
     "collect_match_files",
     "failure_from",

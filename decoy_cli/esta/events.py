@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.esta.frames import MAX_COORD_U
+from decoy_cli.esta.frames import MAX_COORD_U, RoundClock
 from decoy_cli.esta.schema import Invalid, Kind
 from decoy_cli.weapons import is_known
 
@@ -38,17 +38,20 @@ def build_table(
     rows: Sequence[msgspec.Struct] | None,
     columns: dict[str, Kind],
     frame_ticks: np.ndarray,
+    clock: RoundClock | None = None,
 ) -> pd.DataFrame:
-    """One event list as a DataFrame with metre columns and `frame_index`; bad rows raise."""
+    """One event list as a DataFrame with metre columns and `frame_index`; bad rows raise.
+    With the round's `clock`, `seconds` is the clock's reading at each event's tick (where the
+    event has one), as for the frames."""
     if not rows:
         return _empty_table(table, tuple(columns.items())).copy()
-    return _build(table, rows, columns, frame_ticks)
+    return _build(table, rows, columns, frame_ticks, clock)
 
 
 @cache
 def _empty_table(table: str, columns: tuple[tuple[str, Kind], ...]) -> pd.DataFrame:
     """The table without rows, built once: most rounds of the T-side files have no events."""
-    return _build(table, [], dict(columns), np.empty(0, dtype=np.int64))
+    return _build(table, [], dict(columns), np.empty(0, dtype=np.int64), None)
 
 
 def _build(
@@ -56,6 +59,7 @@ def _build(
     rows: Sequence[msgspec.Struct],
     columns: dict[str, Kind],
     frame_ticks: np.ndarray,
+    clock: RoundClock | None,
 ) -> pd.DataFrame:
     """The table of `build_table`, for any number of rows."""
     data: dict[str, object] = {
@@ -74,6 +78,9 @@ def _build(
     ticks = cast(pd.arrays.IntegerArray, data["tick"])  # every table's tick is an "int" column
     tick_values = ticks.to_numpy(dtype=np.float64, na_value=np.nan)
     data["frame_index"] = nearest_frame(tick_values, frame_ticks)
+    if clock is not None and "seconds" in data:
+        written = np.asarray(data["seconds"], dtype=np.float64)
+        data["seconds"] = np.where(np.isfinite(tick_values), clock.seconds(tick_values), written)
     return pd.DataFrame(data, index=pd.RangeIndex(len(rows)))
 
 

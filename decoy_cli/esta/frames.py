@@ -6,6 +6,11 @@ then CT, each by key. A player entry whose x, y or z is null cannot be placed: i
 from that frame, like a player missing from the list. Absent cells hold NaN (position, yaw),
 `MISSING` (hp, armor), "" (weapon) and False (flags, `alive`, `present`). A NaN, infinite or
 off-map coordinate (beyond ±10,000 Hammer units) is an error, and so is an unknown weapon.
+
+The round's clock is the game's: seconds since freeze-time end counted in ticks at the file's
+`tickRate` (`round_clock_zero`). A file's own `seconds` only place the zero: some awpy 1.x
+exports wrote them at 127 per second on 128-tick demos, a clock 0.8% slow against the game's
+115 s round time (benchmarks/clock_study.py measures it).
 """
 
 from __future__ import annotations
@@ -42,12 +47,26 @@ class PlayerInfo:
     side: Side
 
 
+@dataclass(frozen=True)
+class RoundClock:
+    """The game's clock of a round: seconds since freeze-time end (`zero_tick`), in ticks at
+    the server's `tick_rate`."""
+
+    zero_tick: float
+    tick_rate: int
+
+    def seconds(self, ticks: npt.ArrayLike) -> np.ndarray:
+        """Seconds on this clock at each tick."""
+        return (np.asarray(ticks, dtype=np.float64) - self.zero_tick) / self.tick_rate
+
+
 @dataclass(frozen=True, eq=False)
 class FrameArrays:
     """Everything the frames of one round hold, as arrays (see Round for the meaning)."""
 
     ticks: np.ndarray
     seconds: np.ndarray
+    clock: RoundClock | None
     players: list[PlayerInfo]
     position: np.ndarray
     yaw: np.ndarray
@@ -74,13 +93,17 @@ def build_frames(
     if len(frames) > MAX_FRAMES:
         raise Invalid(f"{len(frames):,} frames (a round holds at most {MAX_FRAMES:,})")
     ticks = _ticks(frames)
-    seconds = _seconds(frames, ticks, tick_rate, freeze_end_tick, start_tick)
+    zero_tick = round_clock_zero(frames, ticks, tick_rate, freeze_end_tick, start_tick)
+    clock = None if zero_tick is None else RoundClock(zero_tick, tick_rate)
+    seconds = clock.seconds(ticks) if clock is not None else np.zeros(0)
     _check_clock(seconds, ticks)
+    _check_written_seconds(np.array([f.seconds for f in frames], dtype=np.float64), seconds, ticks)
     bomb_position = _bomb_position(frames, ticks)
     players, arrays = _players(frames, ticks)
     return FrameArrays(
         ticks=ticks,
         seconds=seconds,
+        clock=clock,
         players=players,
         **arrays,
         bomb_position=bomb_position,
@@ -112,33 +135,35 @@ def _ticks(frames: list[FrameState]) -> np.ndarray:
     return ticks
 
 
-def _seconds(
+def round_clock_zero(
     frames: list[FrameState],
     ticks: np.ndarray,
     tick_rate: int,
     freeze_end_tick: int | None,
     start_tick: int | None,
-) -> np.ndarray:
-    """Seconds since freeze-time end: `seconds` where given, else derived from the tick.
+) -> float | None:
+    """The tick at which the round's clock reads 0 s (freeze-time end), None if nothing says.
 
-    The reference tick for derived values is `freezeTimeEndTick`, else the one the frames with
-    `seconds` imply, else `startTick`, else the first frame's tick.
+    `freezeTimeEndTick` when given; else the tick the frames' `seconds` imply, at the rate they
+    were written with (some awpy 1.x exports divided by 127 on 128-tick demos); else `startTick`;
+    else the first frame's tick.
     """
-    seconds = np.array([f.seconds for f in frames], dtype=np.float64)
-    missing = ~np.isfinite(seconds)
-    if not missing.any():
-        return seconds
-    known = ~missing
     if freeze_end_tick is not None:
-        reference = float(freeze_end_tick)
-    elif known.any():
-        reference = float(np.median(ticks[known] - seconds[known] * tick_rate))
-    elif start_tick is not None:
-        reference = float(start_tick)
-    else:
-        reference = float(ticks[0])
-    seconds[missing] = (ticks[missing] - reference) / tick_rate
-    return seconds
+        return float(freeze_end_tick)
+    seconds = np.array([f.seconds for f in frames], dtype=np.float64)
+    known = np.isfinite(seconds)
+    if known.any():
+        rate = float(tick_rate)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            dt = np.diff(seconds[known])
+            if (dt > 0).any():
+                written = float(np.median(np.diff(ticks[known])[dt > 0] / dt[dt > 0]))
+                if 0.5 * tick_rate <= written <= 2.0 * tick_rate:
+                    rate = written
+            return float(np.median(ticks[known] - seconds[known] * rate))
+    if start_tick is not None:
+        return float(start_tick)
+    return float(ticks[0]) if ticks.size else None
 
 
 MAX_ROUND_S = 600.0
@@ -157,7 +182,8 @@ frames) arrays."""
 
 
 def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
-    """Frame times must be finite, non-decreasing and within `MAX_ROUND_S` of freeze-time end."""
+    """Frame times (non-decreasing, as the ticks are) must be finite and within `MAX_ROUND_S`
+    of freeze-time end."""
     bad = ~np.isfinite(seconds) | (np.abs(seconds) > MAX_ROUND_S)
     if bad.any():
         f = int(np.flatnonzero(bad)[0])
@@ -165,12 +191,32 @@ def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
             f"{_where(ticks, f)}: frame time {seconds[f]:g} s is not within {MAX_ROUND_S:g} s "
             "of freeze-time end (a round lasts at most 115 s plus the 40 s bomb timer)"
         )
-    back = np.flatnonzero(np.diff(seconds) < 0)
-    if len(back):
-        f = int(back[0]) + 1
+
+
+CLOCK_TOLERANCE = (0.02, 1.0)
+"""How far a frame's written `seconds` may lie from the game clock's reading at its tick:
+2% of the reading plus 1 s. The real files' `seconds` run 0.8% slow in some matches (127 per
+second on 128-tick demos, benchmarks/clock_study.py); farther off, the file contradicts itself."""
+
+
+def _check_written_seconds(written: np.ndarray, seconds: np.ndarray, ticks: np.ndarray) -> None:
+    """The file's own `seconds` (where given) must run forwards and agree with the ticks."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        given = np.flatnonzero(np.isfinite(written))
+        back = given[1:][np.diff(written[given]) < 0]
+        if len(back):
+            f = int(back[0])
+            raise Invalid(
+                f"{_where(ticks, f)}: frame time {written[f]:g} s is before the previous frame's"
+            )
+        share, slack = CLOCK_TOLERANCE
+        allowed = share * np.abs(seconds[given]) + slack
+        off = given[np.abs(written[given] - seconds[given]) > allowed]
+    if len(off):
+        f = int(off[0])
         raise Invalid(
-            f"{_where(ticks, f)}: frame time {seconds[f]:g} s is before the previous frame's "
-            f"{seconds[f - 1]:g} s"
+            f"{_where(ticks, f)}: frame time {written[f]:g} s disagrees with its tick "
+            f"({seconds[f]:g} s on the game clock)"
         )
 
 

@@ -37,7 +37,7 @@ import pandas as pd
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.events import build_table
-from decoy_cli.esta.frames import PlayerInfo, Side, build_frames
+from decoy_cli.esta.frames import PlayerInfo, RoundClock, Side, build_frames
 from decoy_cli.esta.plausibility import Implausible, check_frames
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
@@ -66,7 +66,9 @@ class Round:
     Per-player arrays have shape (P, F): `position` (P, F, 3) metres and `yaw` degrees (NaN where
     absent), `hp` and `armor` int16 (-1 where absent or null), `helmet`, `has_defuser`, `alive`,
     `present`, `has_bomb` bool (False where absent), `weapon` str ("" where none or absent).
-    Per-frame: `frame_ticks` int64, `frame_seconds` float64, `bomb_position` (F, 3) metres (NaN
+    Per-frame: `frame_ticks` int64, `frame_seconds` float64 (the game's clock: seconds since
+    freeze-time end counted in ticks at `tick_rate`, `clock`; events' `seconds` are on the same
+    clock when the round has one), `bomb_position` (F, 3) metres (NaN
     when null), `bomb_planted` bool, `bombsite` str. Events: `damages`, `kills`, `bomb_events`,
     `flashes` (attacker = the thrower, player = the flashed player).
     `start_tick`/`end_tick` fall back to the first/last frame tick when null (None if no frames).
@@ -102,6 +104,9 @@ class Round:
     bomb_plant_tick: int | None
     start_tick: int | None
     end_tick: int | None
+    clock: RoundClock | None = None
+    """None only for a round without frames whose file gives neither `freezeTimeEndTick` nor
+    `startTick`."""
     warnings: tuple[str, ...] = ()
     """Implausible data kept under the "warn" policy (decoy_cli/esta/plausibility.py)."""
 
@@ -265,6 +270,7 @@ def _build_round(
     )
     warnings = check_frames(arrays, implausible)
     ticks = arrays.ticks
+    clock = arrays.clock
     if ticks.size:
         start_tick = int(ticks[0]) if start_tick is None else start_tick
         end_tick = int(ticks[-1]) if end_tick is None else end_tick
@@ -294,15 +300,16 @@ def _build_round(
         bomb_position=arrays.bomb_position,
         bomb_planted=arrays.bomb_planted,
         bombsite=arrays.bombsite,
-        damages=build_table("damages", state.damages, DAMAGE_COLUMNS, ticks),
-        kills=build_table("kills", state.kills, KILL_COLUMNS, ticks),
-        bomb_events=build_table("bomb_events", state.bombEvents, BOMB_EVENT_COLUMNS, ticks),
-        flashes=build_table("flashes", state.flashes, FLASH_COLUMNS, ticks),
+        damages=build_table("damages", state.damages, DAMAGE_COLUMNS, ticks, clock),
+        kills=build_table("kills", state.kills, KILL_COLUMNS, ticks, clock),
+        bomb_events=build_table("bomb_events", state.bombEvents, BOMB_EVENT_COLUMNS, ticks, clock),
+        flashes=build_table("flashes", state.flashes, FLASH_COLUMNS, ticks, clock),
         winning_side=winner,
         end_reason=state.roundEndReason or None,
         bomb_plant_tick=_optional_int(state.bombPlantTick, "bombPlantTick"),
         start_tick=start_tick,
         end_tick=end_tick,
+        clock=clock,
         warnings=warnings,
     )
 

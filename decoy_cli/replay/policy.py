@@ -15,8 +15,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
+from decoy_cli.replay.bomb import DataPlant
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.graph import STOP_ACTION
 
 _FOREVER = 10**9
@@ -49,7 +51,7 @@ class PlanPolicy:
         plans: list[PlayerPlan],
         tick_of: Callable[[float], int],
         graph_edge_length: np.ndarray,
-        plant_from_tick: int | None = None,
+        plant: DataPlant | None = None,
         defuse_from_tick: dict[int, int] | None = None,
         interval_caps: list[np.ndarray] | None = None,
     ) -> None:
@@ -57,7 +59,7 @@ class PlanPolicy:
         self.interval_caps = interval_caps  # per plan: (T-1,) speed cap of each interval, m/s
         self.tick_of = tick_of  # seconds -> simulator tick
         self.next_action = np.zeros(len(plans), dtype=np.int64)
-        self.plant_from_tick = plant_from_tick
+        self.plant = plant
         self.defuse_from_tick = defuse_from_tick or {}
         self.logs = []
         # per plan and action: path length of this and the later moves of its interval, and
@@ -94,7 +96,7 @@ class PlanPolicy:
     def decide(self, sim: Simulator, agent: int) -> Decision:
         plan = self.plans[agent]
         now = sim.tick
-        plant = self.plant_from_tick is not None and now >= self.plant_from_tick
+        plant = self.plant is not None and now >= self.plant.start_tick
         defuse = agent in self.defuse_from_tick and now >= self.defuse_from_tick[agent]
         if plant and sim.bomb.planter == agent:
             # planting, as the real player did: hold still until the plant completes, then
@@ -102,7 +104,7 @@ class PlanPolicy:
             left = sim.rules.config.plant_ticks - sim.bomb.plant_ticks
             return Decision(STOP_ACTION, hold_ticks=max(1, left), plant=True)
         decision = self._follow_plan(sim, agent, plan, now, plant, defuse)
-        wake = self.plant_from_tick
+        wake = None if self.plant is None else self.plant.start_tick
         if (
             decision.action == STOP_ACTION
             and wake is not None
@@ -111,6 +113,23 @@ class PlanPolicy:
             # wake at the data's plant start, so the wish to plant starts on time
             decision = replace(decision, hold_ticks=wake - now)
         return decision
+
+    def _plants_here(self, sim: Simulator, agent: int, interval: int) -> bool:
+        """Whether the carrier, about to leave its plan's plant spot by a move of `interval`,
+        must stay and plant first: the data's plant has begun, this agent planted it, carries
+        the bomb, stands at the plant target inside a site, and has not planted yet. A carrier
+        that arrived late plants late rather than walking on with the bomb."""
+        data = self.plant
+        if data is None or agent != data.agent or interval < data.target:
+            return False
+        bomb = sim.bomb
+        return (
+            sim.tick >= data.start_tick
+            and bomb.status == BombStatus.CARRIED
+            and bomb.carrier == agent
+            and int(sim.agents.node[agent]) == int(self.plans[agent].target_node[data.target])
+            and bool(sim.rules.zones.site_of(sim.agents.position[agent])[0])
+        )
 
     def _follow_plan(
         self, sim: Simulator, agent: int, plan: PlayerPlan, now: int, plant: bool, defuse: bool
@@ -141,6 +160,9 @@ class PlanPolicy:
                         STOP_ACTION, hold_ticks=deadline - now, plant=plant, defuse=defuse
                     )
                 continue
+            if self._plants_here(sim, agent, interval):
+                self.next_action[agent] = a - 1  # the move waits until the plant completes
+                return Decision(STOP_ACTION, hold_ticks=1, plant=True)
             seconds_left = (deadline - now) / TICK_RATE
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])

@@ -24,7 +24,12 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round
 from decoy_cli.esta.plausibility import Implausible, first_offender
 from decoy_cli.metrics.players import ReplayTrace
-from decoy_cli.replay.bomb import data_carriers, data_defuse_starts, data_plant_start_s
+from decoy_cli.replay.bomb import (
+    carrier_sites,
+    data_carriers,
+    data_defuse_starts,
+    data_plant,
+)
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -164,7 +169,15 @@ def replay_round(
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
             return replay_round(round_, graph, options, physics=own, open_sim=open_sim)
-    plan = snap_round(round_, graph, physics=physics)
+    carriers = data_carriers(round_) if options.bomb else np.full(len(frame_ticks), -1)
+    zones = setup.site_zones()
+    plan = snap_round(
+        round_,
+        graph,
+        physics=physics,
+        sites=carrier_sites(round_, carriers, zones) if options.bomb else None,
+        node_site=zones.site_of(graph.positions),
+    )
     players = plan.players
     n = len(players)
     first = [int(p.target_frame[0]) if len(p.target_node) else 0 for p in plan.plans]
@@ -193,18 +206,14 @@ def replay_round(
     agents.hp[never] = 0
 
     rules_config = setup.rules_config()
-    carriers = data_carriers(round_) if options.bomb else np.full(len(frame_ticks), -1)
     carrier = int(carriers[0])  # the data's carrier at the first frame, if the replay has him
     if carrier >= 0 and not agents.alive[carrier]:
         carrier = -1
-    plant_from = None
-    if options.bomb:
-        start_s = data_plant_start_s(round_, rules_config.plant_s)
-        plant_from = None if start_s is None else tick_at(start_s)
+    plant = data_plant(round_, plan.plans, carriers, rules_config.plant_s) if options.bomb else None
     defuse_from = data_defuse_starts(round_, players)
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
-    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant_from, defuse_from, caps)
+    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant, defuse_from, caps)
     start_tick = int(frame_ticks[0])
     scripted = np.zeros(n, dtype=bool)
     weapon_frames = np.asarray(round_.weapon)
@@ -225,14 +234,17 @@ def replay_round(
             deaths = {
                 i: tick_at(p.death_seconds) for i, p in enumerate(plan.plans) if p.death_frame >= 0
             }
-        while not sim.done and sim.tick < end_tick:
+        # The replay follows the data to its last frame: a round the rules end earlier (the
+        # clock, the bomb) goes on moving through the round-end delay, as the real players
+        # did, with the outcome as decided (`Simulator.step(after_end=True)`).
+        while sim.tick < end_tick and not (sim.done and sim.outcome is None):
             # Scripted deaths come before the step of the death frame's tick, which records the
             # frame: the frame that shows the player dead in the data shows it dead here too.
             for i, tick in deaths.items():
                 if tick <= sim.tick + 1 and agents.alive[i]:
                     sim.kill(i, "scripted")
                     scripted[i] = True
-            sim.step()
+            sim.step(after_end=True)
             f = frame_of_tick.get(sim.tick)
             if f is not None and carriers[f] >= 0 and sim.bomb.carrier != carriers[f]:
                 sim.hand_bomb(int(carriers[f]))  # the bomb changes hands as in the data
@@ -243,6 +255,8 @@ def replay_round(
                         agents.weapon[i] = weapon_frames[i, f]
                         sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
         played_from = sim.tick
+        while sim.bomb.planter >= 0 and not sim.done:
+            sim.step()  # a plant under way when the data ends completes (or aborts) first
         if options.play_out and sim.combat is not None and not sim.done:
             # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later
             limit = max(sim.tick, rules_config.round_ticks) + rules_config.bomb_ticks + 1

@@ -22,6 +22,7 @@ from decoy_cli.replay.snapping import (
     WITHIN_M,
     SnapResult,
     SnapStatus,
+    snap_into_sites,
     snap_positions,
 )
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -88,10 +89,15 @@ def snap_round(
     *,
     max_distance: float = DEFAULT_MAX_SNAP_M,
     physics: PhysicsWorld | None = None,
+    sites: np.ndarray | None = None,
+    node_site: np.ndarray | None = None,
 ) -> RoundPlan:
     """Snap every player of a round to the graph and build its timed plan (one shared path cache).
 
-    With `physics` (the world the graph was built on), frames in the air are not snapped.
+    With `physics` (the world the graph was built on), frames in the air are not snapped. With
+    `sites` (P, F), the bomb site each player must stand in at each frame ("" where free), and
+    `node_site`, the site of every waypoint, those frames snap inside their site
+    (`snap_into_sites`).
 
     Inconsistent round arrays raise EstaError; an unknown weapon name raises EstaError.
     """
@@ -119,6 +125,8 @@ def snap_round(
         snap = snap_positions(
             graph, positions[p], alive[p], max_distance=max_distance, floor_z=floor_z[p]
         )
+        if sites is not None and node_site is not None and (sites[p] != "").any():
+            snap = snap_into_sites(graph, snap, positions[p], sites[p], node_site, max_distance)
         present = np.isfinite(positions[p]).all(axis=1)
         plan = build_plan(
             graph, snap.node, seconds, alive[p], weapons[p], present=present, paths=paths

@@ -122,3 +122,34 @@ def snap_positions(
         status[query[found]] = SnapStatus.SNAPPED
         status[query[~found]] = SnapStatus.NO_WAYPOINT
     return SnapResult(node=node, error_m=error, status=status)
+
+
+def snap_into_sites(
+    graph: WaypointGraph,
+    snap: SnapResult,
+    positions: np.ndarray,
+    sites: np.ndarray,
+    node_site: np.ndarray,
+    max_distance: float = DEFAULT_MAX_SNAP_M,
+) -> SnapResult:
+    """Re-snap the frames where `sites` (F,) names a bomb site to the nearest waypoint inside
+    that site's zone (`node_site`, the site of every waypoint, "" outside every zone).
+
+    A player standing just inside a zone's edge may have its nearest waypoint just outside, and
+    a carrier there could not plant where the real one did: the lattice's 0.7 m spacing must not
+    move a plant out of its site. Frames already on a waypoint of their site, or with none of
+    its waypoints within `max_distance`, keep their snap.
+    """
+    node, error, status = snap.node.copy(), snap.error_m.copy(), snap.status.copy()
+    wrong = np.flatnonzero(
+        (sites != "") & (status == SnapStatus.SNAPPED) & (node_site[np.maximum(node, 0)] != sites)
+    )
+    for f in wrong:
+        inside = np.flatnonzero(node_site == sites[f])
+        if not len(inside):
+            continue
+        distance = np.linalg.norm(graph.positions[inside] - positions[f], axis=1)
+        best = int(np.argmin(distance))
+        if distance[best] <= max_distance:
+            node[f], error[f] = inside[best], distance[best]
+    return SnapResult(node=node, error_m=error, status=status)

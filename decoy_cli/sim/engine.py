@@ -140,6 +140,7 @@ class Simulator:
             events=self.events,
         )
         self._next_record = 0
+        self._filled_after_end = False
         # every loop is bounded: the round's time limit plus the bomb timer after a plant
         self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
         self._record()
@@ -150,28 +151,20 @@ class Simulator:
     def done(self) -> bool:
         return self.outcome is not None or self.tick >= self._max_tick
 
-    def step(self) -> list[SimEvent]:
-        """Advance one tick; returns the events of that tick."""
-        if self.done:
+    def step(self, *, after_end: bool = False) -> list[SimEvent]:
+        """Advance one tick; returns the events of that tick. Nothing happens once the round is
+        done, unless `after_end`: then, after the outcome, the agents go on moving and are
+        recorded (a replay following the data through the round-end delay, when real players
+        still move), while the rules, combat and the outcome stay as they ended."""
+        if self.done and not (after_end and self.outcome is not None):
             return []
+        if self.outcome is not None:
+            return self._move_after_end()
         start = len(self.events)
         self.tick += 1
         self._decide()
-        moved = self.mover.step()
+        moving = self._move()
         agents = self.agents
-        agents.position[:] = self.mover.positions
-        moving = np.asarray(moved.moving, dtype=bool)
-        heading = np.asarray(self.mover.heading, dtype=np.float64)
-        agents.yaw[moving] = heading[moving]
-        arrived = np.asarray(moved.arrived, dtype=bool) & agents.alive
-        for agent in np.nonzero(arrived)[0]:
-            agents.node[agent] = self.goal_node[agent]
-            self.goal_node[agent] = -1
-            self.waiting[agent] = True
-        for agent in np.nonzero(np.asarray(moved.stuck, dtype=bool))[0]:
-            self.events.append(SimEvent(self.tick, "stuck", int(agent)))
-        for agent in np.nonzero(np.asarray(moved.teleported, dtype=bool))[0]:
-            self.events.append(SimEvent(self.tick, "teleport", int(agent)))
         self.events += self.rules.step(
             self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
         )
@@ -191,6 +184,14 @@ class Simulator:
             )
         self._record()
         return self.events[start:]
+
+    def _move_after_end(self) -> list[SimEvent]:
+        """One tick of movement after the outcome (see `step`)."""
+        self.tick += 1
+        self._decide()
+        self._move()
+        self._record()
+        return []
 
     def run(self, until: Callable[[Simulator], bool] | None = None) -> Recording:
         """Step until the round ends, the tick bound, or `until(sim)` says stop."""
@@ -215,8 +216,9 @@ class Simulator:
 
     def hand_bomb(self, agent: int) -> None:
         """Give the bomb to an alive T from outside the rules (a replay following the data's
-        carrier); see `BombRules.hand_over`."""
-        self.events += self.rules.hand_over(self.tick, self.agents, self.bomb, agent)
+        carrier); see `BombRules.hand_over`. Nothing changes hands after the round's end."""
+        if self.outcome is None:
+            self.events += self.rules.hand_over(self.tick, self.agents, self.bomb, agent)
 
     def kill(self, agent: int, reason: str) -> None:
         """Kill an agent from outside the combat step (a scripted death in a replay)."""
@@ -228,12 +230,33 @@ class Simulator:
 
     # ---- internals ----------------------------------------------------------------------------
 
+    def _move(self) -> np.ndarray:
+        """Move every agent one tick and note arrivals, stuck agents and teleports; returns the
+        (N,) mask of the agents that moved."""
+        moved = self.mover.step()
+        agents = self.agents
+        agents.position[:] = self.mover.positions
+        moving = np.asarray(moved.moving, dtype=bool)
+        heading = np.asarray(self.mover.heading, dtype=np.float64)
+        agents.yaw[moving] = heading[moving]
+        arrived = np.asarray(moved.arrived, dtype=bool) & agents.alive
+        for agent in np.nonzero(arrived)[0]:
+            agents.node[agent] = self.goal_node[agent]
+            self.goal_node[agent] = -1
+            self.waiting[agent] = True
+        for agent in np.nonzero(np.asarray(moved.stuck, dtype=bool))[0]:
+            self.events.append(SimEvent(self.tick, "stuck", int(agent)))
+        for agent in np.nonzero(np.asarray(moved.teleported, dtype=bool))[0]:
+            self.events.append(SimEvent(self.tick, "teleport", int(agent)))
+        return moving
+
     def _kill(self, agent: int) -> None:
         self.mover.remove(agent)
         self.waiting[agent] = False
         self.wants_plant[agent] = False
         self.wants_defuse[agent] = False
-        self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
+        if self.outcome is None:  # after the end the bomb stays as the round left it
+            self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
 
     @property
     def needs_decision(self) -> np.ndarray:
@@ -297,11 +320,12 @@ class Simulator:
                 rec.hp[k] = self.agents.hp
                 rec.alive[k] = self.agents.alive
             self._next_record += 1
-        if self.done:
-            # the round ended: later samples keep the final state
-            for k in range(self._next_record, len(self._record_at)):
-                rec.position[k] = self.agents.position
-                rec.yaw[k] = self.agents.yaw
-                rec.hp[k] = self.agents.hp
-                rec.alive[k] = self.agents.alive
-            self._next_record = len(self._record_at)
+        if self.done and not self._filled_after_end:
+            # the round ended: later samples keep the final state, unless the agents go on
+            # moving after the end (`step(after_end=True)`) and record over them
+            k = self._next_record
+            rec.position[k:] = self.agents.position
+            rec.yaw[k:] = self.agents.yaw
+            rec.hp[k:] = self.agents.hp
+            rec.alive[k:] = self.agents.alive
+            self._filled_after_end = True

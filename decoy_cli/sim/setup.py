@@ -56,7 +56,7 @@ class RoundSetup:
     `world` is the geometry for pybullet (None: the nav world of the graph's map); it is used
     only when a client is opened here, not when the caller lends one. `rules` overrides the
     rules' durations and ranges (its `bomb_enabled` is replaced by `bomb`); `zones` the bomb
-    sites (None: the graph's bomb-site regions).
+    sites (None: `SiteZones.from_graph`, the map's measured bomb-target boxes where known).
     """
 
     graph: WaypointGraph
@@ -95,6 +95,10 @@ class RoundSetup:
         if base.bomb_enabled == self.bomb:
             return base
         return replace(base, bomb_enabled=self.bomb)
+
+    def site_zones(self) -> SiteZones:
+        """The bomb-site zones of this setup's rounds."""
+        return self.zones if self.zones is not None else SiteZones.from_graph(self.graph)
 
     def open_physics(self) -> PhysicsWorld:
         """A new pybullet client holding this setup's world (the caller closes it)."""
@@ -146,8 +150,7 @@ def open_round(
             los = LineOfSight(physics, agents.count)
             stack.callback(los.close)
             combat = CombatStep(los, setup.damage_model, setup.map_name)
-        zones = setup.zones if setup.zones is not None else SiteZones.from_graph(setup.graph)
-        rules = BombRules(zones, setup.rules_config())
+        rules = BombRules(setup.site_zones(), setup.rules_config())
         yield Simulator(
             setup.graph,
             agents,
