@@ -1,91 +1,63 @@
-"""How often, and how on time, a replay plants the bomb where the data did (issue 12).
+"""How faithfully a replay's bomb follows real rounds: plants, defuses, sites, times (issue 12).
 
     python benchmarks/plant_study.py ../shared/data/esta_dust2_tside [--workers 2] [--csv X]
 
-Replays every round with the bomb on and combat off and prints: the rounds whose data shows a
-completed plant (`bombPlantTick`), how many of them the replay completes too, plants the replay
-completes where the data has none, the plant time error (replay against data, seconds, median and
-p95), and why the missed plants did not happen (the replay's `plant_abort` reasons).
+Runs the rounds through `decoy evaluate`'s runner with the bomb on and combat off (the data's
+deaths scripted), so the bomb is the only thing that can differ from the data, and prints the
+evaluation's bomb table (docs/metrics.md), the plant confusion, the rounds where the data and
+the replay disagree about a plant, and the data's anomalies. `--csv` writes the round rows
+(rounds.csv's columns) for a closer look.
 """
 
 from __future__ import annotations
 
 import argparse
-from concurrent.futures import ProcessPoolExecutor
+import tempfile
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-
-from decoy_cli.csgo import TICK_RATE
-from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
-from decoy_cli.replay.replayer import ReplayOptions, replay_round
-from decoy_cli.waypoints.build import builtin_graph
-
-COLUMNS = [
-    "file",
-    "round",
-    "data_planted",
-    "data_s",
-    "replay_planted",
-    "replay_s",
-    "site",
-    "aborts",
-]
-
-
-def study_file(file: Path) -> list[tuple]:
-    graph = builtin_graph()
-    rows = []
-    for item in iter_rounds([file]):
-        if isinstance(item, RoundFailure):
-            continue
-        planted = item.bomb_plant_tick is not None and item.clock is not None
-        data_s = float(item.clock.seconds(item.bomb_plant_tick)) if planted else np.nan
-        result = replay_round(item, graph, ReplayOptions(combat=False, bomb=True, play_out=False))
-        plants = [e for e in result.events if e.kind == "plant"]
-        aborts = ",".join(
-            str(e.data.get("reason")) for e in result.events if e.kind == "plant_abort"
-        )
-        rows.append(
-            (
-                file.name,
-                item.round_num,
-                planted,
-                data_s,
-                bool(plants),
-                plants[0].tick / TICK_RATE if plants else np.nan,
-                plants[0].data.get("site", "") if plants else "",
-                aborts,
-            )
-        )
-    return rows
+from decoy_cli.esta import iter_match_files
+from decoy_cli.evaluate.backends import LocalBackend
+from decoy_cli.evaluate.bomb_report import bomb_rows
+from decoy_cli.evaluate.runner import make_settings, run_evaluation
+from decoy_cli.evaluate.tables import build_tables
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path)
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    parser.add_argument("--mover", default="kinematic", choices=("physics", "kinematic"))
     parser.add_argument("--csv", type=Path, help="Write one row per round here.")
     args = parser.parse_args()
-    files, _ = collect_match_files([args.folder])
-    rows: list[tuple] = []
-    with ProcessPoolExecutor(args.workers) as pool:
-        for part in pool.map(study_file, files):
-            rows += part
-    table = pd.DataFrame(rows, columns=COLUMNS)
+    settings = make_settings(
+        map_name="de_dust2", combat=False, bomb=True, models="none", mover=args.mover, seed=0
+    )
+    files = iter_match_files(args.folder)
+    with tempfile.TemporaryDirectory() as out, LocalBackend(args.workers) as backend:
+        evaluation = run_evaluation(files, settings, Path(out), backend)
+    tables = build_tables(evaluation.accumulator)
+    rounds = tables.rounds
     if args.csv:
-        table.to_csv(args.csv, index=False)
-    real = table[table["data_planted"]]
-    print(f"{len(table)} rounds; the data completes a plant in {len(real)}")
-    print(f"the replay completes {int(real['replay_planted'].sum())} of them")
-    extra = int(table[~table["data_planted"]]["replay_planted"].sum())
-    print(f"plants where the data has none: {extra}")
-    error = (real["replay_s"] - real["data_s"]).abs().dropna()
-    if len(error):
-        print(f"plant time error: median {error.median():.3f} s, p95 {error.quantile(0.95):.3f} s")
-    missed = real[~real["replay_planted"]]["aborts"].replace("", "never began")
-    print("missed plants by abort reasons:", {k: int(v) for k, v in missed.value_counts().items()})
+        rounds.to_csv(args.csv, index=False)
+    bomb = tables.bomb
+    assert bomb is not None  # the bomb is on
+    print(
+        f"{len(rounds)} rounds ({len(evaluation.failures)} failures), {bomb.n_rounds} with bomb "
+        f"data; mover {args.mover}, combat off, bomb on"
+    )
+    for metric, value, count, note in bomb_rows(bomb):
+        print(f"  {metric:<32}{value:>8}  over {count} rounds {note}")
+    print("plants, data (rows) against replay (columns):")
+    print(bomb.plant_confusion.to_string())
+    disagree = rounds[rounds["plant_data"].astype(bool) != rounds["plant_replay"].astype(bool)]
+    for row in disagree.itertuples():
+        print(
+            f"  {row.match}:{row.round}: data {'planted' if row.plant_data else 'no plant'}, "
+            f"replay {'planted' if row.plant_replay else 'no plant'}"
+        )
+    odd = rounds[rounds["bomb_anomalies"].fillna("") != ""]
+    for row in odd.itertuples():
+        print(f"  anomaly {row.match}:{row.round}: {row.bomb_anomalies}")
 
 
 if __name__ == "__main__":

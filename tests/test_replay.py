@@ -158,6 +158,9 @@ def make_round(
         weapon=weapon,
         has_bomb=has_bomb,
         bomb_plant_tick=None if plant_frame is None else int(ticks[plant_frame]) - 10,
+        bomb_planted=np.arange(frames) >= (frames if plant_frame is None else plant_frame),
+        bomb_position=np.full((frames, 3), np.nan),
+        bombsite=np.full(frames, ""),
         bomb_events=pd.DataFrame(),
         warnings=(),
     )

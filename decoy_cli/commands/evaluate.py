@@ -27,6 +27,8 @@ from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.esta.plausibility import check_policy
+from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
+from decoy_cli.evaluate.markdown import num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
 from decoy_cli.evaluate.report import (
     RunInfo,
@@ -34,7 +36,6 @@ from decoy_cli.evaluate.report import (
     command_line,
     data_kind,
     mechanics,
-    num,
     table_groups,
 )
 from decoy_cli.evaluate.runner import (
@@ -46,7 +47,7 @@ from decoy_cli.evaluate.runner import (
     run_evaluation,
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
-from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, BombMetrics
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -304,6 +305,8 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         for label in matrix.index:
             confusion.add_row(str(label), *map(str, matrix.loc[label]))
         console.print(confusion)
+    if tables.bomb is not None:
+        _show_bomb(console, tables.bomb)
     places = Table(title="where the replay is off most (nav places, by the player's place)")
     for column in ("place", "original", "replay", "diff (pp)", "distance (m)", "off graph"):
         places.add_column(column, justify="left" if column == "place" else "right")
@@ -324,3 +327,20 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         )
     if len(evaluation.failures) > 10:
         console.print(f"… {len(evaluation.failures) - 10} more in failures.csv")
+
+
+def _show_bomb(console: Console, bomb: BombMetrics) -> None:
+    """The bomb table and the plant confusion (report.md has the defuse confusion too)."""
+    matrix = bomb.plant_confusion
+    planted = " · ".join(
+        f"{d} / {r}: {matrix.loc[d, r]}" for d in matrix.index for r in matrix.columns
+    )
+    caption = f"plants, data / replay: {planted}"
+    if bomb.anomalies:
+        caption += f"; {bomb.anomalies} rounds with anomalies in their bomb data (report.md)"
+    table = Table(title=f"the bomb ({bomb.n_rounds} rounds with bomb data)", caption=caption)
+    for column in BOMB_HEADER:
+        table.add_column(column, justify="right" if column in ("value", "rounds") else "left")
+    for row in bomb_rows(bomb):
+        table.add_row(*row)
+    console.print(table)

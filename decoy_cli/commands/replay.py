@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import typer
+from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
@@ -95,6 +97,7 @@ def replay(
     console.print(outcome)
     for warning in result.warnings:
         console.print(f"warning: implausible data replayed anyway: {warning}", style="yellow")
+    _show_bomb(console, result.bomb_row())
     for title, names in (
         ("clock protocol", METRIC_NAMES_CLOCK),
         ("paper protocol", METRIC_NAMES_PAPER),
@@ -126,3 +129,38 @@ def replay(
         )
     console.print(timing)
     console.print(f"replay written to {run.folder}")
+
+
+def _show_bomb(console: Console, bomb: dict[str, Any] | None) -> None:
+    """The bomb of the data against the replay's: plant, defuse and the data's anomalies."""
+    if bomb is None or not bomb["bomb_recorded"]:
+        console.print("bomb: off" if bomb is None else "bomb: not recorded in the data")
+        return
+    table = Table(title="the bomb")
+    for column in ("", "data", "replay", "error"):
+        table.add_column(column, justify="left" if not column else "right")
+    plant_error = "–"
+    if np.isfinite(bomb["plant_time_error_s"]):
+        plant_error = f"{bomb['plant_time_error_s']:+.2f} s"
+        if np.isfinite(bomb["plant_position_error_m"]):
+            plant_error += f", {bomb['plant_position_error_m']:.2f} m"
+    table.add_row(
+        "plant",
+        _yes(bomb["plant_data"], bomb["plant_site_data"]),
+        _yes(bomb["plant_replay"], bomb["plant_site_replay"]),
+        plant_error,
+    )
+    defuse_error = bomb["defuse_time_error_s"]
+    table.add_row(
+        "defuse",
+        _yes(bomb["defuse_data"], ""),
+        _yes(bomb["defuse_replay"], ""),
+        f"{defuse_error:+.2f} s" if np.isfinite(defuse_error) else "–",
+    )
+    console.print(table)
+    if bomb["bomb_anomalies"]:
+        console.print(f"bomb data anomalies: {bomb['bomb_anomalies']}", style="yellow")
+
+
+def _yes(happened: bool, site: str) -> str:
+    return f"yes ({site})" if happened and site else "yes" if happened else "no"

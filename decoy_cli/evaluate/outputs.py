@@ -9,7 +9,8 @@ Layout of the output folder:
 * `players.csv` (one row per player-round), `rounds.csv`, `failures.csv`;
 * `tables/`: `trajectory.csv`, `unevaluated.csv`, `combat.csv`, `death_counts.csv`,
   `outcome_winner_confusion.csv`, `outcome_reason_confusion.csv`, `hp_over_time.csv`,
-  `places.csv`;
+  `places.csv`, `bomb.csv`, `bomb_plant_confusion.csv`, `bomb_defuse_confusion.csv` (the bomb
+  tables have only their header when the bomb was off);
 * `summary.json`: what was run and every aggregate table;
 * `figures/`: see decoy_cli/evaluate/figures.py; `report.md` (decoy_cli/evaluate/report.py)
   shows them all;
@@ -140,6 +141,9 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
         "outcome_reason_confusion": _confusion(tables, "end_reason_confusion"),
         "hp_over_time": tables.hp_curve,
         "places": tables.places,
+        "bomb": tables.bomb.table() if tables.bomb else pd.DataFrame(columns=BOMB_TABLE_COLUMNS),
+        "bomb_plant_confusion": _bomb_confusion(tables, "plant_confusion"),
+        "bomb_defuse_confusion": _bomb_confusion(tables, "defuse_confusion"),
     }
     written += [_csv(folder / f"{name}.csv", frame) for name, frame in frames.items()]
     written.append(
@@ -163,6 +167,16 @@ def _confusion(tables: Tables, name: str) -> pd.DataFrame:
     matrix = getattr(tables.outcome, name, None) if tables.outcome is not None else None
     if matrix is None:
         return pd.DataFrame(columns=["original"])
+    return matrix.reset_index()
+
+
+BOMB_TABLE_COLUMNS = ("metric", "value", "rounds", "note")
+
+
+def _bomb_confusion(tables: Tables, name: str) -> pd.DataFrame:
+    if tables.bomb is None:
+        return pd.DataFrame(columns=["data"])
+    matrix: pd.DataFrame = getattr(tables.bomb, name)
     return matrix.reset_index()
 
 
@@ -209,6 +223,15 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
             "outcome_reason_confusion": None
             if outcome is None or outcome.end_reason_confusion is None
             else outcome.end_reason_confusion.to_dict(),
+            "bomb": None
+            if tables.bomb is None
+            else {
+                "rounds": tables.bomb.n_rounds,
+                "rounds_with_anomalies": tables.bomb.anomalies,
+                "metrics": _records(tables.bomb.table()),
+                "plant_confusion": tables.bomb.plant_confusion.to_dict(),
+                "defuse_confusion": tables.bomb.defuse_confusion.to_dict(),
+            },
             "failures_by_kind": dict(Counter(f.kind for f in evaluation.failures)),
         }
     )

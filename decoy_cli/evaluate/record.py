@@ -17,6 +17,7 @@ import numpy as np
 from decoy_cli.esta import Round
 from decoy_cli.evaluate.settings import HeatGrid
 from decoy_cli.metrics import METRIC_NAMES, player_metrics
+from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask
@@ -115,9 +116,11 @@ ROUND_COLUMNS = (
     "relocations",
     "warnings",
     "wall_seconds",
+    *BOMB_COLUMNS,
 )
 """Columns of a round row (rounds.csv); `warnings` holds the implausible data a round was
-replayed with under `--implausible warn`, joined by `WARNING_SEPARATOR` ("" when none)."""
+replayed with under `--implausible warn`, joined by `WARNING_SEPARATOR` ("" when none); the
+bomb columns (`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off."""
 
 WARNING_SEPARATOR = " | "
 
@@ -186,6 +189,7 @@ def build_record(
         "relocations": int(metrics["relocations"].sum()),
         "warnings": WARNING_SEPARATOR.join(result.warnings),
         "wall_seconds": round(seconds, 4),
+        **(result.bomb_row() or dict.fromkeys(BOMB_COLUMNS)),
     }
     replayed = rec.position.transpose(1, 0, 2)  # (P, F, 3) like the original
     points_o = original[alive_o]  # (M, 3), player-major

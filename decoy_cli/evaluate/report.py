@@ -13,15 +13,13 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
+from decoy_cli.evaluate.bomb_report import bomb_section
+from decoy_cli.evaluate.markdown import first_rows, md_table, num
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
-
-REPORT_ROWS_SHOWN = 20
-"""Rows of a failure or warning list shown in the report; the CSVs hold them all."""
 
 
 @dataclass(frozen=True)
@@ -89,20 +87,6 @@ def run_counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
         "failures": len(evaluation.failures),
         "rounds_with_warnings": tables.rounds_with_warnings,
     }
-
-
-def num(value: Any, digits: int = 3) -> str:
-    """A number with fixed digits; "–" for NaN or None."""
-    if value is None:
-        return "–"
-    value = float(value)
-    return "–" if math.isnan(value) else f"{value:.{digits}f}"
-
-
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def table_groups(tables: Tables) -> list[str]:
@@ -218,9 +202,10 @@ def report_markdown(
         ],
         ["player-rounds", str(counts["player_rounds"])],
     ]
-    parts.append("## What was run\n\n" + _table(["", ""], run_rows))
+    parts.append("## What was run\n\n" + md_table(["", ""], run_rows))
     parts.append(_trajectory_section(tables, settings))
     parts.append(_combat_section(tables, settings.combat))
+    parts.append(bomb_section(tables))
     parts.append(_figures_section(tables, figures))
     parts.append(_failures_section(evaluation))
     if counts["rounds_with_warnings"]:
@@ -244,7 +229,7 @@ def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
     for title, names in (("clock", METRIC_NAMES_CLOCK), ("paper", METRIC_NAMES_PAPER)):
         header, rows = trajectory_rows(tables, names)
         rows = [[f"`{row[0]}`", *row[1:]] for row in rows]
-        text.append(f"### Protocol {title}\n\n" + _table(header, rows))
+        text.append(f"### Protocol {title}\n\n" + md_table(header, rows))
     summary = tables.summary
     evaluated = ", ".join(
         f"{g}: {summary.n_evaluated[g]} of {summary.n_rows[g]}" for g in GROUPS if summary.n_rows[g]
@@ -252,7 +237,7 @@ def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
     text.append(f"Player-rounds evaluated: {evaluated or 'none'}.")
     if len(summary.unevaluated):
         rows = [[r.group, r.reason, str(r.count)] for r in summary.unevaluated.itertuples()]
-        text.append("Not evaluated:\n\n" + _table(["group", "reason", "player-rounds"], rows))
+        text.append("Not evaluated:\n\n" + md_table(["group", "reason", "player-rounds"], rows))
     return "\n\n".join(text)
 
 
@@ -278,7 +263,7 @@ def _combat_section(tables: Tables, combat: bool) -> str:
         [f"`{r.metric}`", num(r.value), str(r.n), num(r.paper), str(r.note)]
         for r in tables.combat.itertuples()
     ]
-    text.append(_table(["metric", "value", "n", "paper", "over / why not"], rows))
+    text.append(md_table(["metric", "value", "n", "paper", "over / why not"], rows))
     counts = tables.deaths.counts
     text.append(
         "Deaths: "
@@ -296,7 +281,7 @@ def _combat_section(tables: Tables, combat: bool) -> str:
                 continue
             header = ["original \\ replay", *map(str, matrix.columns)]
             rows = [[str(i), *map(str, matrix.loc[i])] for i in matrix.index]
-            text.append(f"Confusion of the {title} (rows: data):\n\n" + _table(header, rows))
+            text.append(f"Confusion of the {title} (rows: data):\n\n" + md_table(header, rows))
     return "\n\n".join(text)
 
 
@@ -326,7 +311,7 @@ def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
             "(the place of the nearest waypoint), largest error first, with the share of the "
             "player's samples that have no waypoint on their floor (where the replay cannot "
             "follow):",
-            _table(
+            md_table(
                 [
                     "place",
                     "original",
@@ -362,7 +347,7 @@ def _failures_section(evaluation: Evaluation) -> str:
         [Path(f.file).name, "" if f.round_num is None else str(f.round_num), f.kind, f.message]
         for f in failures
     ]
-    text.append(_first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))
+    text.append(first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))
     return "\n\n".join(text)
 
 
@@ -378,13 +363,5 @@ def _warnings_section(tables: Tables) -> str:
     rows = [
         [Path(str(row.file)).name, str(row.round), str(row.warnings)] for row in rounds.itertuples()
     ]
-    text.append(_first_rows(["file", "round", "warnings"], rows, "rounds.csv"))
+    text.append(first_rows(["file", "round", "warnings"], rows, "rounds.csv"))
     return "\n\n".join(text)
-
-
-def _first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:
-    """A table of the first `REPORT_ROWS_SHOWN` rows, and where the others are."""
-    text = _table(header, rows[:REPORT_ROWS_SHOWN])
-    if len(rows) > REPORT_ROWS_SHOWN:
-        text += f"\n\n… and {len(rows) - REPORT_ROWS_SHOWN} more in `{csv_name}`."
-    return text

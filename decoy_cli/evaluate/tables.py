@@ -10,6 +10,7 @@ finished which round first. `build_tables` then computes:
 * `combat`: `hp_corr`, `paper_hp_corr`, `hp_rmse` from the exact integer HP sums (the same
   values `decoy_cli.metrics.hp_metrics` gives on the pooled player-frames), `death_time_corr`,
   `death_time_mae_s` and `outcome_agreement`, `end_reason_agreement`, with the paper's values;
+* `bomb`: plant and defuse agreement, time, site and position errors (`metrics.bomb`);
 * the death confusion counts, the outcome confusion matrices, HP over time (mean ± std on the
   fixed time grid), and by nav place how much time the players and the replay spend there and
   how far the replay is from the player there.
@@ -29,9 +30,11 @@ from decoy_cli.metrics import (
     GROUPS,
     METRIC_NAMES,
     METRIC_NAMES_CLOCK,
+    BombMetrics,
     DeathTimeMetrics,
     MetricSummary,
     OutcomeMetrics,
+    bomb_metrics,
     death_time_metrics,
     outcome_metrics,
     pearson,
@@ -200,6 +203,8 @@ class Tables:
     rounds_with_winner: int
     rounds_with_warnings: int
     """Rounds replayed with implausible data (`--implausible warn`)."""
+    bomb: BombMetrics | None = None
+    """Bomb fidelity over the rounds whose data records the bomb; None with the bomb off."""
 
 
 def build_tables(acc: Accumulator) -> Tables:
@@ -243,6 +248,7 @@ def build_tables(acc: Accumulator) -> Tables:
         rounds_both_teams=both,
         rounds_with_winner=len(known),
         rounds_with_warnings=int((rounds["warnings"] != "").sum()) if len(rounds) else 0,
+        bomb=bomb_metrics(rounds) if acc.settings.bomb else None,
     )
 
 

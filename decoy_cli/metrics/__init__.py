@@ -3,11 +3,13 @@
 * `distances`: exact DTW (with the warping-path length) and discrete Fréchet kernels.
 * `trajectory`: the ten trajectory metrics of a player-round, protocols "clock" and "paper".
 * `combat`: HP, death-time and round-outcome metrics of full rounds.
+* `bomb`: plant and defuse agreement and their time, site and position errors over rounds.
 * `aggregate`: mean, std, median and p90 by side and overall, with unevaluated rows accounted for.
 * `players`: the per-player fidelity table of a replayed round (`player_metrics`).
 """
 
 from decoy_cli.metrics.aggregate import GROUPS, SIDES, MetricSummary, summarize
+from decoy_cli.metrics.bomb import BOMB_METRIC_NAMES, BombMetrics, bomb_metrics
 from decoy_cli.metrics.combat import (
     DEATH_COUNT_NAMES,
     DEATH_TIME_METRIC_NAMES,
@@ -37,6 +39,7 @@ from decoy_cli.metrics.trajectory import (
 )
 
 __all__ = [
+    "BOMB_METRIC_NAMES",
     "DEATH_COUNT_NAMES",
     "DEATH_TIME_METRIC_NAMES",
     "GROUPS",
@@ -49,6 +52,7 @@ __all__ = [
     "PLAYER_METRIC_COLUMNS",
     "SIDES",
     "TIE_RTOL",
+    "BombMetrics",
     "DeathTimeMetrics",
     "HpMetrics",
     "MetricSummary",
@@ -56,6 +60,7 @@ __all__ = [
     "PlayerRound",
     "ReplayTrace",
     "TrajectoryMetrics",
+    "bomb_metrics",
     "confusion_matrix",
     "death_time_metrics",
     "dtw",

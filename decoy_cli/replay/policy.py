@@ -15,13 +15,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
-from decoy_cli.replay.bomb import DataPlant
+from decoy_cli.replay.bomb import FOREVER, DataPlant
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.graph import STOP_ACTION
-
-_FOREVER = 10**9
 
 
 @dataclass
@@ -52,7 +50,7 @@ class PlanPolicy:
         tick_of: Callable[[float], int],
         graph_edge_length: np.ndarray,
         plant: DataPlant | None = None,
-        defuse_from_tick: dict[int, int] | None = None,
+        defuse_window: dict[int, tuple[int, int]] | None = None,
         interval_caps: list[np.ndarray] | None = None,
     ) -> None:
         self.plans = plans
@@ -60,7 +58,7 @@ class PlanPolicy:
         self.tick_of = tick_of  # seconds -> simulator tick
         self.next_action = np.zeros(len(plans), dtype=np.int64)
         self.plant = plant
-        self.defuse_from_tick = defuse_from_tick or {}
+        self.defuse_window = defuse_window or {}  # agent -> ticks it wants to defuse
         self.logs = []
         # per plan and action: path length of this and the later moves of its interval, and
         # whether it is the last move of its interval
@@ -97,21 +95,27 @@ class PlanPolicy:
         plan = self.plans[agent]
         now = sim.tick
         plant = self.plant is not None and now >= self.plant.start_tick
-        defuse = agent in self.defuse_from_tick and now >= self.defuse_from_tick[agent]
-        if plant and sim.bomb.planter == agent:
+        first, last = self.defuse_window.get(agent, (FOREVER, FOREVER))
+        defuse = first <= now <= last
+        bomb, config = sim.bomb, sim.rules.config
+        if plant and bomb.planter == agent:
             # planting, as the real player did: hold still until the plant completes, then
             # the plan resumes and catches up
-            left = sim.rules.config.plant_ticks - sim.bomb.plant_ticks
+            left = config.plant_ticks - bomb.plant_ticks
             return Decision(STOP_ACTION, hold_ticks=max(1, left), plant=True)
+        if defuse and bomb.defuser == agent:  # likewise while defusing
+            kit = bool(sim.agents.has_defuser[agent])
+            left = (config.defuse_kit_ticks if kit else config.defuse_ticks) - bomb.defuse_ticks
+            return Decision(STOP_ACTION, hold_ticks=max(1, min(left, last - now + 1)), defuse=True)
         decision = self._follow_plan(sim, agent, plan, now, plant, defuse)
-        wake = None if self.plant is None else self.plant.start_tick
-        if (
-            decision.action == STOP_ACTION
-            and wake is not None
-            and now < wake < now + decision.hold_ticks
-        ):
-            # wake at the data's plant start, so the wish to plant starts on time
-            decision = replace(decision, hold_ticks=wake - now)
+        if decision.action == STOP_ACTION:
+            # wake when the data's plant or this agent's defuse starts or ends, so the wish to
+            # plant or defuse follows the data's times
+            wakes = [t for t in (first, last + 1) if now < t < now + decision.hold_ticks]
+            if self.plant is not None and now < self.plant.start_tick < now + decision.hold_ticks:
+                wakes.append(self.plant.start_tick)
+            if wakes:
+                decision = replace(decision, hold_ticks=min(wakes) - now)
         return decision
 
     def _plants_here(self, sim: Simulator, agent: int, interval: int) -> bool:
@@ -144,6 +148,9 @@ class PlanPolicy:
             act = int(plan.action[a])
             interval = int(plan.action_interval[a])
             deadline = self.tick_of(plan.action_deadline_s[a])
+            data = self.plant
+            if data is not None and agent == data.agent and interval == data.arrive_by - 1:
+                deadline = min(deadline, data.start_tick)  # at the plant spot by its start
             if act == RELOCATE_ACTION and now < deadline:
                 return Decision(STOP_ACTION, hold_ticks=deadline - now, plant=plant)
             a += 1
@@ -167,7 +174,7 @@ class PlanPolicy:
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
-        return Decision(STOP_ACTION, hold_ticks=_FOREVER, plant=plant, defuse=defuse)
+        return Decision(STOP_ACTION, hold_ticks=FOREVER, plant=plant, defuse=defuse)
 
     def _arrive(self, agent: int, interval: int, now: int) -> None:
         """Log the arrival at the target that ends `interval` (first arrival only)."""

@@ -25,11 +25,14 @@ from decoy_cli.esta import Round
 from decoy_cli.esta.plausibility import Implausible, first_offender
 from decoy_cli.metrics.players import ReplayTrace
 from decoy_cli.replay.bomb import (
+    DataBomb,
     carrier_sites,
-    data_carriers,
-    data_defuse_starts,
-    data_plant,
+    defuse_windows,
+    follow_data_bomb,
+    policy_plant,
+    read_data_bomb,
 )
+from decoy_cli.replay.bomb_fidelity import bomb_fidelity
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -58,6 +61,11 @@ class ReplayResult:
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
     played_out_s: float = 0.0  # game seconds simulated after the data's last frame (play_out)
     warnings: tuple[str, ...] = ()  # implausible data replayed anyway (ReplayOptions.implausible)
+    bomb: DataBomb | None = None  # the data's bomb, when the replay followed it
+
+    def bomb_row(self) -> dict[str, object] | None:
+        """The bomb fidelity of this replay (`BOMB_COLUMNS`), None when the bomb was off."""
+        return None if self.bomb is None else bomb_fidelity(self.bomb, self.events)
 
     def trace(self) -> ReplayTrace:
         """What the fidelity metrics need from this replay (`decoy_cli.metrics.player_metrics`)."""
@@ -129,13 +137,14 @@ class ReplayOptions:
 
     def setup(self, graph: WaypointGraph, round_: Round) -> RoundSetup:
         """The simulator setup of a replay of `round_` on `graph`."""
-        rules = RulesConfig()
+        rules = RulesConfig(auto_pickup=False)  # the data says who picks the bomb up
         if not self.bomb and len(round_.frame_seconds):
             # Without the bomb, a round whose data ran past the round time (after a plant,
             # which stops the clock) would time out while the players still move: replay it
             # to the end of its data.
             rules = RulesConfig(
-                round_time_s=max(rules.round_time_s, float(round_.frame_seconds[-1]) + 1.0)
+                round_time_s=max(rules.round_time_s, float(round_.frame_seconds[-1]) + 1.0),
+                auto_pickup=False,
             )
         return RoundSetup(
             graph=graph,
@@ -169,13 +178,13 @@ def replay_round(
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
             return replay_round(round_, graph, options, physics=own, open_sim=open_sim)
-    carriers = data_carriers(round_) if options.bomb else np.full(len(frame_ticks), -1)
     zones = setup.site_zones()
+    bomb = read_data_bomb(round_, zones, setup.rules_config().plant_s) if options.bomb else None
     plan = snap_round(
         round_,
         graph,
         physics=physics,
-        sites=carrier_sites(round_, carriers, zones) if options.bomb else None,
+        sites=carrier_sites(round_, bomb.carriers, zones) if bomb is not None else None,
         node_site=zones.site_of(graph.positions),
     )
     players = plan.players
@@ -206,17 +215,19 @@ def replay_round(
     agents.hp[never] = 0
 
     rules_config = setup.rules_config()
-    carrier = int(carriers[0])  # the data's carrier at the first frame, if the replay has him
+    carrier = int(bomb.carriers[0]) if bomb is not None else -1  # the data's, if alive here
     if carrier >= 0 and not agents.alive[carrier]:
         carrier = -1
-    plant = data_plant(round_, plan.plans, carriers, rules_config.plant_s) if options.bomb else None
-    defuse_from = data_defuse_starts(round_, players)
+    plant = policy_plant(bomb, plan.plans, round_) if bomb is not None else None
+    defuse = defuse_windows(bomb, players) if bomb is not None else {}
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
-    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant, defuse_from, caps)
+    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant, defuse, caps)
     start_tick = int(frame_ticks[0])
     scripted = np.zeros(n, dtype=bool)
     weapon_frames = np.asarray(round_.weapon)
+    kit_frames = np.asarray(round_.has_defuser, dtype=bool)
+    present = np.asarray(round_.present, dtype=bool)
     frame_of_tick = {int(t): f for f, t in enumerate(frame_ticks)}
     end_tick = int(frame_ticks[-1])
     with open_sim(
@@ -246,11 +257,13 @@ def replay_round(
                     scripted[i] = True
             sim.step(after_end=True)
             f = frame_of_tick.get(sim.tick)
-            if f is not None and carriers[f] >= 0 and sim.bomb.carrier != carriers[f]:
-                sim.hand_bomb(int(carriers[f]))  # the bomb changes hands as in the data
-            if f is not None:  # follow the weapon in hand, as the data shows it
+            if f is not None and bomb is not None:
+                follow_data_bomb(sim, bomb, f, round_)
+            if f is not None:  # follow the weapon in hand and the kit, as the data shows them
                 for alive in np.nonzero(agents.alive)[0]:
                     i = int(alive)
+                    if present[i, f]:
+                        agents.has_defuser[i] = kit_frames[i, f]
                     if weapon_frames[i, f]:
                         agents.weapon[i] = weapon_frames[i, f]
                         sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
@@ -276,6 +289,7 @@ def replay_round(
         recoveries=recoveries,
         played_out_s=(sim.tick - played_from) / TICK_RATE,
         warnings=warnings,
+        bomb=bomb,
     )
 
 

@@ -99,7 +99,8 @@ def replay_summary(
     players: pd.DataFrame,
     seconds: float,
 ) -> dict[str, Any]:
-    """The contents of `summary.json`: the round, the options, both outcomes, counts."""
+    """The contents of `summary.json`: the round, the options, both outcomes, counts, and the
+    bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off)."""
     outcome = result.outcome
     return {
         "round": address,
@@ -125,4 +126,5 @@ def replay_summary(
         "recoveries": int(players["recoveries"].sum()),
         "relocations": int(players["relocations"].sum()),
         "warnings": list(result.warnings),
+        "bomb": result.bomb_row(),
     }

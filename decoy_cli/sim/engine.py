@@ -220,6 +220,12 @@ class Simulator:
         if self.outcome is None:
             self.events += self.rules.hand_over(self.tick, self.agents, self.bomb, agent)
 
+    def drop_bomb(self, position: np.ndarray) -> None:
+        """The carrier lets the bomb go at `position` (a replay following the data's drop); see
+        `BombRules.drop`. Nothing happens after the round's end."""
+        if self.outcome is None:
+            self.events += self.rules.drop(self.tick, self.agents, self.bomb, position)
+
     def kill(self, agent: int, reason: str) -> None:
         """Kill an agent from outside the combat step (a scripted death in a replay)."""
         if self.agents.alive[agent]:

@@ -5,7 +5,8 @@ Durations are whole tick counts (`RulesConfig`), so every rule fires on an exact
 * plant: the carrier, alive, inside a bomb-site zone and not moving, wants to plant at tick t0
   ("plant_begin"); the plant completes at t0 + plant_ticks (3.0 s = 180 ticks at 60 Hz) if at
   every tick in between it is still alive, still, in the zone and still wants to; otherwise
-  "plant_abort" (data "reason": died, stopped, moved or left_zone);
+  "plant_abort" (data "reason": died, stopped, moved or left_zone; in a replay also
+  handed_over or dropped, when the data moves the bomb);
 * detonation: at planted_tick + bomb_ticks (40 s = 2400 ticks), checked before any defuse
   progress of that tick, so a defuse must end strictly before the detonation tick;
 * defuse: an alive CT that wants to, stands still and is within 1.5 m horizontally and 1.0 m
@@ -15,7 +16,8 @@ Durations are whole tick counts (`RulesConfig`), so every rule fires on an exact
   leaving the range or no longer wanting to ("defuse_aborted");
 * a carrier that dies drops the bomb where it stood ("bomb_drop"); the first (lowest index)
   alive T within 0.8 m horizontally and 1.0 m vertically picks it up ("bomb_pickup"), from the
-  next tick on.
+  next tick on (unless `auto_pickup` is off: a replay lets the data say who picks it up, and
+  drops it where the data does, `BombRules.drop`).
 
 Round end (`BombRules.outcome`), checked in this order:
 
@@ -92,6 +94,7 @@ class RulesConfig:
     defuse_vertical_m: float = 1.0
     pickup_range_m: float = 0.8  # horizontal
     pickup_vertical_m: float = 1.0
+    auto_pickup: bool = True
     bomb_enabled: bool = True
     round_ticks: int = field(init=False)
     plant_ticks: int = field(init=False)
@@ -175,6 +178,25 @@ class BombRules:
         )
         return events
 
+    def drop(self, tick: int, agents: Agents, bomb: Bomb, position: np.ndarray) -> list[SimEvent]:
+        """The carrier lets the bomb go and it lies at `position` (a replay following the data's
+        drop or throw); a plant in progress stops. Nothing happens unless the bomb is carried."""
+        if not self.config.bomb_enabled or bomb.status != BombStatus.CARRIED or bomb.carrier < 0:
+            return []
+        events = []
+        if bomb.planter >= 0:
+            events.append(self._abort_plant(tick, bomb, "dropped"))
+        carrier = bomb.carrier
+        bomb.status = BombStatus.DROPPED
+        bomb.carrier = -1
+        bomb.position = np.asarray(position, dtype=np.float64).copy()
+        events.append(
+            SimEvent(
+                tick, "bomb_drop", carrier, data={"position": bomb.position.tolist(), "data": True}
+            )
+        )
+        return events
+
     # ---- one tick -----------------------------------------------------------------------------
 
     def step(
@@ -196,7 +218,7 @@ class BombRules:
             else:
                 bomb.position = agents.position[bomb.carrier].copy()
                 events += self._plant(tick, agents, bomb, wants_plant, moving)
-        elif bomb.status == BombStatus.DROPPED:
+        elif bomb.status == BombStatus.DROPPED and self.config.auto_pickup:
             events += self._pickup(tick, agents, bomb)
         elif bomb.status == BombStatus.PLANTED:
             if tick >= bomb.planted_tick + self.config.bomb_ticks:
@@ -281,7 +303,8 @@ class BombRules:
             bomb.planter = -1
             bomb.site = site
             bomb.planted_tick = tick
-            return [SimEvent(tick, "plant", carrier, data={"site": site})]
+            where = bomb.position.tolist()
+            return [SimEvent(tick, "plant", carrier, data={"site": site, "position": where})]
         if wants_plant[carrier] and not moving[carrier] and site:
             bomb.planter = carrier
             bomb.plant_ticks = 0

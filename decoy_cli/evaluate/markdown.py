@@ -1,0 +1,31 @@
+"""Markdown pieces shared by the evaluation's report sections: numbers, tables, long lists."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+REPORT_ROWS_SHOWN = 20
+"""Rows of a failure, warning or anomaly list shown in the report; the CSVs hold them all."""
+
+
+def num(value: Any, digits: int = 3) -> str:
+    """A number with fixed digits; "–" for NaN or None."""
+    if value is None:
+        return "–"
+    value = float(value)
+    return "–" if math.isnan(value) else f"{value:.{digits}f}"
+
+
+def md_table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:
+    """A table of the first `REPORT_ROWS_SHOWN` rows, and where the others are."""
+    text = md_table(header, rows[:REPORT_ROWS_SHOWN])
+    if len(rows) > REPORT_ROWS_SHOWN:
+        text += f"\n\n… and {len(rows) - REPORT_ROWS_SHOWN} more in `{csv_name}`."
+    return text
