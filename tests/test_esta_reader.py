@@ -640,3 +640,24 @@ def test_real_folder_info() -> None:
     assert result.exit_code == 0, result.output
     assert result.stdout.count("de_dust2") == 15
     assert "00e7fec9-cee0-430f-80f4-6b50443ceacd.json.xz" in result.stdout
+
+
+def test_the_round_clock_is_the_games_whatever_rate_the_file_wrote_seconds_at(
+    tmp_path: Path,
+) -> None:
+    """Some awpy 1.x exports wrote `seconds` at 127 per second on 128-tick demos: the reader
+    keeps the game's clock (ticks at tickRate), placing only its zero by the file's seconds;
+    events get the same clock."""
+    document = make_match()
+    round2 = document["gameRounds"][1]
+    round2["freezeTimeEndTick"] = None
+    for frame in round2["frames"]:
+        frame["seconds"] = (frame["tick"] - ROUND2_FREEZE_END) / 127
+    for event in round2["bombEvents"]:
+        event["seconds"] = (event["tick"] - ROUND2_FREEZE_END) / 127
+    played = read_match(write_match(tmp_path / "slow.json", document)).round(2)
+    ticks = np.asarray(played.frame_ticks, dtype=float)
+    assert np.allclose(played.frame_seconds, (ticks - ROUND2_FREEZE_END) / 128)
+    assert played.clock is not None and played.clock.zero_tick == pytest.approx(ROUND2_FREEZE_END)
+    events = played.bomb_events
+    assert np.allclose(events["seconds"], (events["tick"].astype(float) - ROUND2_FREEZE_END) / 128)

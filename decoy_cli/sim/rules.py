@@ -88,13 +88,19 @@ class RulesConfig:
     """CS:GO's C4 arm time; the 9 real plants with a `plant_begin` in
     ../shared/data/esta_dust2_events take 3.04 to 3.06 s from `plant_begin` to `plant`."""
     bomb_timer_s: float = 40.0
+    """CS:GO's C4 timer (mp_c4timer, 40 s in competitive play)."""
     defuse_s: float = 10.0
+    """CS:GO's defuse time without a kit."""
     defuse_kit_s: float = 5.0
+    """CS:GO's defuse time with a kit; the one real defuse in ../shared/data/esta_dust2_events
+    took 5.02 s from `defuse_start` to `defuse`."""
     defuse_range_m: float = 1.5  # horizontal; CS:GO's use range is about 62 u (1.2 m)
     defuse_vertical_m: float = 1.0
     pickup_range_m: float = 0.8  # horizontal
     pickup_vertical_m: float = 1.0
     auto_pickup: bool = True
+    """A T walking over a dropped bomb picks it up (CS:GO); a replay turns it off and lets the
+    data say who picks it up."""
     bomb_enabled: bool = True
     round_ticks: int = field(init=False)
     plant_ticks: int = field(init=False)
