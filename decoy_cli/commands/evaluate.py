@@ -35,6 +35,7 @@ from decoy_cli.evaluate.report import (
     combat_caveats,
     command_line,
     data_kind,
+    interval,
     mechanics,
     table_groups,
 )
@@ -265,8 +266,14 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
     groups = table_groups(tables)
     stats = tables.trajectory.set_index(["metric", "group"])
     for title, names in (
-        ("protocol clock (m): mean ± std, then median · p90", METRIC_NAMES_CLOCK),
-        ("protocol paper (m): mean ± std, then (the paper's Table 2)", METRIC_NAMES_PAPER),
+        (
+            "protocol clock (m): mean ± std, [95% interval of the mean, by round], median · p90",
+            METRIC_NAMES_CLOCK,
+        ),
+        (
+            "protocol paper (m): mean ± std, [95% interval of the mean], (the paper's Table 2)",
+            METRIC_NAMES_PAPER,
+        ),
     ):
         console.print(title, style="italic", highlight=False)
         table = Table()
@@ -281,8 +288,10 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
                     detail = f"({num(row['paper_mean'])} ± {num(row['paper_std'])})"
                 else:
                     detail = f"{num(row['median'])} · {num(row['p90'])}"
+                mean = f"{num(row['mean'])} ± {num(row['std'])}"
+                ci = interval(row["mean_low"], row["mean_high"])
                 cells.append(
-                    Text.assemble(f"{num(row['mean'])} ± {num(row['std'])}\n", (detail, "dim"))
+                    Text.assemble(f"{mean}\n", (f"{ci}\n" if ci else "", "dim"), (detail, "dim"))
                 )
             table.add_row(name, *cells)
         console.print(table)

@@ -20,6 +20,7 @@ from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
+from decoy_cli.metrics.bootstrap import MIN_ROUNDS, RESAMPLES
 
 
 @dataclass(frozen=True)
@@ -89,6 +90,11 @@ def run_counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
     }
 
 
+def interval(low: float, high: float) -> str:
+    """A 95% interval as "[low, high]"; "" when there is none (too few rounds)."""
+    return "" if math.isnan(low) else f"[{num(low)}, {num(high)}]"
+
+
 def table_groups(tables: Tables) -> list[str]:
     """The groups a trajectory table shows: each side in the data, and all when both are."""
     sides = [g for g in SIDES if tables.summary.n_evaluated[g]]
@@ -110,7 +116,11 @@ def trajectory_rows(tables: Tables, names: tuple[str, ...]) -> tuple[list[str], 
         row = [name]
         for group in groups:
             s = stats.loc[(name, group)]
-            row += [f"{num(s['mean'])} ± {num(s['std'])}", num(s["median"]), num(s["p90"])]
+            row += [
+                f"{num(s['mean'])} ± {num(s['std'])} {interval(s['mean_low'], s['mean_high'])}",
+                f"{num(s['median'])} {interval(s['median_low'], s['median_high'])}",
+                num(s["p90"]),
+            ]
         for group in paper_groups:
             s = stats.loc[(name, group)]
             row.append(
@@ -235,6 +245,11 @@ def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
         f"{g}: {summary.n_evaluated[g]} of {summary.n_rows[g]}" for g in GROUPS if summary.n_rows[g]
     )
     text.append(f"Player-rounds evaluated: {evaluated or 'none'}.")
+    text.append(
+        f"In brackets: 95% bootstrap intervals of the mean and the median that resample whole "
+        f"rounds ({RESAMPLES} resamples, seed {settings.seed}; none over fewer than "
+        f"{MIN_ROUNDS} rounds)."
+    )
     if len(summary.unevaluated):
         rows = [[r.group, r.reason, str(r.count)] for r in summary.unevaluated.itertuples()]
         text.append("Not evaluated:\n\n" + md_table(["group", "reason", "player-rounds"], rows))

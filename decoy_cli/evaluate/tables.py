@@ -5,8 +5,9 @@ end, heat, place and HP data are integer sums, so the tables are identical which
 finished which round first. `build_tables` then computes:
 
 * `trajectory`: the ten trajectory metrics (both protocols, docs/metrics.md) by side and
-  overall (mean, std, median, p90), with the paper's Table 2 mean and std beside the paper
-  protocol's metrics;
+  overall (mean, std, median, p90, and 95% bootstrap intervals of the mean and median that
+  resample whole rounds), with the paper's Table 2 mean and std beside the paper protocol's
+  metrics;
 * `combat`: `hp_corr`, `paper_hp_corr`, `hp_rmse` from the exact integer HP sums (the same
   values `decoy_cli.metrics.hp_metrics` gives on the pooled player-frames), `death_time_corr`,
   `death_time_mae_s` and `outcome_agreement`, `end_reason_agreement`, with the paper's values;
@@ -40,6 +41,7 @@ from decoy_cli.metrics import (
     pearson,
     summarize,
 )
+from decoy_cli.metrics.bootstrap import RoundBootstrap
 
 PAPER_TABLE2: dict[str, dict[str, tuple[float, float]]] = {
     "T": {
@@ -188,7 +190,8 @@ class Tables:
     rounds: pd.DataFrame
     summary: MetricSummary
     trajectory: pd.DataFrame
-    """protocol, metric, group, n, mean, std, median, p90, paper_mean, paper_std."""
+    """protocol, metric, group, n, mean, std, median, p90, paper_mean, paper_std, and the 95%
+    bootstrap intervals by round of the mean and median (`INTERVAL_COLUMNS`)."""
     combat: pd.DataFrame
     """metric, value, n, paper, note."""
     deaths: DeathTimeMetrics
@@ -212,7 +215,7 @@ def build_tables(acc: Accumulator) -> Tables:
     players = acc.players()
     rounds = acc.round_rows()
     summary = summarize(players[["side", *METRIC_NAMES, "reason"]])
-    trajectory = _trajectory_table(summary)
+    trajectory = with_intervals(trajectory_table(summary), players, acc.settings.seed)
     deaths = death_time_metrics(
         players["death_time_original_s"].to_numpy(np.float64),
         players["death_time_replay_s"].to_numpy(np.float64),
@@ -252,7 +255,7 @@ def build_tables(acc: Accumulator) -> Tables:
     )
 
 
-def _trajectory_table(summary: MetricSummary) -> pd.DataFrame:
+def trajectory_table(summary: MetricSummary) -> pd.DataFrame:
     """The summary's statistics with the protocol and the paper's Table 2 beside them."""
     table = summary.table.copy()
     protocol = ["clock" if m in METRIC_NAMES_CLOCK else "paper" for m in table["metric"]]
@@ -265,6 +268,29 @@ def _trajectory_table(summary: MetricSummary) -> pd.DataFrame:
     table["paper_std"] = [std for _, std in paper]
     order = table["metric"].map(METRIC_NAMES.index) * len(GROUPS) + table["group"].map(GROUPS.index)
     return table.iloc[np.argsort(order.to_numpy(), kind="stable")].reset_index(drop=True)
+
+
+INTERVAL_COLUMNS = ("mean_low", "mean_high", "median_low", "median_high", "interval_note")
+"""Columns the 95% bootstrap intervals (by round, `decoy_cli.metrics.bootstrap`) add to the
+trajectory table."""
+
+
+def with_intervals(table: pd.DataFrame, players: pd.DataFrame, seed: int) -> pd.DataFrame:
+    """The trajectory table with the intervals of each row's mean and median, resampling the
+    rounds of the evaluated player-rounds (`seed`: the run's, so a rerun gives the same)."""
+    codes, rounds = pd.factorize(players["match"].astype(str) + "\0" + players["round"].astype(str))
+    boot = RoundBootstrap(len(rounds), seed=seed)
+    evaluated = players["reason"].isna().to_numpy()
+    sides = players["side"].to_numpy()
+    rows = []
+    for group, metric in zip(table["group"], table["metric"], strict=True):
+        chosen = evaluated & ((sides == group) if group != "all" else True)
+        values = players[metric].to_numpy(np.float64)[chosen]
+        mean = boot.interval(values, codes[chosen], "mean")
+        median = boot.interval(values, codes[chosen], "median")
+        rows.append((mean.low, mean.high, median.low, median.high, mean.note or median.note))
+    intervals = pd.DataFrame(rows, columns=list(INTERVAL_COLUMNS), index=table.index)
+    return pd.concat([table, intervals], axis=1)
 
 
 def hp_metrics_from_sums(
