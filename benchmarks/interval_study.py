@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from decoy_cli.evaluate.tables import trajectory_table, with_intervals
+from decoy_cli.evaluate.intervals import trajectory_intervals
+from decoy_cli.evaluate.tables import trajectory_table
 from decoy_cli.metrics import METRIC_NAMES, summarize
 
 
@@ -32,7 +33,7 @@ def main() -> None:
     runs = {}
     for seed in (0, 1):
         started = time.perf_counter()
-        runs[seed] = with_intervals(table, players, seed)
+        runs[seed] = trajectory_intervals(table, players, seed)
         seconds = time.perf_counter() - started
     mean_dist = [r[r["metric"] == "mean_dist"].set_index("group") for r in runs.values()]
     for group in mean_dist[0].index:

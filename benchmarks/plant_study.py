@@ -45,8 +45,8 @@ def main() -> None:
         f"{len(rounds)} rounds ({len(evaluation.failures)} failures), {bomb.n_rounds} with bomb "
         f"data; mover {args.mover}, combat off, bomb on"
     )
-    for metric, value, count, note in bomb_rows(bomb):
-        print(f"  {metric:<32}{value:>8}  over {count} rounds {note}")
+    for metric, value, interval, count, note in bomb_rows(bomb):
+        print(f"  {metric:<32}{value:>8} {interval:<18} over {count} rounds {note}")
     print("plants, data (rows) against replay (columns):")
     print(bomb.plant_confusion.to_string())
     disagree = rounds[rounds["plant_data"].astype(bool) != rounds["plant_replay"].astype(bool)]

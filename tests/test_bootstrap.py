@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from decoy_cli.metrics.bootstrap import MIN_ROUNDS, RoundBootstrap
@@ -55,3 +56,65 @@ def test_too_few_rounds_give_no_interval() -> None:
     assert "fewer than" in interval.note
     with pytest.raises(ValueError, match="mean' or 'median"):
         RoundBootstrap(40).interval(*rows(), "p90")
+
+
+def test_statistics_from_per_round_sums() -> None:
+    """A correlation bootstrapped from per-round moments: each resample's value is the Pearson
+    correlation of the drawn rounds' pairs."""
+    from decoy_cli.metrics.bootstrap import pearson_from_sums
+
+    rng = np.random.default_rng(5)
+    index = np.repeat(np.arange(20), 3)
+    x = rng.normal(size=60)
+    y = x + rng.normal(size=60)
+    sums = np.zeros((20, 6))
+    for k, column in enumerate((np.ones(60), x, y, x * x, y * y, x * y)):
+        np.add.at(sums[:, k], index, column)
+    assert pearson_from_sums(sums.sum(axis=0, keepdims=True))[0] == pytest.approx(
+        np.corrcoef(x, y)[0, 1]
+    )
+    boot = RoundBootstrap(20, resamples=30, seed=2)
+    draws = pearson_from_sums(boot.weights @ sums)
+    for b in range(30):
+        keep = np.repeat(np.arange(20), boot.weights[b])
+        rows = np.concatenate([np.flatnonzero(index == r) for r in keep])
+        assert draws[b] == pytest.approx(np.corrcoef(x[rows], y[rows])[0, 1])
+    interval = boot.sums_interval(sums, pearson_from_sums)
+    assert interval.low <= np.corrcoef(x, y)[0, 1] <= interval.high
+
+
+def test_the_combat_table_gets_intervals_by_round() -> None:
+    from decoy_cli.evaluate.intervals import combat_intervals
+
+    rounds = pd.DataFrame(
+        {
+            "match": ["m"] * 12,
+            "round": range(1, 13),
+            "winner_original": ["T", "CT"] * 6,
+            "winner_replay": ["T", "CT", "CT", "CT"] * 3,
+            "reason_original": [None] * 12,
+            "reason_replay": [None] * 12,
+            "played_out_s": [0.0] * 12,
+        }
+    )
+    players = pd.DataFrame(
+        {
+            "match": ["m"] * 12,
+            "round": range(1, 13),
+            "death_time_original_s": np.linspace(10, 60, 12),
+            "death_time_replay_s": np.linspace(12, 70, 12),
+        }
+    )
+    hp = np.tile([10, 800, 790, 70000, 69000, 69500, 40], (12, 1)).astype(float)
+    combat = pd.DataFrame(
+        {
+            "metric": ["outcome_agreement", "death_time_mae_s", "hp_rmse", "paper_hp_corr"],
+            "value": [0.75, 6.0, 2.0, 0.9],
+        }
+    )
+    table = combat_intervals(combat, players, rounds, hp, seed=0).set_index("metric")
+    low, high = table.loc["outcome_agreement", ["low", "high"]]
+    assert low < 0.75 < high
+    assert table.loc["hp_rmse", "low"] == pytest.approx(2.0)  # every round alike
+    assert np.isnan(table.loc["paper_hp_corr", "low"])
+    assert "mean curves" in table.loc["paper_hp_corr", "interval_note"]

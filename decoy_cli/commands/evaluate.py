@@ -28,14 +28,13 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
-from decoy_cli.evaluate.markdown import num
+from decoy_cli.evaluate.markdown import interval, num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
 from decoy_cli.evaluate.report import (
     RunInfo,
     combat_caveats,
     command_line,
     data_kind,
-    interval,
     mechanics,
     table_groups,
 )
@@ -299,10 +298,17 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         console.print(f"  {row.group}: {row.count} not evaluated ({row.reason})", highlight=False)
     caveats = combat_caveats(tables, evaluation.settings.combat)
     combat = Table(title="HP, deaths and outcomes", caption=" ".join(caveats) or None)
-    for column in ("metric", "value", "n", "paper", "over / why not"):
+    for column in ("metric", "value", "95% interval", "n", "paper", "over / why not"):
         combat.add_column(column, justify="right" if column in ("value", "n", "paper") else "left")
     for row in tables.combat.itertuples():
-        combat.add_row(row.metric, num(row.value), str(row.n), num(row.paper), str(row.note))
+        combat.add_row(
+            row.metric,
+            num(row.value),
+            interval(row.low, row.high),
+            str(row.n),
+            num(row.paper),
+            str(row.note),
+        )
     console.print(combat)
     if tables.outcome is not None:
         matrix = tables.outcome.winner_confusion

@@ -8,7 +8,7 @@ from decoy_cli.evaluate.markdown import first_rows, md_table, num
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import BombMetrics
 
-BOMB_HEADER = ["metric", "value", "rounds", "over / why not"]
+BOMB_HEADER = ["metric", "value", "95% interval", "rounds", "over / why not"]
 
 
 def bomb_rows(bomb: BombMetrics) -> list[list[str]]:

@@ -29,3 +29,8 @@ def first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:
     if len(rows) > REPORT_ROWS_SHOWN:
         text += f"\n\n… and {len(rows) - REPORT_ROWS_SHOWN} more in `{csv_name}`."
     return text
+
+
+def interval(low: float, high: float) -> str:
+    """A 95% interval as "[low, high]"; "" when there is none (too few rounds)."""
+    return "" if math.isnan(low) else f"[{num(low)}, {num(high)}]"

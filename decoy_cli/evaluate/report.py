@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from decoy_cli.evaluate.bomb_report import bomb_section
-from decoy_cli.evaluate.markdown import first_rows, md_table, num
+from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
@@ -88,11 +88,6 @@ def run_counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
         "failures": len(evaluation.failures),
         "rounds_with_warnings": tables.rounds_with_warnings,
     }
-
-
-def interval(low: float, high: float) -> str:
-    """A 95% interval as "[low, high]"; "" when there is none (too few rounds)."""
-    return "" if math.isnan(low) else f"[{num(low)}, {num(high)}]"
 
 
 def table_groups(tables: Tables) -> list[str]:
@@ -275,10 +270,18 @@ def combat_caveats(tables: Tables, combat: bool) -> list[str]:
 def _combat_section(tables: Tables, combat: bool) -> str:
     text = ["## HP, deaths and outcomes", *combat_caveats(tables, combat)]
     rows = [
-        [f"`{r.metric}`", num(r.value), str(r.n), num(r.paper), str(r.note)]
+        [
+            f"`{r.metric}`",
+            num(r.value),
+            interval(r.low, r.high),
+            str(r.n),
+            num(r.paper),
+            str(r.note) + (f"; {r.interval_note}" if r.interval_note else ""),
+        ]
         for r in tables.combat.itertuples()
     ]
-    text.append(md_table(["metric", "value", "n", "paper", "over / why not"], rows))
+    header = ["metric", "value", "95% interval", "n", "paper", "over / why not"]
+    text.append(md_table(header, rows))
     counts = tables.deaths.counts
     text.append(
         "Deaths: "

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from decoy_cli.evaluate.intervals import combat_intervals, trajectory_intervals
 from decoy_cli.evaluate.record import PLAYER_COLUMNS, ROUND_COLUMNS, RoundRecord, read_grid_sums
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.metrics import (
@@ -41,7 +42,6 @@ from decoy_cli.metrics import (
     pearson,
     summarize,
 )
-from decoy_cli.metrics.bootstrap import RoundBootstrap
 
 PAPER_TABLE2: dict[str, dict[str, tuple[float, float]]] = {
     "T": {
@@ -98,6 +98,7 @@ class Accumulator:
     place_names: list[str]
     """Labels of the per-place counts (decoy_cli.evaluate.job.place_names)."""
     _rows: dict[tuple[str, int, str], tuple[dict, list[dict]]] = field(default_factory=dict)
+    _hp_rounds: dict[tuple[str, int, str], list[int]] = field(default_factory=dict)
     heat_original: np.ndarray = field(init=False)
     heat_replay: np.ndarray = field(init=False)
     heat_off_graph: np.ndarray = field(init=False)
@@ -133,6 +134,7 @@ class Accumulator:
         if key in self._rows:
             raise ValueError(f"round {record.round_num} of {record.match_id} added twice")
         self._rows[key] = ({**record.round, "file": file}, record.players)
+        self._hp_rounds[key] = list(record.hp.pooled)
         # the cells of one encoding are distinct: fancy-index += loses no update
         for heat, data in (
             (self.heat_original, record.heat_original),
@@ -171,6 +173,12 @@ class Accumulator:
         ).reshape(5, -1)
         self.hp_bins[:, hp.bin_first : hp.bin_first + bins.shape[1]] += bins
 
+    def hp_by_round(self) -> np.ndarray:
+        """(rounds, 7) the `HpStats.pooled` sums of each round, in `round_rows` order."""
+        return np.array([self._hp_rounds[key] for key in sorted(self._rows)], np.float64).reshape(
+            -1, 7
+        )
+
     def players(self) -> pd.DataFrame:
         """players.csv: one row per player-round, rounds in (match, round) order."""
         rows = [row for key in sorted(self._rows) for row in self._rows[key][1]]
@@ -191,7 +199,7 @@ class Tables:
     summary: MetricSummary
     trajectory: pd.DataFrame
     """protocol, metric, group, n, mean, std, median, p90, paper_mean, paper_std, and the 95%
-    bootstrap intervals by round of the mean and median (`INTERVAL_COLUMNS`)."""
+    bootstrap intervals by round of the mean and median (`evaluate.intervals`)."""
     combat: pd.DataFrame
     """metric, value, n, paper, note."""
     deaths: DeathTimeMetrics
@@ -215,7 +223,8 @@ def build_tables(acc: Accumulator) -> Tables:
     players = acc.players()
     rounds = acc.round_rows()
     summary = summarize(players[["side", *METRIC_NAMES, "reason"]])
-    trajectory = with_intervals(trajectory_table(summary), players, acc.settings.seed)
+    seed = acc.settings.seed
+    trajectory = trajectory_intervals(trajectory_table(summary), players, seed)
     deaths = death_time_metrics(
         players["death_time_original_s"].to_numpy(np.float64),
         players["death_time_replay_s"].to_numpy(np.float64),
@@ -237,6 +246,7 @@ def build_tables(acc: Accumulator) -> Tables:
         after = float((known["played_out_s"] > 0).mean())
         note = "share of rounds decided by playing on after the data's last frame"
         combat.loc[len(combat)] = ("decided_after_data", after, len(known), math.nan, note)
+    combat = combat_intervals(combat, players, rounds, acc.hp_by_round(), seed)
     both = int(((rounds["players_t"] > 0) & (rounds["players_ct"] > 0)).sum()) if len(rounds) else 0
     return Tables(
         players=players,
@@ -251,7 +261,7 @@ def build_tables(acc: Accumulator) -> Tables:
         rounds_both_teams=both,
         rounds_with_winner=len(known),
         rounds_with_warnings=int((rounds["warnings"] != "").sum()) if len(rounds) else 0,
-        bomb=bomb_metrics(rounds) if acc.settings.bomb else None,
+        bomb=bomb_metrics(rounds, seed=seed) if acc.settings.bomb else None,
     )
 
 
@@ -268,29 +278,6 @@ def trajectory_table(summary: MetricSummary) -> pd.DataFrame:
     table["paper_std"] = [std for _, std in paper]
     order = table["metric"].map(METRIC_NAMES.index) * len(GROUPS) + table["group"].map(GROUPS.index)
     return table.iloc[np.argsort(order.to_numpy(), kind="stable")].reset_index(drop=True)
-
-
-INTERVAL_COLUMNS = ("mean_low", "mean_high", "median_low", "median_high", "interval_note")
-"""Columns the 95% bootstrap intervals (by round, `decoy_cli.metrics.bootstrap`) add to the
-trajectory table."""
-
-
-def with_intervals(table: pd.DataFrame, players: pd.DataFrame, seed: int) -> pd.DataFrame:
-    """The trajectory table with the intervals of each row's mean and median, resampling the
-    rounds of the evaluated player-rounds (`seed`: the run's, so a rerun gives the same)."""
-    codes, rounds = pd.factorize(players["match"].astype(str) + "\0" + players["round"].astype(str))
-    boot = RoundBootstrap(len(rounds), seed=seed)
-    evaluated = players["reason"].isna().to_numpy()
-    sides = players["side"].to_numpy()
-    rows = []
-    for group, metric in zip(table["group"], table["metric"], strict=True):
-        chosen = evaluated & ((sides == group) if group != "all" else True)
-        values = players[metric].to_numpy(np.float64)[chosen]
-        mean = boot.interval(values, codes[chosen], "mean")
-        median = boot.interval(values, codes[chosen], "median")
-        rows.append((mean.low, mean.high, median.low, median.high, mean.note or median.note))
-    intervals = pd.DataFrame(rows, columns=list(INTERVAL_COLUMNS), index=table.index)
-    return pd.concat([table, intervals], axis=1)
 
 
 def hp_metrics_from_sums(

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from decoy_cli.metrics.bootstrap import Interval, RoundBootstrap
+
 BOMB_METRIC_NAMES = (
     "plant_agreement",
     "plant_time_error_median_s",
@@ -35,6 +37,8 @@ class BombMetrics:
     """Bomb fidelity over the rounds whose data records the bomb."""
 
     values: dict[str, float]
+    intervals: dict[str, Interval]
+    """95% bootstrap interval of each metric, resampling rounds (`metrics.bootstrap`)."""
     counts: dict[str, int]
     """Rounds each metric is over (`BOMB_METRIC_NAMES` keys)."""
     reasons: dict[str, str]
@@ -46,19 +50,25 @@ class BombMetrics:
     """Rounds with at least one anomaly in their bomb data."""
 
     def table(self) -> pd.DataFrame:
-        """One row per metric: value, rounds it is over, and why it is NaN when it is."""
+        """One row per metric: value, rounds it is over, its interval, and why the value or
+        the interval is missing when one is."""
         return pd.DataFrame(
             {
                 "metric": list(BOMB_METRIC_NAMES),
                 "value": [self.values[name] for name in BOMB_METRIC_NAMES],
                 "rounds": [self.counts[name] for name in BOMB_METRIC_NAMES],
-                "note": [self.reasons.get(name, "") for name in BOMB_METRIC_NAMES],
+                "low": [self.intervals[name].low for name in BOMB_METRIC_NAMES],
+                "high": [self.intervals[name].high for name in BOMB_METRIC_NAMES],
+                "note": [
+                    self.reasons.get(name) or self.intervals[name].note
+                    for name in BOMB_METRIC_NAMES
+                ],
             }
         )
 
 
-def bomb_metrics(rounds: pd.DataFrame) -> BombMetrics:
-    """Aggregate the bomb columns of `rounds` (module docstring)."""
+def bomb_metrics(rounds: pd.DataFrame, *, seed: int = 0) -> BombMetrics:
+    """Aggregate the bomb columns of `rounds` (module docstring); `seed` fixes the bootstrap."""
     rows = rounds[rounds["bomb_recorded"].astype(bool)] if len(rounds) else rounds
     values: dict[str, float] = {}
     counts: dict[str, int] = {}
@@ -90,6 +100,7 @@ def bomb_metrics(rounds: pd.DataFrame) -> BombMetrics:
     anomalies = rows["bomb_anomalies"].fillna("").astype(str) if len(rows) else pd.Series([])
     return BombMetrics(
         values=values,
+        intervals=_intervals(rows, plant_d, plant_r, defuse_d, defuse_r, seed),
         counts=counts,
         reasons=reasons,
         n_rounds=len(rows),
@@ -99,6 +110,48 @@ def bomb_metrics(rounds: pd.DataFrame) -> BombMetrics:
         ),
         anomalies=int((anomalies != "").sum()),
     )
+
+
+def _intervals(
+    rows: pd.DataFrame,
+    plant_d: np.ndarray,
+    plant_r: np.ndarray,
+    defuse_d: np.ndarray,
+    defuse_r: np.ndarray,
+    seed: int,
+) -> dict[str, Interval]:
+    """The interval of each metric: agreements are means of per-round indicators, the time and
+    position errors' medians are medians of per-round values; a p95 gets none."""
+    boot = RoundBootstrap(len(rows), seed=seed)
+    index = np.arange(len(rows))
+    planted = plant_d | plant_r
+    both = plant_d & plant_r
+    same_site = np.zeros(len(rows), bool)
+    if len(rows):
+        same_site = (rows["plant_site_data"] == rows["plant_site_replay"]).to_numpy()
+    tail = Interval(np.nan, np.nan, "no interval for a p95")
+
+    def median(name: str) -> Interval:
+        values = np.zeros(0)
+        if len(rows):
+            values = np.abs(pd.to_numeric(rows[name], errors="coerce").to_numpy(np.float64))
+        return boot.interval(values, index, "median")
+
+    def share(agree: np.ndarray, over: np.ndarray) -> Interval:
+        return boot.interval(agree[over].astype(np.float64), index[over], "mean")
+
+    everywhere = np.ones(len(rows), bool)
+    return {
+        "plant_agreement": share(plant_d == plant_r, everywhere),
+        "plant_time_error_median_s": median("plant_time_error_s"),
+        "plant_time_error_p95_s": tail,
+        "plant_site_agreement": share(same_site, both),
+        "plant_position_error_median_m": median("plant_position_error_m"),
+        "plant_position_error_p95_m": tail,
+        "defuse_agreement": share(defuse_d == defuse_r, planted),
+        "defuse_time_error_median_s": median("defuse_time_error_s"),
+        "defuse_time_error_p95_s": tail,
+    }
 
 
 def _flag(rows: pd.DataFrame, column: str) -> np.ndarray:

@@ -13,6 +13,7 @@ reason.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,7 +65,22 @@ class RoundBootstrap:
             draws = self._medians(values, round_index)
         else:
             raise ValueError(f"statistic must be 'mean' or 'median', not {statistic!r}")
+        return self._percentiles(draws)
+
+    def sums_interval(
+        self, sums: np.ndarray, statistic: Callable[[np.ndarray], np.ndarray]
+    ) -> Interval:
+        """Interval of a statistic computed from additive per-round sums: `sums` is (rounds, k),
+        `statistic` maps a (resamples, k) array of summed rounds to (resamples,) values (NaN
+        where undefined), e.g. a Pearson correlation from its moments."""
+        if self.rounds < MIN_ROUNDS:
+            return Interval(np.nan, np.nan, f"{self.rounds} rounds: fewer than {MIN_ROUNDS}")
+        return self._percentiles(statistic(self.weights @ np.asarray(sums, dtype=np.float64)))
+
+    def _percentiles(self, draws: np.ndarray) -> Interval:
         draws = draws[np.isfinite(draws)]
+        if not len(draws):
+            return Interval(np.nan, np.nan, "undefined in every resample")
         tail = 100 * (1 - CONFIDENCE) / 2
         low, high = np.percentile(draws, [tail, 100 - tail])
         return Interval(float(low), float(high))
@@ -97,3 +113,12 @@ class RoundBootstrap:
 
 _CHUNK_CELLS = 4_000_000
 """Resample-by-row cells handled at once by the median (32 MB of int64)."""
+
+
+def pearson_from_sums(sums: np.ndarray) -> np.ndarray:
+    """Pearson correlations from summed moments, one per row of [n, Σx, Σy, Σx², Σy², Σxy]
+    (NaN where a series is constant or n < 2)."""
+    n, sx, sy, sxx, syy, sxy = (sums[:, k] for k in range(6))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = (n * sxy - sx * sy) / np.sqrt((n * sxx - sx * sx) * (n * syy - sy * sy))
+    return np.where(n >= 2, np.clip(r, -1.0, 1.0), np.nan)
