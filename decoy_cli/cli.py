@@ -12,6 +12,7 @@ from decoy_cli import __version__
 from decoy_cli.commands import (
     bench,
     build_waypoints,
+    compare,
     download,
     evaluate,
     info,
@@ -110,6 +111,7 @@ def main(
 
 app.command("bench")(bench.bench)
 app.command("build-waypoints")(build_waypoints.build_waypoints)
+app.command("compare")(compare.compare)
 app.command("download")(download.download)
 app.command("evaluate")(evaluate.evaluate)
 app.command("info")(info.info)

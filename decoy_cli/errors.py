@@ -28,6 +28,11 @@ class ModelError(DecoyError):
     """A damage model that cannot be used: missing, corrupt or incompatible files or inputs."""
 
 
+class CompareError(DecoyError):
+    """Two evaluation runs that cannot be compared: a missing or broken table, other data, other
+    metrics, nothing in common."""
+
+
 class DownloadError(DecoyError):
     """A file that cannot be fetched or fails verification: HTTP error, timeout, short body."""
 

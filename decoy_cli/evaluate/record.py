@@ -52,7 +52,8 @@ class RoundRecord(msgspec.Struct, frozen=True):
     match_id: str
     round_num: int
     round: dict[str, Any]
-    """The rounds.csv row, but `file` (where the content was read, set by whoever reads it)."""
+    """The rounds.csv row, but `file` and `file_sha` (where the content was read and its
+    content hash, set by whoever reads it)."""
     players: list[dict[str, Any]]
     heat_original: bytes
     """Alive samples by grid cell of the original position (`grid_sums` encoding)."""
@@ -102,6 +103,7 @@ ROUND_COLUMNS = (
     "match",
     "round",
     "file",
+    "file_sha",
     "frames",
     "seconds",
     "players_t",

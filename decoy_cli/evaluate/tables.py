@@ -133,7 +133,8 @@ class Accumulator:
         key = (record.match_id, record.round_num, record.file_sha)
         if key in self._rows:
             raise ValueError(f"round {record.round_num} of {record.match_id} added twice")
-        self._rows[key] = ({**record.round, "file": file}, record.players)
+        row = {**record.round, "file": file, "file_sha": record.file_sha}
+        self._rows[key] = (row, record.players)
         self._hp_rounds[key] = list(record.hp.pooled)
         # the cells of one encoding are distinct: fancy-index += loses no update
         for heat, data in (
