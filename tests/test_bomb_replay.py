@@ -84,24 +84,21 @@ def test_a_plant_with_bomb_events_begins_at_plant_begin_and_takes_the_rules_time
     assert row["bomb_anomalies"] == ""
 
 
-def test_a_plant_known_only_from_the_frames_is_placed_mid_frame(tmp_path: Path) -> None:
+def test_a_plant_known_only_from_the_frames_is_the_first_planted_frame(tmp_path: Path) -> None:
     """The T-side files: no bomb events, `bombPlantTick` is the first frame showing the bomb
-    planted, so the plant completed within the half second before it."""
+    planted (docs/metrics.md), known to the frame interval before it."""
     scenario, _ = carrier_round()
     result = replayed(scenario, tmp_path)
     planted_frame = scenario.planted_from
     assert planted_frame is not None
-    data_s = (frame_tick(planted_frame) - FRAME_HALF - 10_000) / 128
+    data_s = (frame_tick(planted_frame) - 10_000) / 128
     assert result.bomb is not None and result.bomb.plant is not None
     assert result.bomb.plant.seconds == pytest.approx(data_s)
-    assert result.bomb.plant.resolution_s == pytest.approx(0.25)
+    assert result.bomb.plant.resolution_s == pytest.approx(0.5)
+    assert result.bomb.plant.start_s == pytest.approx(data_s - 3.0)
     (plant,) = kinds(result, "plant")
     assert abs(plant.tick / TICK_RATE - data_s) <= ONE_TICK_S
     assert result.bomb_row()["plant_site_data"] == "A"  # type: ignore[index]
-
-
-FRAME_HALF = 32
-"""Half a frame interval in ticks at 128 ticks/s."""
 
 
 def test_a_late_plant_stops_the_round_clock(tmp_path: Path) -> None:
@@ -216,8 +213,9 @@ def test_anomalies_in_the_bomb_data_are_replayed_and_named(tmp_path: Path) -> No
 
 
 def test_the_bomb_table_of_evaluate_by_hand(tmp_path: Path) -> None:
-    """Three rounds: a plant with events (replay 0.05 s early), a plant from frames only
-    (on time), a defuse with a kit (0.02 s early); the table's numbers follow by hand."""
+    """Three rounds: a plant with events (replay 0.047 s early: 11.0 s against the data's tick
+    at 11.047 s), a plant from frames only (on time), a defuse with a kit (planted like the
+    first, defused 0.02 s early); the table's numbers follow by hand."""
     data = tmp_path / "data"
     data.mkdir()
     with_events, t1 = carrier_round()
@@ -237,13 +235,21 @@ def test_the_bomb_table_of_evaluate_by_hand(tmp_path: Path) -> None:
     table = pd.read_csv(out / "tables" / "bomb.csv").set_index("metric")
     assert table.loc["plant_agreement", "value"] == 1.0
     assert table.loc["plant_agreement", "rounds"] == 3
-    # |errors| 0.05, 0.05 (the defuse round plants like the first), ~0
-    assert table.loc["plant_time_error_median_s", "value"] == pytest.approx(0.05, abs=ONE_TICK_S)
+    early = (11.0 * 128 - (tick_of(PLANT_S) - 10_000)) / 128  # -0.047 s
+    assert table.loc["plants_completed_share", "value"] == 1.0
+    assert table.loc["plants_replay_only", "value"] == 0
+    # signed errors: early, early, 0
+    assert table.loc["plant_time_error_median_s", "value"] == pytest.approx(early, abs=ONE_TICK_S)
+    assert table.loc["plant_time_error_mean_abs_s", "value"] == pytest.approx(
+        -2 * early / 3, abs=ONE_TICK_S
+    )
     assert table.loc["plant_site_agreement", "value"] == 1.0
     assert table.loc["defuse_agreement", "value"] == 1.0
     assert table.loc["defuse_time_error_median_s", "rounds"] == 1
-    assert table.loc["defuse_time_error_median_s", "value"] == pytest.approx(0.02, abs=ONE_TICK_S)
+    assert table.loc["defuse_time_error_median_s", "value"] == pytest.approx(-0.02, abs=ONE_TICK_S)
     confusion = pd.read_csv(out / "tables" / "bomb_plant_confusion.csv").set_index("data")
     assert confusion.loc["planted", "planted"] == 3 and confusion.loc["not planted"].sum() == 0
-    assert "## The bomb" in (out / "report.md").read_text()
+    report = (out / "report.md").read_text()
+    assert "## The bomb" in report
+    assert "| `plants_completed_share` | 1.000 |  | 3 |" in report  # 3 rounds: no interval
     assert "the bomb (3 rounds with bomb data)" in result.stdout

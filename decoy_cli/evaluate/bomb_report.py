@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from decoy_cli.evaluate.markdown import first_rows, md_table, num
+from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import BombMetrics
 
@@ -12,9 +12,11 @@ BOMB_HEADER = ["metric", "value", "95% interval", "rounds", "over / why not"]
 
 
 def bomb_rows(bomb: BombMetrics) -> list[list[str]]:
-    """One row per bomb metric: name, value, rounds it is over, why it is not defined."""
+    """One row per bomb metric: name, value, its 95% interval, rounds it is over, and why the
+    value or the interval is missing."""
     return [
-        [str(r.metric), num(r.value), str(r.rounds), str(r.note)] for r in bomb.table().itertuples()
+        [str(r.metric), num(r.value), interval(r.low, r.high), str(r.rounds), str(r.note)]
+        for r in bomb.table().itertuples()
     ]
 
 
@@ -27,9 +29,10 @@ def bomb_section(tables: Tables) -> str:
         return "\n\n".join([*text, "The bomb was off (`--no-bomb`): nothing to compare."])
     text.append(
         f"Over the {bomb.n_rounds} rounds whose data records the bomb; definitions in "
-        "docs/metrics.md. Time errors are |replay − data| in seconds, on the round's clock; "
-        "a plant time the data derives from its frames is the middle of the frame interval "
-        "(`plant_time_resolution_s` in `rounds.csv` gives ± how exactly it is known)."
+        "docs/metrics.md. Time errors are replay − data in seconds on the round's clock (the "
+        "median signed, the mean and p95 of the absolute value); a plant time the data derives "
+        "from its frames is known to a frame interval (`plant_time_resolution_s` in "
+        "`rounds.csv`)."
     )
     rows = [[f"`{row[0]}`", *row[1:]] for row in bomb_rows(bomb)]
     text.append(md_table(BOMB_HEADER, rows))

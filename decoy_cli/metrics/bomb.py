@@ -10,7 +10,6 @@ none), and the plant and defuse confusions (rows: the data, columns: the replay)
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,16 +19,21 @@ from decoy_cli.metrics.bootstrap import Interval, RoundBootstrap
 
 BOMB_METRIC_NAMES = (
     "plant_agreement",
+    "plants_completed_share",
+    "plants_replay_only",
     "plant_time_error_median_s",
+    "plant_time_error_mean_abs_s",
     "plant_time_error_p95_s",
     "plant_site_agreement",
     "plant_position_error_median_m",
     "plant_position_error_p95_m",
     "defuse_agreement",
     "defuse_time_error_median_s",
+    "defuse_time_error_mean_abs_s",
     "defuse_time_error_p95_s",
 )
-"""The aggregate bomb metrics, in table order. Time errors are of |replay − data|."""
+"""The aggregate bomb metrics, in table order (docs/metrics.md): the time errors' median is of
+the signed error (replay − data), their mean and p95 of its absolute value."""
 
 
 @dataclass(frozen=True)
@@ -70,108 +74,109 @@ class BombMetrics:
 def bomb_metrics(rounds: pd.DataFrame, *, seed: int = 0) -> BombMetrics:
     """Aggregate the bomb columns of `rounds` (module docstring); `seed` fixes the bootstrap."""
     rows = rounds[rounds["bomb_recorded"].astype(bool)] if len(rounds) else rounds
+    plant_d, plant_r = _flag(rows, "plant_data"), _flag(rows, "plant_replay")
+    defuse_d, defuse_r = _flag(rows, "defuse_data"), _flag(rows, "defuse_replay")
+    both = plant_d & plant_r
+    planted = plant_d | plant_r
+    same_site = np.zeros(len(rows), bool)
+    if len(rows):
+        same_site = (rows["plant_site_data"] == rows["plant_site_replay"]).to_numpy()
+    plant_error = _numbers(rows, "plant_time_error_s")
+    position_error = _numbers(rows, "plant_position_error_m")
+    defuse_error = _numbers(rows, "defuse_time_error_s")
+    everywhere = np.ones(len(rows), bool)
+    neither = "no round planted in both"
+    # name: (per-round values, the rounds they are over, statistic, why empty)
+    specs: dict[str, tuple[np.ndarray, np.ndarray, str, str]] = {
+        "plant_agreement": (plant_d == plant_r, everywhere, "mean", "no round with bomb data"),
+        "plants_completed_share": (plant_r, plant_d, "mean", "no plant in the data"),
+        "plants_replay_only": (plant_r & ~plant_d, everywhere, "count", "no round with bomb data"),
+        "plant_time_error_median_s": (plant_error, both, "median", neither),
+        "plant_time_error_mean_abs_s": (
+            np.abs(plant_error),
+            both,
+            "mean",
+            neither,
+        ),
+        "plant_time_error_p95_s": (np.abs(plant_error), both, "p95", neither),
+        "plant_site_agreement": (same_site, both, "mean", neither),
+        "plant_position_error_median_m": (
+            position_error,
+            both & np.isfinite(position_error),
+            "median",
+            "no plant position",
+        ),
+        "plant_position_error_p95_m": (
+            position_error,
+            both & np.isfinite(position_error),
+            "p95",
+            "no plant position",
+        ),
+        "defuse_agreement": (defuse_d == defuse_r, planted, "mean", "no round with a plant"),
+        "defuse_time_error_median_s": (
+            defuse_error,
+            defuse_d & defuse_r,
+            "median",
+            "no round defused in both",
+        ),
+        "defuse_time_error_mean_abs_s": (
+            np.abs(defuse_error),
+            defuse_d & defuse_r,
+            "mean",
+            "no round defused in both",
+        ),
+        "defuse_time_error_p95_s": (
+            np.abs(defuse_error),
+            defuse_d & defuse_r,
+            "p95",
+            "no round defused in both",
+        ),
+    }
+    boot = RoundBootstrap(len(rows), seed=seed)
+    index = np.arange(len(rows))
     values: dict[str, float] = {}
     counts: dict[str, int] = {}
     reasons: dict[str, str] = {}
-
-    def put(name: str, value: float, n: int, why: str) -> None:
-        values[name], counts[name] = (value, n) if n else (float("nan"), 0)
-        if not n:
+    intervals: dict[str, Interval] = {}
+    for name, (per_round, over, statistic, why) in specs.items():
+        chosen = np.asarray(per_round, dtype=np.float64)[over]
+        counts[name] = int(over.sum())
+        if statistic == "count":
+            values[name] = float(chosen.sum()) if len(chosen) else float("nan")
+            intervals[name] = Interval(np.nan, np.nan, "a count")
+        elif not len(chosen):
+            values[name] = float("nan")
+            intervals[name] = Interval(np.nan, np.nan, "")
+        elif statistic == "p95":
+            values[name] = float(np.percentile(chosen, 95))
+            intervals[name] = Interval(np.nan, np.nan, "no interval for a p95")
+        else:
+            values[name] = float(np.mean(chosen) if statistic == "mean" else np.median(chosen))
+            intervals[name] = boot.interval(chosen, index[over], statistic)
+        if not len(chosen):
             reasons[name] = why
-
-    plant_d = _flag(rows, "plant_data")
-    plant_r = _flag(rows, "plant_replay")
-    put("plant_agreement", float(np.mean(plant_d == plant_r)), len(rows), "no round with bomb data")
-    _errors(put, rows, "plant_time_error", "s", "no round planted in both")
-    both = rows[plant_d & plant_r]
-    put(
-        "plant_site_agreement",
-        float(np.mean(both["plant_site_data"] == both["plant_site_replay"])),
-        len(both),
-        "no round planted in both",
-    )
-    _errors(put, rows, "plant_position_error", "m", "no plant position in the data")
-    defuse_d = _flag(rows, "defuse_data")
-    defuse_r = _flag(rows, "defuse_replay")
-    planted = rows[plant_d | plant_r]
-    agree = defuse_d[plant_d | plant_r] == defuse_r[plant_d | plant_r]
-    put("defuse_agreement", float(np.mean(agree)), len(planted), "no round with a plant")
-    _errors(put, rows, "defuse_time_error", "s", "no round defused in both")
     anomalies = rows["bomb_anomalies"].fillna("").astype(str) if len(rows) else pd.Series([])
     return BombMetrics(
         values=values,
-        intervals=_intervals(rows, plant_d, plant_r, defuse_d, defuse_r, seed),
+        intervals=intervals,
         counts=counts,
         reasons=reasons,
         n_rounds=len(rows),
         plant_confusion=_confusion(plant_d, plant_r, "planted"),
-        defuse_confusion=_confusion(
-            defuse_d[plant_d | plant_r], defuse_r[plant_d | plant_r], "defused"
-        ),
+        defuse_confusion=_confusion(defuse_d[planted], defuse_r[planted], "defused"),
         anomalies=int((anomalies != "").sum()),
     )
-
-
-def _intervals(
-    rows: pd.DataFrame,
-    plant_d: np.ndarray,
-    plant_r: np.ndarray,
-    defuse_d: np.ndarray,
-    defuse_r: np.ndarray,
-    seed: int,
-) -> dict[str, Interval]:
-    """The interval of each metric: agreements are means of per-round indicators, the time and
-    position errors' medians are medians of per-round values; a p95 gets none."""
-    boot = RoundBootstrap(len(rows), seed=seed)
-    index = np.arange(len(rows))
-    planted = plant_d | plant_r
-    both = plant_d & plant_r
-    same_site = np.zeros(len(rows), bool)
-    if len(rows):
-        same_site = (rows["plant_site_data"] == rows["plant_site_replay"]).to_numpy()
-    tail = Interval(np.nan, np.nan, "no interval for a p95")
-
-    def median(name: str) -> Interval:
-        values = np.zeros(0)
-        if len(rows):
-            values = np.abs(pd.to_numeric(rows[name], errors="coerce").to_numpy(np.float64))
-        return boot.interval(values, index, "median")
-
-    def share(agree: np.ndarray, over: np.ndarray) -> Interval:
-        return boot.interval(agree[over].astype(np.float64), index[over], "mean")
-
-    everywhere = np.ones(len(rows), bool)
-    return {
-        "plant_agreement": share(plant_d == plant_r, everywhere),
-        "plant_time_error_median_s": median("plant_time_error_s"),
-        "plant_time_error_p95_s": tail,
-        "plant_site_agreement": share(same_site, both),
-        "plant_position_error_median_m": median("plant_position_error_m"),
-        "plant_position_error_p95_m": tail,
-        "defuse_agreement": share(defuse_d == defuse_r, planted),
-        "defuse_time_error_median_s": median("defuse_time_error_s"),
-        "defuse_time_error_p95_s": tail,
-    }
 
 
 def _flag(rows: pd.DataFrame, column: str) -> np.ndarray:
     return rows[column].fillna(False).astype(bool).to_numpy() if len(rows) else np.zeros(0, bool)
 
 
-Put = Callable[[str, float, int, str], None]
-"""Records one metric: name, value, rounds it is over, why it is NaN when over none."""
-
-
-def _errors(put: Put, rows: pd.DataFrame, stem: str, unit: str, why: str) -> None:
-    """Median and p95 of |error| of one column over the rounds where it is defined."""
-    column = f"{stem}_{unit}"
-    error = np.zeros(0)
-    if len(rows):
-        error = np.abs(pd.to_numeric(rows[column], errors="coerce").to_numpy(np.float64))
-    error = error[np.isfinite(error)]
-    n = len(error)
-    put(f"{stem}_median_{unit}", float(np.median(error)) if n else np.nan, n, why)
-    put(f"{stem}_p95_{unit}", float(np.percentile(error, 95)) if n else np.nan, n, why)
+def _numbers(rows: pd.DataFrame, column: str) -> np.ndarray:
+    """A column as float64 (NaN where empty)."""
+    if not len(rows):
+        return np.zeros(0)
+    return pd.to_numeric(rows[column], errors="coerce").to_numpy(np.float64)
 
 
 def _confusion(data: np.ndarray, replay: np.ndarray, what: str) -> pd.DataFrame:

@@ -39,12 +39,12 @@ class DataPlantRecord:
     """The plant that completed in the data."""
 
     seconds: float
-    """When it completed, on the round's clock: the `plant` event's tick; else `bombPlantTick`;
-    when that is a frame's tick (files that derive it from the first frame showing the bomb
-    planted), the middle of the interval since the frame before."""
+    """When it completed, on the round's clock: the `plant` event's tick, else `bombPlantTick`
+    (docs/metrics.md)."""
     resolution_s: float
-    """± how exactly the data knows `seconds` (0 for an event's tick, half a frame interval
-    when derived from frames)."""
+    """How long before `seconds` the plant may have completed: 0 for an event's tick; the
+    frame interval when `bombPlantTick` is a frame's tick (files that derive it from the first
+    frame showing the bomb planted, such as the T-side files)."""
     start_s: float
     """When the plant began: the last `plant_begin` within `PLANT_BEGIN_WINDOW_S` before it,
     else `seconds` minus the plant's duration."""
@@ -230,8 +230,7 @@ def _plant(
         plant_tick = float(round_.bomb_plant_tick)  # type: ignore[arg-type]  # checked above
         k = int(np.searchsorted(ticks, plant_tick))
         if 0 < k < len(ticks) and ticks[k] == plant_tick:  # derived from the frames
-            resolution = (plant_tick - ticks[k - 1]) / 2 / clock.tick_rate
-            plant_tick -= (plant_tick - ticks[k - 1]) / 2
+            resolution = (plant_tick - ticks[k - 1]) / clock.tick_rate
     seconds = float(clock.seconds(plant_tick))
     begins = events.loc[events["bombAction"] == "plant_begin", "tick"].to_numpy(np.float64)
     begins = clock.seconds(begins)
