@@ -10,7 +10,7 @@ from rich.table import Table
 from decoy_cli.commands._console import make_console
 from decoy_cli.evaluate.compare import compare_runs, read_run
 from decoy_cli.evaluate.compare_outputs import write_comparison
-from decoy_cli.evaluate.markdown import interval, num
+from decoy_cli.evaluate.markdown import interval, num, p_value
 from decoy_cli.files import check_folder_writable
 
 
@@ -45,7 +45,7 @@ def compare(
             interval(r.low, r.high),
             f"{100 * r.improved_share:.1f}%",
             f"{100 * r.worse_share:.1f}%",
-            "–" if r.wilcoxon_p != r.wilcoxon_p else f"{r.wilcoxon_p:.2g}",
+            p_value(r.wilcoxon_p),
         )
     console.print(table)
     console.print(f"comparison written to {out} (report: {out / 'compare.md'})")

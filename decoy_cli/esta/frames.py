@@ -93,11 +93,12 @@ def build_frames(
     if len(frames) > MAX_FRAMES:
         raise Invalid(f"{len(frames):,} frames (a round holds at most {MAX_FRAMES:,})")
     ticks = _ticks(frames)
-    zero_tick = round_clock_zero(frames, ticks, tick_rate, freeze_end_tick, start_tick)
+    written = np.array([f.seconds for f in frames], dtype=np.float64)
+    zero_tick = round_clock_zero(written, ticks, tick_rate, freeze_end_tick, start_tick)
     clock = None if zero_tick is None else RoundClock(zero_tick, tick_rate)
     seconds = clock.seconds(ticks) if clock is not None else np.zeros(0)
     _check_clock(seconds, ticks)
-    _check_written_seconds(np.array([f.seconds for f in frames], dtype=np.float64), seconds, ticks)
+    _check_written_seconds(written, seconds, ticks)
     bomb_position = _bomb_position(frames, ticks)
     players, arrays = _players(frames, ticks)
     return FrameArrays(
@@ -136,7 +137,7 @@ def _ticks(frames: list[FrameState]) -> np.ndarray:
 
 
 def round_clock_zero(
-    frames: list[FrameState],
+    seconds: np.ndarray,
     ticks: np.ndarray,
     tick_rate: int,
     freeze_end_tick: int | None,
@@ -144,13 +145,12 @@ def round_clock_zero(
 ) -> float | None:
     """The tick at which the round's clock reads 0 s (freeze-time end), None if nothing says.
 
-    `freezeTimeEndTick` when given; else the tick the frames' `seconds` imply, at the rate they
-    were written with (some awpy 1.x exports divided by 127 on 128-tick demos); else `startTick`;
-    else the first frame's tick.
+    `freezeTimeEndTick` when given; else the tick the frames' written `seconds` (NaN where
+    null) imply, at the rate they were written with (some awpy 1.x exports divided by 127 on
+    128-tick demos); else `startTick`; else the first frame's tick.
     """
     if freeze_end_tick is not None:
         return float(freeze_end_tick)
-    seconds = np.array([f.seconds for f in frames], dtype=np.float64)
     known = np.isfinite(seconds)
     if known.any():
         rate = float(tick_rate)

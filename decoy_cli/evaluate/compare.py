@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import CompareError
+from decoy_cli.evaluate.intervals import round_codes
 from decoy_cli.metrics import METRIC_NAMES
 from decoy_cli.metrics.bootstrap import RoundBootstrap
 
@@ -141,8 +142,8 @@ def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
         raise CompareError(
             f"{a.folder} and {b.folder} have no evaluated player-round in common: nothing to pair"
         )
-    codes, rounds = pd.factorize(pairs["match"].astype(str) + "\0" + pairs["round"].astype(str))
-    boot = RoundBootstrap(len(rounds), seed=seed)
+    codes, rounds = round_codes(pairs)
+    boot = RoundBootstrap(rounds, seed=seed)
     differences = pairs[[*KEY, "side"]].copy()
     rows = []
     for metric in metrics:
@@ -173,7 +174,7 @@ def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
         table=pd.DataFrame(rows, columns=list(COMPARE_COLUMNS)),
         differences=differences,
         places=_places(a, b),
-        rounds=len(rounds),
+        rounds=rounds,
         only_a=len(left) - len(pairs),
         only_b=len(right) - len(pairs),
     )

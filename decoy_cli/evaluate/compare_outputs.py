@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from decoy_cli.evaluate.compare import Comparison
-from decoy_cli.evaluate.markdown import interval, md_table, num
+from decoy_cli.evaluate.markdown import interval, md_table, num, p_value
 from decoy_cli.figures import save_figure
 from decoy_cli.files import write_atomic
 
@@ -60,7 +60,7 @@ def compare_markdown(comparison: Comparison) -> str:
             f"{r.mean_difference:+.3f}",
             interval(r.low, r.high),
             f"{100 * r.improved_share:.1f}% / {100 * r.worse_share:.1f}%",
-            "–" if r.wilcoxon_p != r.wilcoxon_p else f"{r.wilcoxon_p:.2g}",
+            p_value(r.wilcoxon_p),
             str(r.note),
         ]
         for r in comparison.table.itertuples()

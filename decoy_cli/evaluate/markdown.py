@@ -34,3 +34,8 @@ def first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:
 def interval(low: float, high: float) -> str:
     """A 95% interval as "[low, high]"; "" when there is none (too few rounds)."""
     return "" if math.isnan(low) else f"[{num(low)}, {num(high)}]"
+
+
+def p_value(p: float) -> str:
+    """A p-value in two significant digits; "–" when there is none."""
+    return "–" if math.isnan(p) else f"{p:.2g}"

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.metrics.bootstrap import Interval, RoundBootstrap
+from decoy_cli.metrics.combat import confusion_matrix
 
 BOMB_METRIC_NAMES = (
     "plant_agreement",
@@ -182,9 +183,7 @@ def _numbers(rows: pd.DataFrame, column: str) -> np.ndarray:
 def _confusion(data: np.ndarray, replay: np.ndarray, what: str) -> pd.DataFrame:
     """2×2 counts: rows the data, columns the replay, labels `what` / not `what`."""
     labels = [what, f"not {what}"]
-    table = pd.DataFrame(
-        0, index=pd.Index(labels, name="data"), columns=pd.Index(labels, name="replay")
-    )
-    for d, r in zip(data, replay, strict=True):
-        table.loc[labels[0 if d else 1], labels[0 if r else 1]] += 1
+    table = confusion_matrix([labels[not d] for d in data], [labels[not r] for r in replay])
+    table = table.reindex(index=labels, columns=labels, fill_value=0)
+    table.index.name, table.columns.name = "data", "replay"
     return table

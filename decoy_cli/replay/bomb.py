@@ -22,7 +22,7 @@ import pandas as pd
 
 from decoy_cli.csgo import tick_at
 from decoy_cli.errors import EstaError
-from decoy_cli.esta import PlayerInfo, Round
+from decoy_cli.esta import Round
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.sites import SiteZones
@@ -99,8 +99,8 @@ def read_data_bomb(round_: Round, zones: SiteZones, plant_s: float) -> DataBomb:
     plant = _plant(round_, events, carriers, zones, plant_s, anomalies)
     defuses = _defuses(round_, events, plant, anomalies)
     planted = np.asarray(round_.bomb_planted, bool)
-    if plant is not None and round_.clock is not None:
-        planted = planted | (round_.clock.seconds(round_.frame_ticks) >= plant.seconds)
+    if plant is not None:
+        planted = planted | (np.asarray(round_.frame_seconds) >= plant.seconds)
     alive = np.asarray(round_.alive, bool)
     before = np.concatenate([[-1], carriers[:-1]])
     before_alive = np.zeros(len(carriers), bool)
@@ -167,15 +167,15 @@ class DataPlant:
     planting by then, though the frames only show it at the frame after); -1: no such target."""
 
 
-def policy_plant(bomb: DataBomb, plans: list[PlayerPlan], round_: Round) -> DataPlant | None:
+def policy_plant(bomb: DataBomb, plans: list[PlayerPlan]) -> DataPlant | None:
     """The data's plant for `PlanPolicy`, None when the data shows no completed plant."""
     plant = bomb.plant
-    if plant is None or round_.clock is None:
+    if plant is None:
         return None
     agent, target, arrive_by = plant.planter, -1, -1
     if agent >= 0:
         own = plans[agent]
-        seconds = round_.clock.seconds(round_.frame_ticks)[own.target_frame]
+        seconds = own.target_seconds
         earlier = np.flatnonzero(seconds < plant.seconds)
         target = int(earlier[-1]) if len(earlier) else -1
         during = np.flatnonzero(seconds >= plant.start_s)
@@ -293,14 +293,14 @@ def _defuses(
     return sorted(out, key=lambda d: d.start_s)
 
 
-def defuse_windows(bomb: DataBomb, players: list[PlayerInfo]) -> dict[int, tuple[int, int]]:
+def defuse_windows(bomb: DataBomb) -> dict[int, tuple[int, int]]:
     """Agent -> (first, last) simulator tick of its wish to defuse: from its data defuse start
     (of the attempt that completed, else its first) to the data's end of that attempt; for ever
     after the start of a completed one (the replay's own defuse may end later) or of one whose
     end the data does not show."""
     windows: dict[int, tuple[int, int]] = {}
     for d in sorted(bomb.defuses, key=lambda d: (not d.completed, d.start_s)):
-        if 0 <= d.agent < len(players) and d.agent not in windows:
+        if d.agent not in windows:  # a round row: `_defuses` keeps only players it found
             end = tick_at(d.end_s) if np.isfinite(d.end_s) and not d.completed else FOREVER
             windows[d.agent] = (tick_at(d.start_s), end)
     return windows

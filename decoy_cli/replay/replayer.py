@@ -14,7 +14,7 @@ S_t on the same clock.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -142,10 +142,8 @@ class ReplayOptions:
             # Without the bomb, a round whose data ran past the round time (after a plant,
             # which stops the clock) would time out while the players still move: replay it
             # to the end of its data.
-            rules = RulesConfig(
-                round_time_s=max(rules.round_time_s, float(round_.frame_seconds[-1]) + 1.0),
-                auto_pickup=False,
-            )
+            last = float(round_.frame_seconds[-1])
+            rules = replace(rules, round_time_s=max(rules.round_time_s, last + 1.0))
         return RoundSetup(
             graph=graph,
             mover=self.mover,
@@ -178,14 +176,15 @@ def replay_round(
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
             return replay_round(round_, graph, options, physics=own, open_sim=open_sim)
+    rules_config = setup.rules_config()
     zones = setup.site_zones()
-    bomb = read_data_bomb(round_, zones, setup.rules_config().plant_s) if options.bomb else None
+    bomb = read_data_bomb(round_, zones, rules_config.plant_s) if options.bomb else None
     plan = snap_round(
         round_,
         graph,
         physics=physics,
         sites=carrier_sites(round_, bomb.carriers, zones) if bomb is not None else None,
-        node_site=zones.site_of(graph.positions),
+        node_site=zones.site_of(graph.positions) if bomb is not None else None,
     )
     players = plan.players
     n = len(players)
@@ -214,12 +213,11 @@ def replay_round(
     agents.alive[never] = False
     agents.hp[never] = 0
 
-    rules_config = setup.rules_config()
     carrier = int(bomb.carriers[0]) if bomb is not None else -1  # the data's, if alive here
     if carrier >= 0 and not agents.alive[carrier]:
         carrier = -1
-    plant = policy_plant(bomb, plan.plans, round_) if bomb is not None else None
-    defuse = defuse_windows(bomb, players) if bomb is not None else {}
+    plant = policy_plant(bomb, plan.plans) if bomb is not None else None
+    defuse = defuse_windows(bomb) if bomb is not None else {}
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
     policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant, defuse, caps)

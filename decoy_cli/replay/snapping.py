@@ -140,10 +140,9 @@ def snap_into_sites(
     move a plant out of its site. Frames already on a waypoint of their site, or with none of
     its waypoints within `max_distance`, keep their snap.
     """
-    node, error, status = snap.node.copy(), snap.error_m.copy(), snap.status.copy()
-    wrong = np.flatnonzero(
-        (sites != "") & (status == SnapStatus.SNAPPED) & (node_site[np.maximum(node, 0)] != sites)
-    )
+    node, error = snap.node.copy(), snap.error_m.copy()
+    snapped = snap.status == SnapStatus.SNAPPED
+    wrong = np.flatnonzero((sites != "") & snapped & (node_site[np.maximum(node, 0)] != sites))
     for f in wrong:
         inside = np.flatnonzero(node_site == sites[f])
         if not len(inside):
@@ -152,4 +151,4 @@ def snap_into_sites(
         best = int(np.argmin(distance))
         if distance[best] <= max_distance:
             node[f], error[f] = inside[best], distance[best]
-    return SnapResult(node=node, error_m=error, status=status)
+    return SnapResult(node=node, error_m=error, status=snap.status)

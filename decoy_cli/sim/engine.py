@@ -156,10 +156,10 @@ class Simulator:
         done, unless `after_end`: then, after the outcome, the agents go on moving and are
         recorded (a replay following the data through the round-end delay, when real players
         still move), while the rules, combat and the outcome stay as they ended."""
-        if self.done and not (after_end and self.outcome is not None):
-            return []
-        if self.outcome is not None:
+        if after_end and self.outcome is not None:
             return self._move_after_end()
+        if self.done:
+            return []
         start = len(self.events)
         self.tick += 1
         self._decide()
@@ -186,12 +186,14 @@ class Simulator:
         return self.events[start:]
 
     def _move_after_end(self) -> list[SimEvent]:
-        """One tick of movement after the outcome (see `step`)."""
+        """One tick of movement after the outcome (see `step`); returns its events (stuck,
+        teleport)."""
+        start = len(self.events)
         self.tick += 1
         self._decide()
         self._move()
         self._record()
-        return []
+        return self.events[start:]
 
     def run(self, until: Callable[[Simulator], bool] | None = None) -> Recording:
         """Step until the round ends, the tick bound, or `until(sim)` says stop."""
