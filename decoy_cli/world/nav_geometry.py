@@ -15,6 +15,8 @@ from scipy.sparse.linalg import lsqr
 
 from decoy_cli.world.nav_data import NavMesh
 
+HEIGHT_DECIMALS = 3
+"""Fitted corner heights are rounded to this many decimals of a Hammer unit."""
 WALL_PUSH_U = 16.0
 """How far walls stand beyond the nav edge (half a player hull)."""
 BRIDGE_MAX_GAP_U = 32.0
@@ -126,6 +128,9 @@ def fit_corner_heights(nav: NavMesh, contacts: list[_Contact]) -> tuple[np.ndarr
         eq += 2
     matrix = coo_matrix((vals, (rows, cols)), shape=(eq, 2 * n)).tocsr()
     solution = lsqr(matrix, np.asarray(rhs), atol=1e-10, btol=1e-10, iter_lim=20000)[0]
+    # The iterations' last bits depend on the CPU's BLAS kernels; rounding far below anything
+    # that matters (a thousandth of a unit, 25 µm) makes the world the same on every machine.
+    solution = np.round(solution, HEIGHT_DECIMALS)
     return solution[:n], solution[n:]
 
 
