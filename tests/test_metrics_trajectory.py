@@ -15,10 +15,13 @@ from decoy_cli.metrics import (
     METRIC_NAMES_PAPER,
     PAPER_LENGTH,
     PlayerRound,
+    dtw,
+    frechet,
     resample,
     trajectory_metrics,
     trajectory_metrics_frame,
 )
+from decoy_cli.metrics.trajectory_kernel import pairwise_sum
 
 
 def line(frames: int) -> np.ndarray:
@@ -231,3 +234,51 @@ def test_frame_of_many_player_rounds() -> None:
         trajectory_metrics_frame(mixed)
     with pytest.raises(ValueError, match="reserved"):
         trajectory_metrics_frame([PlayerRound({"dtw": 1}, line(6), alive(6), line(6), alive(6))])
+
+
+# ---- the compiled core against plain numpy -------------------------------------------------
+
+
+def test_pairwise_sum_is_numpys_sum_to_the_bit() -> None:
+    rng = np.random.default_rng(21)
+    for n in [*range(0, 40), 127, 128, 129, 255, 256, 257, 1000, 1353, 4099]:
+        values = rng.normal(scale=1e3, size=n) ** 2
+        assert pairwise_sum(values) == np.sum(values), n
+
+
+def test_resampling_is_numpys_linspace_interpolation_to_the_bit() -> None:
+    rng = np.random.default_rng(22)
+    for n in [2, 3, 7, 150, 451, 452, 999]:
+        points = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+        position = np.linspace(0.0, n - 1.0, PAPER_LENGTH)
+        lower = np.minimum(position.astype(np.int64), n - 2)
+        frac = (position - lower)[:, None]
+        expected = points[lower] * (1.0 - frac) + points[lower + 1] * frac
+        assert np.array_equal(resample(points), expected), n
+
+
+def test_metrics_equal_the_plain_numpy_definitions() -> None:
+    rng = np.random.default_rng(23)
+    for _ in range(30):
+        frames = int(rng.integers(5, 300))
+        original = np.cumsum(rng.normal(size=(frames, 3)), axis=0)
+        simulated = original + np.cumsum(rng.normal(scale=0.3, size=(frames, 3)), axis=0)
+        original_alive = alive(frames, last=int(rng.integers(2, frames)))
+        simulated_alive = alive(frames, first=int(rng.integers(0, 2)))
+        values = trajectory_metrics(original, original_alive, simulated, simulated_alive).values
+        both = original_alive & simulated_alive
+        step = np.linalg.norm(original[both] - simulated[both], axis=1)
+        a = resample(original[original_alive])
+        b = resample(simulated[simulated_alive])
+        assert values["mean_dist"] == step.mean()
+        assert values["rmse"] == np.sqrt(np.mean(step**2))
+        assert values["max_dist"] == step.max()
+        assert values["final_dist"] == step[-1]
+        assert values["paper_rmse"] == np.sqrt(np.mean((a - b) ** 2))
+        # numpy's norm sums with BLAS, the kernel pairwise: equal to rounding
+        assert values["paper_euclidean"] == pytest.approx(
+            np.linalg.norm(a - b) / PAPER_LENGTH, rel=1e-14
+        )
+        total, steps = dtw(a, b)
+        assert values["paper_dtw"] == total / steps
+        assert values["paper_frechet_2d"] == frechet(a[:, :2], b[:, :2])

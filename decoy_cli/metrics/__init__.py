@@ -1,6 +1,9 @@
 """Replay fidelity metrics, exactly as defined in docs/metrics.md.
 
-* `distances`: exact DTW (with the warping-path length) and discrete Fréchet kernels.
+* `distances`: exact DTW (with the warping-path length) and discrete Fréchet kernels, in one
+  pruned sweep.
+* `trajectory_kernel`: the compiled per-player-round core of the trajectory metrics.
+* `fastdtw_metric`: the paper's DTW as the paper computed it (the `fastdtw` package).
 * `trajectory`: the ten trajectory metrics of a player-round, protocols "clock" and "paper".
 * `combat`: HP, death-time and round-outcome metrics of full rounds.
 * `bomb`: plant and defuse agreement and their time, site and position errors over rounds.
@@ -24,24 +27,37 @@ from decoy_cli.metrics.combat import (
     outcome_metrics,
     pearson,
 )
-from decoy_cli.metrics.distances import TIE_RTOL, dtw, dtw_mean, frechet
+from decoy_cli.metrics.distances import (
+    TIE_RTOL,
+    CurveDistances,
+    dtw,
+    dtw_and_frechet,
+    dtw_mean,
+    frechet,
+)
 from decoy_cli.metrics.players import PLAYER_METRIC_COLUMNS, ReplayTrace, player_metrics
 from decoy_cli.metrics.trajectory import (
+    ALL_METRIC_NAMES,
+    FASTDTW_METRIC,
     METRIC_NAMES,
     METRIC_NAMES_CLOCK,
     METRIC_NAMES_PAPER,
     PAPER_LENGTH,
+    PAPER_PROTOCOL_NAMES,
     PlayerRound,
     TrajectoryMetrics,
+    metric_names,
     resample,
     trajectory_metrics,
     trajectory_metrics_frame,
 )
 
 __all__ = [
+    "ALL_METRIC_NAMES",
     "BOMB_METRIC_NAMES",
     "DEATH_COUNT_NAMES",
     "DEATH_TIME_METRIC_NAMES",
+    "FASTDTW_METRIC",
     "GROUPS",
     "HP_METRIC_NAMES",
     "METRIC_NAMES",
@@ -49,10 +65,12 @@ __all__ = [
     "METRIC_NAMES_PAPER",
     "OUTCOME_METRIC_NAMES",
     "PAPER_LENGTH",
+    "PAPER_PROTOCOL_NAMES",
     "PLAYER_METRIC_COLUMNS",
     "SIDES",
     "TIE_RTOL",
     "BombMetrics",
+    "CurveDistances",
     "DeathTimeMetrics",
     "HpMetrics",
     "MetricSummary",
@@ -64,9 +82,11 @@ __all__ = [
     "confusion_matrix",
     "death_time_metrics",
     "dtw",
+    "dtw_and_frechet",
     "dtw_mean",
     "frechet",
     "hp_metrics",
+    "metric_names",
     "outcome_metrics",
     "pearson",
     "player_metrics",

@@ -55,11 +55,12 @@ class ReplayTrace:
     relocations: np.ndarray
 
 
-def player_metrics(round_: Round, trace: ReplayTrace) -> pd.DataFrame:
+def player_metrics(round_: Round, trace: ReplayTrace, *, fastdtw: bool = False) -> pd.DataFrame:
     """One row per player: identity, fate in both worlds, timing, and all ten metrics.
 
-    Columns: `PLAYER_METRIC_COLUMNS`, the ten `METRIC_NAMES`, and reason (why the metrics are
-    NaN, else None). `death` is "scripted", "simulated" or "".
+    Columns: `PLAYER_METRIC_COLUMNS`, the ten `METRIC_NAMES` (and `paper_dtw_fastdtw` with
+    `fastdtw`), and reason (why the metrics are NaN, else None). `death` is "scripted",
+    "simulated" or "".
     """
     rows = []
     for p, player in enumerate(round_.players):
@@ -68,6 +69,7 @@ def player_metrics(round_: Round, trace: ReplayTrace) -> pd.DataFrame:
             np.asarray(round_.alive[p]),
             trace.position[:, p],
             trace.alive[:, p] & round_.present[p],
+            fastdtw=fastdtw,
         )
         # a player never alive on the graph (absent) never lived in the replay: not a death
         died_replay = bool(trace.alive[:, p].any() and not trace.alive[-1, p])

@@ -25,18 +25,50 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from decoy_cli.metrics.distances import dtw_mean, frechet
+from decoy_cli.metrics.distances import curve_kernel
+from decoy_cli.metrics.fastdtw_metric import fastdtw_mean
+from decoy_cli.metrics.trajectory_kernel import (
+    FEW_ORIGINAL,
+    FEW_SIMULATED,
+    NON_FINITE,
+    NONE_IN_BOTH,
+    OK,
+    metric_values,
+    resample_points,
+)
 
 METRIC_NAMES_CLOCK = ("mean_dist", "rmse", "max_dist", "dtw", "frechet_2d", "final_dist")
 METRIC_NAMES_PAPER = ("paper_euclidean", "paper_rmse", "paper_dtw", "paper_frechet_2d")
 METRIC_NAMES = METRIC_NAMES_CLOCK + METRIC_NAMES_PAPER
 """All trajectory metrics, clock protocol first, in the order of docs/metrics.md."""
 
+FASTDTW_METRIC = "paper_dtw_fastdtw"
+"""The paper's DTW computed with the `fastdtw` package (`fastdtw_metric`); only on request."""
+
+ALL_METRIC_NAMES = (*METRIC_NAMES, FASTDTW_METRIC)
+"""Every trajectory metric a table may hold, in display order."""
+
+PAPER_PROTOCOL_NAMES = (*METRIC_NAMES_PAPER, FASTDTW_METRIC)
+"""The metrics of protocol "paper", `paper_dtw_fastdtw` included."""
+
+
+def metric_names(fastdtw: bool) -> tuple[str, ...]:
+    """The trajectory metrics computed, with or without `paper_dtw_fastdtw`."""
+    return ALL_METRIC_NAMES if fastdtw else METRIC_NAMES
+
+
 PAPER_LENGTH = 451
 """Number of points each alive trajectory is resampled to in the paper protocol."""
 
 MIN_ALIVE_FRAMES = 2
 """Fewest alive frames a trajectory needs (interpolation needs two points)."""
+
+_REASONS = {
+    FEW_ORIGINAL: f"original alive in fewer than {MIN_ALIVE_FRAMES} frames",
+    FEW_SIMULATED: f"simulated alive in fewer than {MIN_ALIVE_FRAMES} frames",
+    NONE_IN_BOTH: "no frame alive in both",
+    NON_FINITE: "non-finite position at an alive frame",
+}
 
 
 @dataclass(frozen=True)
@@ -70,10 +102,7 @@ def resample(points: np.ndarray, length: int = PAPER_LENGTH) -> np.ndarray:
     n = points.shape[0]
     if n < 2 or length < 2:
         raise ValueError(f"resampling needs at least 2 input and output points, got {n}, {length}")
-    position = np.linspace(0.0, n - 1.0, length)
-    lower = np.minimum(position.astype(np.int64), n - 2)
-    frac = (position - lower)[:, None]
-    return points[lower] * (1.0 - frac) + points[lower + 1] * frac
+    return resample_points(np.asarray(points, dtype=np.float64), length)
 
 
 def _validated(
@@ -101,8 +130,10 @@ def _validated(
     return original, original_alive, simulated, simulated_alive
 
 
-def _not_evaluable(reason: str) -> TrajectoryMetrics:
-    return TrajectoryMetrics(values=dict.fromkeys(METRIC_NAMES, float("nan")), reason=reason)
+def _not_evaluable(reason: str, fastdtw: bool) -> TrajectoryMetrics:
+    return TrajectoryMetrics(
+        values=dict.fromkeys(metric_names(fastdtw), float("nan")), reason=reason
+    )
 
 
 def trajectory_metrics(
@@ -110,43 +141,30 @@ def trajectory_metrics(
     original_alive: np.ndarray,
     simulated: np.ndarray,
     simulated_alive: np.ndarray,
+    *,
+    fastdtw: bool = False,
 ) -> TrajectoryMetrics:
     """All ten trajectory metrics (both protocols) of one player-round; see the module doc.
+    With `fastdtw`, also `paper_dtw_fastdtw` (the paper's FastDTW on the paper protocol).
 
     Raises ValueError when the arrays are not (F, 3) positions with (F,) boolean masks.
     """
     original, original_alive, simulated, simulated_alive = _validated(
         original, original_alive, simulated, simulated_alive
     )
-    o = original[original_alive]
-    s = simulated[simulated_alive]
-    both = original_alive & simulated_alive
-    if o.shape[0] < MIN_ALIVE_FRAMES:
-        return _not_evaluable(f"original alive in fewer than {MIN_ALIVE_FRAMES} frames")
-    if s.shape[0] < MIN_ALIVE_FRAMES:
-        return _not_evaluable(f"simulated alive in fewer than {MIN_ALIVE_FRAMES} frames")
-    if not both.any():
-        return _not_evaluable("no frame alive in both")
-    if not (np.isfinite(o).all() and np.isfinite(s).all()):
-        return _not_evaluable("non-finite position at an alive frame")
-
-    step = np.linalg.norm(original[both] - simulated[both], axis=1)
-    a = resample(o)
-    b = resample(s)
-    diff = a - b
-    values = {
-        "mean_dist": float(step.mean()),
-        "rmse": float(np.sqrt(np.mean(step**2))),
-        "max_dist": float(step.max()),
-        "dtw": dtw_mean(o, s),
-        "frechet_2d": frechet(o[:, :2], s[:, :2]),
-        "final_dist": float(step[-1]),
-        "paper_euclidean": float(np.linalg.norm(diff) / PAPER_LENGTH),
-        "paper_rmse": float(np.sqrt(np.mean(diff**2))),
-        "paper_dtw": dtw_mean(a, b),
-        "paper_frechet_2d": frechet(a[:, :2], b[:, :2]),
-    }
-    return TrajectoryMetrics(values=values)
+    outcome, values, o, s, a, b = metric_values(
+        original, original_alive, simulated, simulated_alive, PAPER_LENGTH, MIN_ALIVE_FRAMES
+    )
+    if outcome != OK:
+        return _not_evaluable(_REASONS[outcome], fastdtw)
+    clock_total, clock_steps, values[4] = curve_kernel(o, s, 2)
+    paper_total, paper_steps, values[9] = curve_kernel(a, b, 2)
+    values[3] = clock_total / clock_steps
+    values[8] = paper_total / paper_steps
+    named = dict(zip(METRIC_NAMES, values.tolist(), strict=True))
+    if fastdtw:
+        named[FASTDTW_METRIC] = fastdtw_mean(a, b)
+    return TrajectoryMetrics(values=named)
 
 
 def trajectory_metrics_frame(player_rounds: Iterable[PlayerRound]) -> pd.DataFrame:
