@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 from typing import Any
 
 import typer
+from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 from rich.text import Text
@@ -13,6 +15,7 @@ from rich.text import Text
 from decoy_cli.bench import (
     SECTIONS,
     BenchConfig,
+    BenchData,
     check_damage_model,
     failed_sections,
     find_data,
@@ -20,9 +23,10 @@ from decoy_cli.bench import (
     report,
     run_isolated,
 )
+from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
 from decoy_cli.commands._console import make_console
 from decoy_cli.damage import CHOICES_HELP
-from decoy_cli.errors import OutputError
+from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
 
 DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
@@ -71,6 +75,20 @@ def bench(
     ),
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="The JSON report."),
     seed: int = typer.Option(0, "--seed", help="Seed of agent placements and actions."),
+    sections: str = typer.Option(
+        ",".join(SECTIONS), "--sections", help="Comma-separated sections to run."
+    ),
+    baseline: str | None = typer.Option(
+        None,
+        "--baseline",
+        help="Measure the speed-up against a baseline in the same run: a git ref of this "
+        "checkout (e.g. HEAD~3, a tag) or the Python interpreter of another environment. Each "
+        "section runs --repeats times on each side, alternating, in fresh processes; the table "
+        "gives the ratio (median, min, max).",
+    ),
+    repeats: int = typer.Option(
+        3, "--repeats", min=1, help="Runs per side of each section with --baseline."
+    ),
 ) -> None:
     """Measure the simulator's speed (the paper's Table 1) and the throughput of the pipeline.
 
@@ -81,12 +99,18 @@ def bench(
     if out.is_dir():
         raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
     check_writable(out)  # before minutes of measuring
+    chosen = _chosen_sections(sections)
     config = BenchConfig.create(
         quick=quick, models=models, mover=mover, combat=combat, bomb=bomb, seed=seed
     )
     bench_data = find_data(data)
     machine = machine_info()
     console.print(_machine_line(machine), highlight=False)
+    if baseline is not None:
+        switches = {"quick": quick, "models": models, "mover": mover, "combat": combat}
+        switches |= {"bomb": bomb, "seed": seed}
+        _side_by_side(console, chosen, switches, bench_data, baseline, repeats, out)
+        return
     status = check_damage_model(models)
     if status.error:
         console.print(
@@ -104,7 +128,7 @@ def bench(
         ),
         highlight=False,
     )
-    sections: dict[str, dict[str, Any]] = {}
+    results: dict[str, dict[str, Any]] = {}
     with Progress(
         TextColumn("{task.description}", markup=False),
         BarColumn(),
@@ -113,13 +137,13 @@ def bench(
         console=console,
         transient=True,
     ) as progress:
-        task = progress.add_task("bench", total=len(SECTIONS))
-        for name in SECTIONS:
+        task = progress.add_task("bench", total=len(chosen))
+        for name in chosen:
             progress.update(task, description=TITLES[name])
-            sections[name] = run_isolated(name, config, status, bench_data)
-            progress.console.print(_render(name, sections[name]))
+            results[name] = run_isolated(name, config, status, bench_data)
+            progress.console.print(_render(name, results[name]))
             progress.advance(task)
-    document = report(config, status, bench_data, sections, machine)
+    document = report(config, status, bench_data, results, machine)
     write_json(out, document, sort_keys=False)
     console.print(
         f"peak memory of this process {document['peak_rss_mb_main']:.0f} MB; load average at "
@@ -127,12 +151,94 @@ def bench(
         f"report written to {out}",
         highlight=False,
     )
-    failed = failed_sections(sections)
+    failed = failed_sections(results)
     if failed:
         make_console(stderr=True).print(
             f"error: {len(failed)} section(s) failed: {', '.join(failed)}", highlight=False
         )
         raise typer.Exit(1)
+
+
+def _chosen_sections(text: str) -> list[str]:
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in SECTIONS]
+    if unknown or not names:
+        raise DecoyError(
+            f"--sections {text!r}: unknown {', '.join(unknown) or '(none given)'}; "
+            f"the sections are {', '.join(SECTIONS)}"
+        )
+    return [name for name in SECTIONS if name in names]
+
+
+def _side_by_side(
+    console: Console,
+    chosen: list[str],
+    config: dict[str, Any],
+    bench_data: BenchData | None,
+    ref: str,
+    repeats: int,
+    out: Path,
+) -> None:
+    """Run the sections on this code and on the baseline, alternating; print the ratios."""
+    work = out.parent
+    work.mkdir(parents=True, exist_ok=True)
+    baseline = baseline_tree(ref, work)
+    data = bench_data.folder if bench_data else None
+    console.print(
+        f"side by side: current code against {baseline.label}, {repeats} runs each, "
+        f"alternating; data: {data or 'none (replay and reader skipped)'}",
+        highlight=False,
+    )
+    try:
+        with Progress(
+            TextColumn("{task.description}", markup=False),
+            TimeElapsedColumn(),
+            console=console,
+            transient=True,
+        ) as progress:
+            task = progress.add_task("")
+            result = side_by_side(
+                chosen,
+                config,
+                data,
+                current_tree(),
+                baseline,
+                repeats,
+                work,
+                on_run=lambda section, side, k: progress.update(
+                    task, description=f"{TITLES[section]}: {side}, run {k + 1} of {repeats}"
+                ),
+            )
+    finally:
+        if baseline.path is not None:
+            shutil.rmtree(baseline.path, ignore_errors=True)
+    console.print(_ratio_table(result))
+    write_json(out, {"machine": machine_info(), "side_by_side": result}, sort_keys=False)
+    console.print(f"report written to {out}", highlight=False)
+    if result["errors"]:
+        for line in result["errors"]:
+            make_console(stderr=True).print(f"error: {line}", highlight=False)
+        raise typer.Exit(1)
+
+
+def _ratio_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        f"speed-up of the current code over {result['baseline']}, measured side by side",
+        ["section", "figure", "current (min-max)", "baseline (min-max)", "ratio", "min", "max"],
+        caption=f"{result['repeats']} alternating runs per side, each in a fresh process; "
+        "ratio = current / baseline of each alternating pair",
+    )
+    for row in result["ratios"]:
+        table.add_row(
+            TITLES[row["section"]],
+            row["figure"],
+            f"{min(row['current']):,.4g}-{max(row['current']):,.4g}",
+            f"{min(row['baseline']):,.4g}-{max(row['baseline']):,.4g}",
+            f"{row['ratio_median']:.2f}x" if row["ratio_median"] else "-",
+            f"{row['ratio_min']:.2f}x" if row["ratio_min"] else "-",
+            f"{row['ratio_max']:.2f}x" if row["ratio_max"] else "-",
+        )
+    return table
 
 
 def _machine_line(machine: dict[str, Any]) -> str:

@@ -1,0 +1,77 @@
+"""`decoy bench --baseline`: the same sections on two code trees, alternating, as ratios."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from decoy_cli.bench.baseline import Ratio, baseline_tree, current_tree, headlines
+from decoy_cli.cli import app
+from decoy_cli.errors import DecoyError
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "200"}
+CHECKOUT = Path(__file__).resolve().parents[1]
+
+
+def test_ratios_pair_the_alternating_runs() -> None:
+    ratio = Ratio("metrics", "pairs/s", [300.0, 330.0, 360.0], [100.0, 110.0, 90.0])
+    row = ratio.to_dict()
+    assert row["ratios"] == [3.0, 3.0, 4.0]
+    assert (row["ratio_median"], row["ratio_min"], row["ratio_max"]) == (3.0, 3.0, 4.0)
+
+
+def test_headlines_are_rates_higher_is_better() -> None:
+    assert headlines("metrics", {"pairs_per_s": 10.0}) == {"pairs/s": 10.0}
+    rows = [{"agents": 2, "ticks_per_s": 5.0}, {"agents": 10, "ticks_per_s": 2.0}]
+    assert headlines("table1", {"rows": rows}) == {
+        "ticks/s, 2 agents": 5.0,
+        "ticks/s, 10 agents": 2.0,
+    }
+    step = {"layout": "spread", "parts": {"step": {"median_ms": 0.5}}}
+    assert headlines("combat_step", {"rows": [step]}) == {"steps/s, spread": 2000.0}
+    assert headlines("replay", {"error": "boom"}) == {}
+    assert headlines("reader", {"files": 0}) == {}
+
+
+def test_the_python_of_another_environment_is_a_baseline(tmp_path: Path) -> None:
+    out = tmp_path / "bench.json"
+    args = ["bench", "--quick", "--sections", "metrics", "--repeats", "1"]
+    result = runner.invoke(app, [*args, "--baseline", sys.executable, "--out", str(out)], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert "speed-up of the current code over python" in result.output
+    report = json.loads(out.read_text())["side_by_side"]
+    (row,) = report["ratios"]
+    assert row["section"] == "metrics" and len(row["current"]) == len(row["baseline"]) == 1
+    assert row["current"][0] > 0 and row["baseline"][0] > 0
+    assert not report["errors"]
+    assert [p.name for p in tmp_path.iterdir()] == ["bench.json"]  # nothing left behind
+
+
+@pytest.mark.skipif(not (CHECKOUT / ".git").exists(), reason="needs a git checkout")
+def test_a_git_ref_is_exported_beside_the_report(tmp_path: Path) -> None:
+    head = subprocess.run(
+        ["git", "-C", str(CHECKOUT), "rev-parse", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
+    tree = baseline_tree("HEAD", tmp_path)
+    assert tree.path == tmp_path / f"baseline-{head[:12]}"
+    assert (tree.path / "decoy_cli" / "bench" / "baseline.py").is_file()
+    assert tree.label == f"HEAD ({head[:12]})"
+    assert current_tree().path == CHECKOUT
+
+
+@pytest.mark.skipif(not (CHECKOUT / ".git").exists(), reason="needs a git checkout")
+def test_bad_baselines_and_sections_are_one_line(tmp_path: Path) -> None:
+    with pytest.raises(DecoyError, match="no-such-ref"):
+        baseline_tree("no-such-ref", tmp_path)
+    out = str(tmp_path / "b.json")
+    bad_ref = runner.invoke(app, ["bench", "--baseline", "no-such-ref", "--out", out], env=WIDE)
+    assert bad_ref.exit_code != 0 and "error: --baseline" in bad_ref.output
+    sections = runner.invoke(app, ["bench", "--sections", "metrics,warp", "--out", out], env=WIDE)
+    assert sections.exit_code != 0
+    assert "unknown warp" in sections.output and "table1" in sections.output
