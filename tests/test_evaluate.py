@@ -34,7 +34,7 @@ from decoy_cli.evaluate.record import PlaceFinder, grid_sums, hp_stats, read_gri
 from decoy_cli.evaluate.runner import Evaluation, ProgressEvent, make_settings, run_evaluation
 from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
 from decoy_cli.evaluate.tables import Tables, build_tables, hp_metrics_from_sums
-from decoy_cli.metrics import METRIC_NAMES, hp_metrics
+from decoy_cli.metrics import FASTDTW_METRIC, METRIC_NAMES, hp_metrics
 from decoy_cli.waypoints.build import builtin_graph
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -221,6 +221,11 @@ def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(
     trajectory = pd.read_csv(out / "tables" / "trajectory.csv")
     paper_t = trajectory[(trajectory["group"] == "T") & (trajectory["metric"] == "paper_dtw")]
     assert paper_t["paper_mean"].item() == 0.873
+    # the paper's Table 2 setting computes the paper's own FastDTW beside the exact DTW
+    fast_t = trajectory[(trajectory["group"] == "T") & (trajectory["metric"] == FASTDTW_METRIC)]
+    assert fast_t["paper_mean"].item() == 0.873 and fast_t["mean"].item() > 0
+    assert "--fastdtw" in summary["command"]
+    assert f"`{FASTDTW_METRIC}` is the paper's own computation" in report
     assert list(pd.read_csv(out / "failures.csv").columns) == list(FAILURE_COLUMNS)
 
 
@@ -578,6 +583,9 @@ def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
     assert combat.loc["decided_after_data", "value"] == pytest.approx(played_on / 3)
     report = (out / "report.md").read_text()
     assert "damage model: shipped" in report
+    # FastDTW only on request outside the paper's Table 2 setting
+    assert FASTDTW_METRIC not in pd.read_csv(out / "players.csv").columns
+    assert "--no-fastdtw" in report
     for figure in sorted((out / "figures").glob("*.png")):
         assert f"figures/{figure.name}" in report
 

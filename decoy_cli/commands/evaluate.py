@@ -36,6 +36,7 @@ from decoy_cli.evaluate.report import (
     command_line,
     data_kind,
     mechanics,
+    protocols,
     table_groups,
 )
 from decoy_cli.evaluate.runner import (
@@ -47,7 +48,7 @@ from decoy_cli.evaluate.runner import (
     run_evaluation,
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
-from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, BombMetrics
+from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -98,6 +99,14 @@ def evaluate(
         help="Wall-clock seconds one round may take before it is recorded as a timeout "
         "failure (0: no limit; local workers only).",
     ),
+    fastdtw: bool | None = typer.Option(
+        None,
+        "--fastdtw/--no-fastdtw",
+        show_default=False,
+        help="Also compute paper_dtw_fastdtw, the paper's DTW as its code computed it (the "
+        "fastdtw package, radius 1), beside the exact paper_dtw. Slow (pure Python). Default: "
+        "on for the paper's Table 2 setting (--no-combat --no-bomb), off otherwise.",
+    ),
     implausible: str = typer.Option(
         "fail",
         "--implausible",
@@ -139,6 +148,7 @@ def evaluate(
         mover=mover,
         seed=seed,
         implausible=check_policy(implausible),
+        fastdtw=fastdtw,
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend
@@ -264,17 +274,14 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         )
     groups = table_groups(tables)
     stats = tables.trajectory.set_index(["metric", "group"])
-    for title, names in (
-        (
-            "protocol clock (m): mean ± std, [95% interval of the mean, by round], median · p90",
-            METRIC_NAMES_CLOCK,
-        ),
-        (
-            "protocol paper (m): mean ± std, [95% interval of the mean], (the paper's Table 2)",
-            METRIC_NAMES_PAPER,
-        ),
-    ):
-        console.print(title, style="italic", highlight=False)
+    titles = {
+        "clock": "protocol clock (m): mean ± std, [95% interval of the mean, by round], "
+        "median · p90",
+        "paper": "protocol paper (m): mean ± std, [95% interval of the mean], (the paper's "
+        "Table 2)",
+    }
+    for protocol, names in protocols(tables):
+        console.print(titles[protocol], style="italic", highlight=False)
         table = Table()
         table.add_column("metric", no_wrap=True)
         for group in groups:
@@ -283,7 +290,7 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
             cells = []
             for group in groups:
                 row = stats.loc[(name, group)]
-                if name in METRIC_NAMES_PAPER:
+                if name in PAPER_PROTOCOL_NAMES:
                     detail = f"({num(row['paper_mean'])} ± {num(row['paper_std'])})"
                 else:
                     detail = f"{num(row['median'])} · {num(row['p90'])}"

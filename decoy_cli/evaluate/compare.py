@@ -24,7 +24,7 @@ import pandas as pd
 
 from decoy_cli.errors import CompareError
 from decoy_cli.evaluate.intervals import round_codes
-from decoy_cli.metrics import METRIC_NAMES
+from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.metrics.bootstrap import RoundBootstrap
 
 KEY = ["match", "round", "player"]
@@ -99,7 +99,7 @@ def read_run(folder: Path) -> Run:
         missing = [c for c in needed if c not in frame.columns]
         if missing:
             raise CompareError(f"{folder / name}: lacks the columns {', '.join(missing)}")
-    metrics = tuple(m for m in METRIC_NAMES if m in players.columns)
+    metrics = tuple(m for m in ALL_METRIC_NAMES if m in players.columns)
     if not metrics:
         raise CompareError(f"{folder / 'players.csv'}: no trajectory metric column")
     evaluated = players["reason"].isna()

@@ -16,7 +16,7 @@ import numpy as np
 
 from decoy_cli.esta import Round
 from decoy_cli.evaluate.settings import HeatGrid
-from decoy_cli.metrics import METRIC_NAMES, player_metrics
+from decoy_cli.metrics import metric_names, player_metrics
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
 
 if TYPE_CHECKING:
@@ -133,7 +133,7 @@ def build_record(
     """The `RoundRecord` of a replayed round (see the module docstring)."""
     settings = task.settings
     rec = result.recording
-    metrics = player_metrics(round_, result.trace())
+    metrics = player_metrics(round_, result.trace(), fastdtw=settings.fastdtw)
     frame_seconds = np.asarray(round_.frame_seconds, dtype=np.float64)
     original = np.asarray(round_.position, dtype=np.float64)  # (P, F, 3)
     present = np.asarray(round_.present, dtype=bool)
@@ -169,7 +169,7 @@ def build_record(
                 "hp_final_original": int(hp_o[p, known[-1]]) if len(known) else -1,
                 "hp_final_replay": int(hp_r[p, known[-1]]) if len(known) else -1,
                 **{name: row[name] for name in _REPLAY_COLUMNS},
-                **{name: float(row[name]) for name in METRIC_NAMES},
+                **{name: float(row[name]) for name in metric_names(settings.fastdtw)},
                 "reason": row["reason"],
             }
         )

@@ -19,7 +19,14 @@ from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
-from decoy_cli.metrics import GROUPS, METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER, SIDES
+from decoy_cli.metrics import (
+    FASTDTW_METRIC,
+    GROUPS,
+    METRIC_NAMES_CLOCK,
+    METRIC_NAMES_PAPER,
+    PAPER_PROTOCOL_NAMES,
+    SIDES,
+)
 from decoy_cli.metrics.bootstrap import MIN_ROUNDS, RESAMPLES
 
 
@@ -68,7 +75,7 @@ def command_line(
     if settings.combat:
         words += ["--models", settings.models]
     words += ["--mover", settings.mover, "--implausible", settings.implausible]
-    words += ["--out", str(out)]
+    words += ["--fastdtw" if settings.fastdtw else "--no-fastdtw", "--out", str(out)]
     return shlex.join(words)
 
 
@@ -96,6 +103,27 @@ def table_groups(tables: Tables) -> list[str]:
     return [*sides, "all"] if len(sides) != 1 else sides
 
 
+def protocols(tables: Tables) -> list[tuple[str, tuple[str, ...]]]:
+    """The metrics of each protocol this run computed (`paper_dtw_fastdtw` only on request)."""
+    paper: tuple[str, ...] = METRIC_NAMES_PAPER
+    if FASTDTW_METRIC in tables.players.columns:
+        paper = PAPER_PROTOCOL_NAMES
+    return [("clock", METRIC_NAMES_CLOCK), ("paper", paper)]
+
+
+def fastdtw_note(tables: Tables) -> str:
+    """What `paper_dtw_fastdtw` is, and how often its per-step mean fell below the exact one."""
+    evaluated = tables.players[tables.players["reason"].isna()]
+    below = int((evaluated[FASTDTW_METRIC] < evaluated["paper_dtw"]).sum())
+    return (
+        f"`{FASTDTW_METRIC}` is the paper's own computation: FastDTW (the `fastdtw` package, "
+        "radius 1, Euclidean point cost) on the resampled trajectories, its total cost over its "
+        "path's length. FastDTW's total cost is never below the exact DTW's minimum; its "
+        f"per-step mean fell below the exact `paper_dtw` in {below} of {len(evaluated)} "
+        "player-rounds (where its path is longer)."
+    )
+
+
 def trajectory_rows(tables: Tables, names: tuple[str, ...]) -> tuple[list[str], list[list[str]]]:
     """Header and rows of one protocol's table: mean ± std, median, p90 of each `table_groups`
     group, and the paper's Table 2 for the same groups."""
@@ -104,7 +132,7 @@ def trajectory_rows(tables: Tables, names: tuple[str, ...]) -> tuple[list[str], 
     header = ["metric"]
     for group in groups:
         header += [f"{group} mean ± std", f"{group} median", f"{group} p90"]
-    paper_groups = groups if any(n in METRIC_NAMES_PAPER for n in names) else []
+    paper_groups = groups if any(n in PAPER_PROTOCOL_NAMES for n in names) else []
     header += [f"paper {g}" for g in paper_groups]
     rows = []
     for name in names:
@@ -231,10 +259,12 @@ def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
             else " (movement only there and here)."
         ),
     ]
-    for title, names in (("clock", METRIC_NAMES_CLOCK), ("paper", METRIC_NAMES_PAPER)):
+    for title, names in protocols(tables):
         header, rows = trajectory_rows(tables, names)
         rows = [[f"`{row[0]}`", *row[1:]] for row in rows]
         text.append(f"### Protocol {title}\n\n" + md_table(header, rows))
+    if FASTDTW_METRIC in tables.players.columns:
+        text.append(fastdtw_note(tables))
     summary = tables.summary
     evaluated = ", ".join(
         f"{g}: {summary.n_evaluated[g]} of {summary.n_rows[g]}" for g in GROUPS if summary.n_rows[g]

@@ -108,9 +108,11 @@ def make_settings(
     mover: str,
     seed: int,
     implausible: Implausible = "fail",
+    fastdtw: bool | None = None,
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
-    `--models` choice fails at once with one line instead of in every round."""
+    `--models` choice fails at once with one line instead of in every round. `fastdtw` None
+    means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise."""
     from decoy_cli.sim.setup import check_mover
     from decoy_cli.waypoints.build import canonical_map
 
@@ -136,6 +138,7 @@ def make_settings(
         code=code_fingerprint(name),
         models_fingerprint=models_fingerprint,
         implausible=implausible,
+        fastdtw=(not combat and not bomb) if fastdtw is None else fastdtw,
     )
 
 

@@ -107,6 +107,8 @@ class EvalSettings:
     models_fingerprint: str
     """Fingerprint of the damage model files ("" without combat or with no model)."""
     implausible: Implausible = "fail"
+    fastdtw: bool = False
+    """Also compute `paper_dtw_fastdtw` (the paper's FastDTW; slow, `metrics.fastdtw_metric`)."""
     hp_bin_s: float = HP_BIN_S
     hp_bins: int = HP_BINS
 
