@@ -17,6 +17,7 @@ from decoy_cli.errors import DecoyError
 runner = CliRunner()
 WIDE = {"COLUMNS": "200"}
 CHECKOUT = Path(__file__).resolve().parents[1]
+needs_git = pytest.mark.skipif(not (CHECKOUT / ".git").exists(), reason="needs a git checkout")
 
 
 def test_ratios_pair_the_alternating_runs() -> None:
@@ -37,41 +38,63 @@ def test_headlines_are_rates_higher_is_better() -> None:
     assert headlines("combat_step", {"rows": [step]}) == {"steps/s, spread": 2000.0}
     assert headlines("replay", {"error": "boom"}) == {}
     assert headlines("reader", {"files": 0}) == {}
+    # an older baseline's result without a figure, or a zero time, gives no ratio, not a crash
+    assert headlines("metrics", {"wall_s": 1.0}) == {}
+    broken = {"layout": "spread", "parts": {"step": {"median_ms": 0.0}}}
+    assert headlines("combat_step", {"rows": [broken]}) == {}
 
 
-def test_the_python_of_another_environment_is_a_baseline(tmp_path: Path) -> None:
-    out = tmp_path / "bench.json"
-    args = ["bench", "--quick", "--sections", "metrics", "--repeats", "1"]
-    result = runner.invoke(app, [*args, "--baseline", sys.executable, "--out", str(out)], env=WIDE)
+@needs_git
+def test_a_git_ref_side_by_side_with_a_relative_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    args = ["bench", "--quick", "--sections", "metrics", "--repeats", "1", "--baseline", "HEAD"]
+    result = runner.invoke(app, [*args, "--out", "side/bench.json"], env=WIDE)
     assert result.exit_code == 0, result.output
-    assert "speed-up of the current code over python" in result.output
-    report = json.loads(out.read_text())["side_by_side"]
+    assert "speed-up of the current code over HEAD" in result.output
+    report = json.loads((tmp_path / "side" / "bench.json").read_text())["side_by_side"]
     (row,) = report["ratios"]
     assert row["section"] == "metrics" and len(row["current"]) == len(row["baseline"]) == 1
     assert row["current"][0] > 0 and row["baseline"][0] > 0
-    assert not report["errors"]
-    assert [p.name for p in tmp_path.iterdir()] == ["bench.json"]  # nothing left behind
+    runs = report["runs"]["metrics"]
+    assert "/baseline-" in runs["baseline"][0]["code"]
+    assert runs["current"][0]["code"].startswith(str(CHECKOUT))
+    assert [p.name for p in (tmp_path / "side").iterdir()] == ["bench.json"]  # nothing left
 
 
-@pytest.mark.skipif(not (CHECKOUT / ".git").exists(), reason="needs a git checkout")
-def test_a_git_ref_is_exported_beside_the_report(tmp_path: Path) -> None:
+def test_a_baseline_that_runs_the_current_code_is_an_error(tmp_path: Path) -> None:
+    # This interpreter imports this very code: a "ratio" would be 1 and mean nothing.
+    out = tmp_path / "bench.json"
+    args = ["bench", "--quick", "--sections", "metrics", "--repeats", "1"]
+    result = runner.invoke(app, [*args, "--baseline", sys.executable, "--out", str(out)], env=WIDE)
+    assert result.exit_code != 0
+    assert "error: the baseline ran the same code as the current side" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+@needs_git
+def test_a_git_ref_is_exported_beside_the_report_and_removed(tmp_path: Path) -> None:
     head = subprocess.run(
         ["git", "-C", str(CHECKOUT), "rev-parse", "HEAD"], capture_output=True, text=True
     ).stdout.strip()
-    tree = baseline_tree("HEAD", tmp_path)
-    assert tree.path == tmp_path / f"baseline-{head[:12]}"
-    assert (tree.path / "decoy_cli" / "bench" / "baseline.py").is_file()
-    assert tree.label == f"HEAD ({head[:12]})"
+    with baseline_tree("HEAD", tmp_path) as tree:
+        assert tree.path is not None and tree.path.parent == tmp_path
+        assert tree.path.name.startswith(f"baseline-{head[:12]}-")
+        assert (tree.path / "decoy_cli" / "bench" / "baseline.py").is_file()
+        assert tree.label == f"HEAD ({head[:12]})"
+    assert list(tmp_path.iterdir()) == []
     assert current_tree().path == CHECKOUT
 
 
-@pytest.mark.skipif(not (CHECKOUT / ".git").exists(), reason="needs a git checkout")
+@needs_git
 def test_bad_baselines_and_sections_are_one_line(tmp_path: Path) -> None:
-    with pytest.raises(DecoyError, match="no-such-ref"):
-        baseline_tree("no-such-ref", tmp_path)
+    unknown = pytest.raises(DecoyError, match="neither a commit of this checkout nor an executable")
+    with unknown, baseline_tree("no-such-ref", tmp_path):
+        pass
     out = str(tmp_path / "b.json")
     bad_ref = runner.invoke(app, ["bench", "--baseline", "no-such-ref", "--out", out], env=WIDE)
-    assert bad_ref.exit_code != 0 and "error: --baseline" in bad_ref.output
+    assert bad_ref.exit_code != 0 and "error: --baseline no-such-ref" in bad_ref.output
     sections = runner.invoke(app, ["bench", "--sections", "metrics,warp", "--out", out], env=WIDE)
     assert sections.exit_code != 0
     assert "unknown warp" in sections.output and "table1" in sections.output

@@ -12,7 +12,7 @@ from scipy.stats import wilcoxon
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
-from decoy_cli.metrics import METRIC_NAMES
+from decoy_cli.metrics import FASTDTW_METRIC, METRIC_NAMES
 
 runner = CliRunner()
 ROUNDS = 12
@@ -114,3 +114,18 @@ def test_runs_that_cannot_be_paired_are_one_error_line(tmp_path: Path) -> None:
         runner.invoke(app, ["compare", str(a), str(tmp_path / "binary"), *out])
     )
     assert not (tmp_path / "cmp").exists()
+
+
+def test_a_run_with_fastdtw_pairs_with_one_without_on_the_shared_metrics(tmp_path: Path) -> None:
+    a = write_run(tmp_path / "a")
+    b = write_run(tmp_path / "b", better_b())
+    players = pd.read_csv(b / "players.csv")
+    players[FASTDTW_METRIC] = 0.5
+    players.to_csv(b / "players.csv", index=False)
+    out = tmp_path / "cmp"
+    result = runner.invoke(app, ["compare", str(a), str(b), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert f"only one run has {FASTDTW_METRIC}: left out" in result.stdout
+    table = pd.read_csv(out / "compare.csv")
+    assert list(table["metric"]) == list(METRIC_NAMES)
+    assert f"Only one run computed {FASTDTW_METRIC}: left out." in (out / "compare.md").read_text()

@@ -16,7 +16,13 @@ import pytest
 import similaritymeasures
 
 from decoy_cli.metrics import dtw, dtw_and_frechet, dtw_mean, frechet
-from decoy_cli.metrics.distances import TIE_RTOL, _sweep, curve_kernel
+from decoy_cli.metrics.distances import (
+    PRUNE_MARGIN,
+    TIE_RTOL,
+    _sweep,
+    _upper_bounds,
+    curve_kernel,
+)
 
 STEPS = ((1, 0), (0, 1), (1, 1))
 
@@ -256,18 +262,37 @@ def pruning_cases() -> Iterator[tuple[np.ndarray, np.ndarray]]:
         yield still, walk[:m]
 
 
-def test_pruning_changes_nothing() -> None:
+def padded(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's layout: (3, n) and (3, m) with b's points reversed, zero-padded."""
+    a_t = np.zeros((3, len(a)))
+    a_t[: a.shape[1]] = a.T
+    b_rev_t = np.zeros((3, len(b)))
+    b_rev_t[: b.shape[1]] = b[::-1].T
+    return a_t, b_rev_t
+
+
+def test_the_bounded_sweep_is_the_full_sweep() -> None:
     for a, b in pruning_cases():
+        a_t, b_rev_t = padded(a, b)
         for dims in range(1, a.shape[1] + 1):
+            total_bound, frechet_bound = _upper_bounds(a_t, b_rev_t, dims)
+            limit = total_bound * (1 + PRUNE_MARGIN)
+            pruned = _sweep(a_t, b_rev_t, dims, TIE_RTOL, limit, frechet_bound)
+            full = _sweep(a_t, b_rev_t, dims, TIE_RTOL, math.inf, math.inf)
+            assert math.isfinite(pruned[0]) and math.isfinite(pruned[2])
+            assert pruned == full
             assert curve_kernel(a, b, dims, True) == curve_kernel(a, b, dims, False)
 
 
-def test_a_bound_that_leaves_no_path_is_reported_not_hidden() -> None:
-    # The sweep says "no path" when its limits are below every path; curve_kernel then sweeps
-    # in full instead of returning a wrong value.
-    a_t = np.array([[0.0, 1.0, 2.0], [0.0] * 3, [0.0] * 3])
-    b_rev_t = np.array([[2.5, 1.5, 0.5], [0.0] * 3, [0.0] * 3])
-    assert _sweep(a_t, b_rev_t, 3, TIE_RTOL, 0.1, 0.01) == (math.inf, 0, math.inf)
+def test_the_sweep_skips_what_lies_above_its_limits() -> None:
+    # Limits just below the optimum leave no path: the sweep really drops those cells.
+    rng = np.random.default_rng(13)
+    a = np.cumsum(rng.normal(size=(40, 3)), axis=0)
+    b = a + rng.normal(scale=0.3, size=a.shape)
+    a_t, b_rev_t = padded(a, b)
+    total, _, frechet_sq = _sweep(a_t, b_rev_t, 3, TIE_RTOL, math.inf, math.inf)
+    assert _sweep(a_t, b_rev_t, 3, TIE_RTOL, total * 0.999, math.inf)[0] == math.inf
+    assert _sweep(a_t, b_rev_t, 3, TIE_RTOL, math.inf, frechet_sq * 0.999)[2] == math.inf
 
 
 def test_dtw_and_frechet_is_dtw_and_frechet_of_the_first_coordinates() -> None:
@@ -280,6 +305,10 @@ def test_dtw_and_frechet_is_dtw_and_frechet_of_the_first_coordinates() -> None:
     assert dtw_and_frechet(a, b).frechet == frechet(a, b)
     with pytest.raises(ValueError, match="frechet_dims"):
         dtw_and_frechet(a, b, frechet_dims=4)
+    with pytest.raises(ValueError, match="frechet_dims"):
+        dtw_and_frechet(a, b, frechet_dims=True)
+    with pytest.raises(TypeError):
+        dtw_and_frechet(a, b, frechet_dims=2.5)  # type: ignore[arg-type]
 
 
 def test_more_than_three_coordinates_are_refused() -> None:

@@ -9,7 +9,9 @@ ratio of the section's headline figures (`headlines`), reported as median, min a
 
 The baseline is a git ref of the checkout this code runs from (exported with `git archive` into
 a folder beside the report, removed afterwards) or the Python interpreter of another environment
-where another version is installed.
+where another version is installed. Each run starts in an empty folder beside the report and
+writes its result there atomically; a baseline that turns out to run the current code is an
+error, not a ratio of 1.
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ import statistics
 import subprocess
 import sys
 import tarfile
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,6 +36,8 @@ from decoy_cli.errors import DecoyError
 
 DRIVER = """
 import json, os, sys
+if sys.path and sys.path[0] in ("", os.getcwd()):
+    sys.path.pop(0)  # `python -c` puts the working folder first: only the tree's code may load
 args = json.loads(sys.argv[1])
 devnull = os.open(os.devnull, os.O_WRONLY)
 os.dup2(devnull, 1)
@@ -46,8 +52,9 @@ try:
 except Exception as error:
     result = {"error": f"{type(error).__name__}: {error}"}
 result["code"] = decoy_cli.__file__
-with open(args["result"], "w") as handle:
+with open(args["result"] + ".part", "w") as handle:
     json.dump(result, handle)
+os.replace(args["result"] + ".part", args["result"])
 """
 """Runs one section of whichever decoy_cli the interpreter imports; writes its JSON result."""
 
@@ -70,31 +77,49 @@ def current_tree() -> CodeTree:
     return CodeTree("current", sys.executable, package_parent)
 
 
-def baseline_tree(ref: str, work: Path) -> CodeTree:
-    """The baseline: the Python of another environment (a path to an interpreter), or a git
-    ref of this checkout exported into `work`. A ref that does not resolve, or no checkout, is
-    a DecoyError."""
+@contextmanager
+def baseline_tree(ref: str, work: Path) -> Iterator[CodeTree]:
+    """The baseline while the block runs: the Python of another environment (a path to an
+    interpreter), or a git ref of this checkout exported into a fresh folder in `work` that is
+    removed afterwards, whatever happens. Neither is a DecoyError."""
     candidate = Path(ref)
     if candidate.is_file() and os.access(candidate, os.X_OK):
-        return CodeTree(f"python {candidate}", str(candidate), None)
+        yield CodeTree(f"python {candidate}", str(candidate), None)
+        return
     root = _checkout_root()
-    sha = _git(root, "rev-parse", "--verify", "--quiet", f"{ref}^{{commit}}").strip()
+    try:
+        sha = _git(root, "rev-parse", "--verify", "--quiet", f"{ref}^{{commit}}").strip()
+    except DecoyError:
+        raise DecoyError(
+            f"--baseline {ref}: neither a commit of this checkout nor an executable Python"
+        ) from None
     archive = subprocess.run(
-        ["git", "-C", str(root), "archive", "--format=tar", sha],
-        capture_output=True,
-        check=False,
+        ["git", "-C", str(root), "archive", "--format=tar", sha], capture_output=True, check=False
     )
     if archive.returncode != 0:
         raise DecoyError(f"--baseline {ref}: git archive failed: {archive.stderr.decode().strip()}")
-    target = work / f"baseline-{sha[:12]}"
-    if target.exists():
-        shutil.rmtree(target)
-    target.mkdir(parents=True)
-    with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
-        tar.extractall(target, filter="data")
-    if not (target / "decoy_cli" / "bench" / "__init__.py").is_file():
-        raise DecoyError(f"--baseline {ref}: commit {sha[:12]} has no decoy_cli/bench to run")
-    return CodeTree(f"{ref} ({sha[:12]})", sys.executable, target)
+    target = Path(tempfile.mkdtemp(prefix=f"baseline-{sha[:12]}-", dir=work))
+    try:
+        _extract(archive.stdout, target)
+        if not (target / "decoy_cli" / "bench" / "__init__.py").is_file():
+            raise DecoyError(f"--baseline {ref}: commit {sha[:12]} has no decoy_cli/bench to run")
+        yield CodeTree(f"{ref} ({sha[:12]})", sys.executable, target)
+    finally:
+        shutil.rmtree(target, ignore_errors=True)
+
+
+def _extract(archive: bytes, target: Path) -> None:
+    """Unpack a tar of the repository's files, refusing any member that would land outside
+    `target` (Python's "data" filter where this Python has it, the same check by hand before)."""
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        if hasattr(tarfile, "data_filter"):
+            tar.extractall(target, filter="data")
+            return
+        for member in tar.getmembers():
+            parts = Path(member.name).parts
+            if member.name.startswith("/") or ".." in parts or member.issym() or member.islnk():
+                raise DecoyError(f"the baseline archive holds an unsafe member: {member.name}")
+        tar.extractall(target)  # every member checked above
 
 
 def _checkout_root() -> Path:
@@ -121,37 +146,36 @@ def _git(where: Path, *args: str) -> str:
     return done.stdout
 
 
-def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | None, result: Path):
-    """One section in a fresh process of `tree`; its result, or {"error": one line}."""
+def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | None, work: Path):
+    """One section in a fresh process of `tree`, in an empty folder of `work` removed after;
+    its result, or {"error": one line}."""
     env = dict(os.environ)
     if tree.path is not None:
         env["PYTHONPATH"] = os.pathsep.join(
             [str(tree.path), *filter(None, [env.get("PYTHONPATH")])]
         )
-    args = {
-        "config": config,
-        "data": str(data) if data else None,
-        "section": section,
-        "result": str(result),
-    }
-    result.unlink(missing_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix="section-", dir=work))
+    result = scratch / "result.json"
+    args = {"config": config, "data": str(data) if data else None, "section": section}
+    args["result"] = str(result)
     try:
         done = subprocess.run(
             [tree.python, "-c", DRIVER, json.dumps(args)],
             env=env,
-            cwd=result.parent,  # not the caller's folder: `python -c` imports from there first
+            cwd=scratch,
             capture_output=True,
             text=True,
             timeout=RUN_TIMEOUT_S,
             check=False,
         )
-    except (OSError, subprocess.TimeoutExpired) as error:
+        if not result.is_file():
+            last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            return {"error": f"{tree.label}: the section process failed: {last}"}
+        loaded: dict[str, Any] = json.loads(result.read_text())
+    except (OSError, ValueError, subprocess.TimeoutExpired) as error:
         return {"error": f"{tree.label}: {error}"}
-    if not result.is_file():
-        last = (done.stderr.strip().splitlines() or ["no output"])[-1]
-        return {"error": f"{tree.label}: the section process failed: {last}"}
-    loaded: dict[str, Any] = json.loads(result.read_text())
-    result.unlink()
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
     if tree.path is not None and not str(loaded.get("code", "")).startswith(str(tree.path)):
         return {"error": f"{tree.label}: ran {loaded.get('code')}, not the code in {tree.path}"}
     return loaded
@@ -161,20 +185,21 @@ def headlines(section: str, result: dict[str, Any]) -> dict[str, float]:
     """The figures a speed-up is the ratio of, higher is better (a time becomes a rate)."""
     if "error" in result or "skipped" in result:
         return {}
+    figures: dict[str, Any] = {}
     if section == "metrics":
-        return {"pairs/s": result["pairs_per_s"]}
-    if section == "reader":
-        return {"MB/s (JSON)": result["mb_per_s_decompressed"]} if result.get("files") else {}
-    if section == "replay":
-        return {"rounds/s": result["rounds_per_s"]} if result.get("rounds") else {}
-    if section == "table1":
-        return {f"ticks/s, {row['agents']} agents": row["ticks_per_s"] for row in result["rows"]}
-    if section == "combat_step":
-        return {
-            f"steps/s, {row['layout']}": 1e3 / row["parts"]["step"]["median_ms"]
-            for row in result["rows"]
-        }
-    return {}
+        figures = {"pairs/s": result.get("pairs_per_s")}
+    elif section == "reader" and result.get("files"):
+        figures = {"MB/s (JSON)": result.get("mb_per_s_decompressed")}
+    elif section == "replay" and result.get("rounds"):
+        figures = {"rounds/s": result.get("rounds_per_s")}
+    elif section == "table1":
+        rows = result.get("rows", [])
+        figures = {f"ticks/s, {row.get('agents')} agents": row.get("ticks_per_s") for row in rows}
+    elif section == "combat_step":
+        for row in result.get("rows", []):
+            median = row.get("parts", {}).get("step", {}).get("median_ms")
+            figures[f"steps/s, {row.get('layout')}"] = 1e3 / median if median else None
+    return {k: float(v) for k, v in figures.items() if isinstance(v, int | float) and v > 0}
 
 
 @dataclass(frozen=True)
@@ -217,13 +242,20 @@ def side_by_side(
     """Each section `repeats` times on each side, alternating; raw results and the ratios."""
     runs: dict[str, dict[str, list[dict[str, Any]]]] = {}
     ratios: list[Ratio] = []
-    result_file = work / "section-result.json"
     for section in sections:
         runs[section] = {"current": [], "baseline": []}
         for repeat in range(repeats):
             for side, tree in (("current", current), ("baseline", baseline)):
                 on_run(section, side, repeat)
-                runs[section][side].append(run_in(tree, section, config, data, result_file))
+                runs[section][side].append(run_in(tree, section, config, data, work))
+        same = {str(r["code"]) for r in runs[section]["current"] if "code" in r} & {
+            str(r["code"]) for r in runs[section]["baseline"] if "code" in r
+        }
+        if same:
+            raise DecoyError(
+                f"the baseline ran the same code as the current side ({min(same)}): give a "
+                "commit, or the Python of an environment with another version installed"
+            )
         figures_c = [headlines(section, r) for r in runs[section]["current"]]
         figures_b = [headlines(section, r) for r in runs[section]["baseline"]]
         for figure in figures_c[0] if figures_c else {}:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 from typing import Any
 
@@ -179,17 +178,19 @@ def _side_by_side(
     repeats: int,
     out: Path,
 ) -> None:
-    """Run the sections on this code and on the baseline, alternating; print the ratios."""
-    work = out.parent
+    """Run the sections on this code and on the baseline, alternating; print the ratios.
+    Paths are made absolute: the runs start in folders of their own."""
+    work = out.resolve().parent
     work.mkdir(parents=True, exist_ok=True)
-    baseline = baseline_tree(ref, work)
-    data = bench_data.folder if bench_data else None
-    console.print(
-        f"side by side: current code against {baseline.label}, {repeats} runs each, "
-        f"alternating; data: {data or 'none (replay and reader skipped)'}",
-        highlight=False,
-    )
-    try:
+    if Path(config["models"]).exists():
+        config = config | {"models": str(Path(config["models"]).resolve())}
+    data = bench_data.folder.resolve() if bench_data else None
+    with baseline_tree(ref, work) as baseline:
+        console.print(
+            f"side by side: current code against {baseline.label}, {repeats} runs each, "
+            f"alternating; data: {data or 'none (replay and reader skipped)'}",
+            highlight=False,
+        )
         with Progress(
             TextColumn("{task.description}", markup=False),
             TimeElapsedColumn(),
@@ -209,9 +210,6 @@ def _side_by_side(
                     task, description=f"{TITLES[section]}: {side}, run {k + 1} of {repeats}"
                 ),
             )
-    finally:
-        if baseline.path is not None:
-            shutil.rmtree(baseline.path, ignore_errors=True)
     console.print(_ratio_table(result))
     write_json(out, {"machine": machine_info(), "side_by_side": result}, sort_keys=False)
     console.print(f"report written to {out}", highlight=False)

@@ -32,6 +32,11 @@ def compare(
     console.print(
         f"{len(comparison.differences)} player-rounds of {comparison.rounds} rounds paired "
         f"({comparison.only_a} only in A, {comparison.only_b} only in B); metres, lower is better"
+        + (
+            f"; only one run has {', '.join(comparison.dropped)}: left out"
+            if comparison.dropped
+            else ""
+        )
     )
     table = Table(title="B − A")
     for column in ("metric", "mean A", "mean B", "B − A", "95% interval", "better", "worse", "p"):

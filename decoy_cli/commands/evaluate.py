@@ -105,7 +105,8 @@ def evaluate(
         show_default=False,
         help="Also compute paper_dtw_fastdtw, the paper's DTW as its code computed it (the "
         "fastdtw package, radius 1), beside the exact paper_dtw. Slow (pure Python). Default: "
-        "on for the paper's Table 2 setting (--no-combat --no-bomb), off otherwise.",
+        "on for the paper's Table 2 setting (--no-combat --no-bomb), off otherwise. Part of "
+        "the cache key: switching it replays the rounds again.",
     ),
     implausible: str = typer.Option(
         "fail",

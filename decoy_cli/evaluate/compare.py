@@ -24,7 +24,7 @@ import pandas as pd
 
 from decoy_cli.errors import CompareError
 from decoy_cli.evaluate.intervals import round_codes
-from decoy_cli.metrics import ALL_METRIC_NAMES
+from decoy_cli.metrics import ALL_METRIC_NAMES, FASTDTW_METRIC
 from decoy_cli.metrics.bootstrap import RoundBootstrap
 
 KEY = ["match", "round", "player"]
@@ -73,6 +73,8 @@ class Comparison:
     only_a: int
     """Evaluated player-rounds of A that B did not evaluate (and the reverse)."""
     only_b: int
+    dropped: tuple[str, ...] = ()
+    """Optional metrics only one run computed (`paper_dtw_fastdtw`), left out of the pairing."""
 
 
 def _csv(path: Path) -> pd.DataFrame:
@@ -118,11 +120,11 @@ def read_run(folder: Path) -> Run:
 
 def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
     """Pair the player-rounds both runs evaluated and compare them (module docstring)."""
-    if a.metrics != b.metrics:
-        only = sorted(set(a.metrics) ^ set(b.metrics))
+    only = set(a.metrics) ^ set(b.metrics)
+    if only - {FASTDTW_METRIC}:
         raise CompareError(
             f"{a.folder} and {b.folder} have different metric sets (only one has "
-            f"{', '.join(only)}): runs of different versions cannot be paired"
+            f"{', '.join(sorted(only))}): runs of different versions cannot be paired"
         )
     shas = a.rounds[["match", "round", "file_sha"]].merge(
         b.rounds[["match", "round", "file_sha"]], on=["match", "round"], suffixes=("_a", "_b")
@@ -134,7 +136,7 @@ def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
             f"{a.folder} and {b.folder} read different data for {len(differ)} rounds (round "
             f"{first['round']} of {first['match']} first): only runs of the same files pair"
         )
-    metrics = list(a.metrics)
+    metrics = [m for m in a.metrics if m in b.metrics]  # an optional metric one run lacks: out
     left = a.players[a.players["reason"].isna()][[*KEY, "side", *metrics]]
     right = b.players[b.players["reason"].isna()][[*KEY, *metrics]]
     pairs = left.merge(right, on=KEY, suffixes=("_a", "_b"))
@@ -177,6 +179,7 @@ def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
         rounds=rounds,
         only_a=len(left) - len(pairs),
         only_b=len(right) - len(pairs),
+        dropped=tuple(sorted(only)),
     )
 
 

@@ -80,7 +80,12 @@ def compare_markdown(comparison: Comparison) -> str:
         f"A: `{comparison.a.folder}`; B: `{comparison.b.folder}`.",
         f"{len(comparison.differences)} player-rounds of {comparison.rounds} rounds paired, "
         "read from the same content in both runs; "
-        f"{comparison.only_a} evaluated only in A, {comparison.only_b} only in B (left out).",
+        f"{comparison.only_a} evaluated only in A, {comparison.only_b} only in B (left out)."
+        + (
+            f" Only one run computed {', '.join(comparison.dropped)}: left out."
+            if comparison.dropped
+            else ""
+        ),
         "Metres; lower is better. The interval is a 95% bootstrap of the mean difference that "
         "resamples whole rounds; better / worse: the share of player-rounds where B is closer "
         "/ farther than A; Wilcoxon: two-sided signed-rank test of the differences.",

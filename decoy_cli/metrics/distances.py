@@ -25,7 +25,8 @@ previous diagonals, so the loops over a diagonal vectorise), and cells that cann
 optimal path are skipped. Two cheap warping paths (the staircase along the proportional diagonal
 and a greedy walk) give an upper bound U on the DTW total and V on the Fréchet distance. Costs only
 grow along a path, so a cell whose accumulated DTW cost exceeds U·(1 + `PRUNE_MARGIN`) is on no
-path the rule above can choose (the margin covers rounding and the tie tolerance), and a cell whose
+path the rule above can choose (the margin covers rounding and the tie tolerance compounded along
+paths of up to `PRUNE_MARGIN / TIE_RTOL` = a million steps), and a cell whose
 Fréchet value exceeds V is on no optimal coupling; such cells count as unreachable and each
 diagonal is computed only between the first and last reachable cells its predecessors allow. The
 results are bit for bit those of the full dynamic program (tests/test_metrics_distances.py).
@@ -37,6 +38,7 @@ Empty input, mismatched dimensions, more than 3 coordinates and non-finite coord
 from __future__ import annotations
 
 import math
+import operator
 from typing import NamedTuple
 
 import numpy as np
@@ -82,8 +84,9 @@ def _squared(
 
 @njit(cache=True, nogil=True)
 def _upper_bounds(a_t: np.ndarray, b_rev_t: np.ndarray, frechet_dims: int) -> tuple[float, float]:
-    """(DTW total, squared Fréchet value) of the better of two warping paths: the staircase
-    along the proportional diagonal and a greedy walk to the cheapest next cell."""
+    """(DTW total, squared Fréchet value), each the smaller over two warping paths (the two
+    may come from different paths; each is the value of a real path): the staircase along the
+    proportional diagonal and a greedy walk to the cheapest next cell."""
     n = a_t.shape[1]
     m = b_rev_t.shape[1]
     stair_total = 0.0
@@ -240,8 +243,8 @@ def _sweep(
 
 def _as_curves(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Validate two curves and return them as float64 (n, d) and (m, d) arrays."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
+    a = np.ascontiguousarray(a, dtype=np.float64)  # one compiled layout
+    b = np.ascontiguousarray(b, dtype=np.float64)
     if a.ndim != 2 or b.ndim != 2:
         raise ValueError(
             f"curves must be 2-D (points, dims) arrays, got shapes {a.shape} and {b.shape}"
@@ -263,10 +266,10 @@ def curve_kernel(
 ) -> tuple[float, int, float]:
     """(DTW total, DTW steps, Fréchet distance) of curves already validated by `_as_curves`.
 
-    Pads to 3 coordinates (zero coordinates add exactly nothing), bounds, sweeps; the full sweep
-    if the bounds ever left no path (they cannot, but it costs nothing to be safe), or with
-    `prune` off (the tests compare the two). For callers in this package that validated their
-    curves once (the trajectory metrics).
+    Pads to 3 coordinates (zero coordinates add exactly nothing), bounds and sweeps; with
+    `prune` off the sweep computes every cell (the tests compare the two). The bounds are the
+    values of real paths computed with the sweep's arithmetic, so they never cut off the last
+    cell. For callers in this package that validated their curves once (the trajectory metrics).
     """
     n, d = a.shape
     m = b.shape[0]
@@ -277,15 +280,13 @@ def curve_kernel(
             a_t[k, i] = a[i, k]
         for j in range(m):
             b_rev_t[k, m - 1 - j] = b[j, k]
-    total, steps, frechet_sq = math.inf, 0, math.inf
+    dtw_limit = frechet_limit = math.inf
     if prune:
-        total_bound, frechet_bound = _upper_bounds(a_t, b_rev_t, frechet_dims)
+        total_bound, frechet_limit = _upper_bounds(a_t, b_rev_t, frechet_dims)
         dtw_limit = total_bound + total_bound * PRUNE_MARGIN
-        total, steps, frechet_sq = _sweep(
-            a_t, b_rev_t, frechet_dims, TIE_RTOL, dtw_limit, frechet_bound
-        )
-    if not (math.isfinite(total) and math.isfinite(frechet_sq)):
-        total, steps, frechet_sq = _sweep(a_t, b_rev_t, frechet_dims, TIE_RTOL, math.inf, math.inf)
+    total, steps, frechet_sq = _sweep(
+        a_t, b_rev_t, frechet_dims, TIE_RTOL, dtw_limit, frechet_limit
+    )
     return total, steps, math.sqrt(frechet_sq)
 
 
@@ -298,8 +299,8 @@ def dtw_and_frechet(
     e.g. 2 for the x-y projection of 3-D positions.
     """
     a, b = _as_curves(a, b)
-    dims = a.shape[1] if frechet_dims is None else frechet_dims
-    if not 1 <= dims <= a.shape[1]:
+    dims = a.shape[1] if frechet_dims is None else operator.index(frechet_dims)
+    if isinstance(frechet_dims, bool) or not 1 <= dims <= a.shape[1]:
         raise ValueError(f"frechet_dims must be between 1 and {a.shape[1]}, got {dims}")
     return CurveDistances(*curve_kernel(a, b, dims))
 

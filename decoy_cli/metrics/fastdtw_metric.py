@@ -6,7 +6,8 @@ protocol. `paper_dtw_fastdtw` is that call's distance divided by the length of t
 it returns, the normalisation of the exact `paper_dtw` (docs/metrics.md).
 
 FastDTW is an approximation: it searches only a band around the path projected from a coarser
-resolution, so its total cost is never below the exact DTW's minimum total cost (`dtw`). The
+resolution, so its total cost is never below the exact DTW's minimum total cost (`dtw`; up to
+the rounding of sums added in another order, `FASTDTW_RTOL`). The
 per-step mean can still come out below `paper_dtw` when FastDTW's path is longer than the exact
 one; the evaluation counts how often. The package is pure Python here (its C extension does not
 build on current Pythons), which makes it far slower than the exact kernel: `decoy evaluate`
@@ -19,6 +20,10 @@ import numpy as np
 
 RADIUS = 1
 """FastDTW's search radius; the package's default, as the paper's code called it."""
+
+FASTDTW_RTOL = 1e-9
+"""Relative difference below which FastDTW and the exact DTW count as equal: scipy's Euclidean
+distance and the exact kernel add a point's squared coordinates in different orders."""
 
 
 def fastdtw_mean(a: np.ndarray, b: np.ndarray) -> float:

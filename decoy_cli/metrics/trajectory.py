@@ -99,10 +99,13 @@ def resample(points: np.ndarray, length: int = PAPER_LENGTH) -> np.ndarray:
     Output point q sits at fractional index q·(n−1)/(length−1) of the input, so the first and
     last points are kept exactly.
     """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.ndim != 2:
+        raise ValueError(f"resampling needs an (n, d) array of points, got shape {points.shape}")
     n = points.shape[0]
     if n < 2 or length < 2:
         raise ValueError(f"resampling needs at least 2 input and output points, got {n}, {length}")
-    return resample_points(np.asarray(points, dtype=np.float64), length)
+    return resample_points(points, length)
 
 
 def _validated(
@@ -112,8 +115,8 @@ def _validated(
     simulated_alive: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Check shapes (one frame clock, 3-D points, boolean masks) and return float/bool arrays."""
-    original = np.asarray(original, dtype=np.float64)
-    simulated = np.asarray(simulated, dtype=np.float64)
+    original = np.ascontiguousarray(original, dtype=np.float64)  # one compiled layout
+    simulated = np.ascontiguousarray(simulated, dtype=np.float64)
     original_alive = np.asarray(original_alive)
     simulated_alive = np.asarray(simulated_alive)
     if original.ndim != 2 or original.shape[1] != 3 or simulated.shape != original.shape:
