@@ -109,6 +109,9 @@ class Round:
     `startTick`."""
     warnings: tuple[str, ...] = ()
     """Implausible data kept under the "warn" policy (decoy_cli/esta/plausibility.py)."""
+    buy_types: dict[str, str] = field(default_factory=dict)
+    """awpy's buy type of each side that has one ("Full Eco", "Semi Eco", "Semi Buy",
+    "Full Buy"), from `tBuyType` and `ctBuyType`; what armour a side could afford."""
 
     @property
     def num_frames(self) -> int:
@@ -311,6 +314,11 @@ def _build_round(
         end_tick=end_tick,
         clock=clock,
         warnings=warnings,
+        buy_types={
+            side: value
+            for side, value in (("T", state.tBuyType), ("CT", state.ctBuyType))
+            if isinstance(value, str) and value
+        },
     )
 
 

@@ -239,6 +239,8 @@ class RoundState(msgspec.Struct):
     bombPlantTick: float | None = None
     winningSide: str | None = None
     roundEndReason: str | None = None
+    tBuyType: str | None = None
+    ctBuyType: str | None = None
     frames: list[FrameState] | None = None
     damages: list[DamageEvent] | None = None
     kills: list[KillEvent] | None = None

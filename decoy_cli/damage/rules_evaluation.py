@@ -1,0 +1,184 @@
+"""The rules-grounded damage outcome model on real hits, leave-rounds-out.
+
+The model: the hit group drawn from a `HitGroupModel` learned from the training hits, the damage
+computed by the game's rules (decoy_cli/damage/rules.py) and capped at 100 HP, as the DOG's
+target is. The protocol is the paper's generative one, made independent of one split: the rounds
+are dealt into `FOLDS` folds; each fold's hits are predicted (`DRAWS` draws each) by a model that
+saw the other folds only, so every hit is a test hit once. On the pooled predictions:
+
+* mean Wasserstein distance between generated and real damage per (weapon, hit group) cell with
+  at least `MIN_CELL` real hits (the real cell by real group, the generated one by drawn group,
+  as `decoy_cli/damage/scores.wasserstein_cells` defines it), and its largest cell;
+* per weapon with at least `MIN_WEAPON_HITS` hits, the total variation distance between the real
+  and the drawn hit-group distributions;
+
+and per fold the mean Wasserstein over the cells the fold has (mean and spread over folds).
+
+The victim's armour: where the round has frames, they say it (`armor`, `helmet`). Events without
+frames still tell some of it: a hit that costs armour says the victim wore it there (kevlar, and
+a helmet on a head hit). Where the hit does not say (a leg, or a head without armour damage), the
+victim wears armour with the training hits' share of armoured body hits of victims whose side had
+the same buy type (awpy's `tBuyType`/`ctBuyType`: an eco round buys little armour), and a drawn
+head hit on an armoured victim meets a helmet with the training share of such head hits that
+met one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
+from decoy_cli.damage.rules import ARMORED_GROUPS, rule_group, shot_damage
+from decoy_cli.damage.rules_check import firearm_hits
+from decoy_cli.damage.scores import wasserstein_cells
+from decoy_cli.esta import Round
+
+FOLDS = 5
+DRAWS = 10
+MIN_CELL = 5
+MIN_WEAPON_HITS = 30
+MAX_DAMAGE_HP = 100
+MIN_SHARE_HITS = 5
+"""Fewest training hits of a buy type for its own armour shares; fewer use all hits'."""
+
+
+@dataclass(frozen=True)
+class RulesEvaluation:
+    """The pooled and per-fold results (module doc)."""
+
+    hits: int
+    rounds: int
+    cells: pd.DataFrame
+    """weapon, group, real, generated, wasserstein_hp over the pooled test predictions."""
+    mean_wasserstein_hp: float
+    max_wasserstein_hp: float
+    fold_mean_wasserstein_hp: list[float]
+    group_tv: pd.DataFrame
+    """weapon, hits, tv, and the real and drawn shares of every group."""
+    armour_shares: dict[str, tuple[float, float]]
+    """(kevlar share, helmet share) by the victim side's buy type, over all training folds."""
+
+
+def _shares(hits: pd.DataFrame) -> tuple[float, float]:
+    body = hits[hits["group"].isin(list(ARMORED_GROUPS))]
+    head = hits[hits["group"] == "Head"]
+    armored = float((body["armorDamage"] > 0).mean()) if len(body) else 0.0
+    helmet = float((head["armorDamage"] > 0).mean()) if len(head) else 0.0
+    return armored, helmet
+
+
+def _armour_shares(train: pd.DataFrame) -> dict[str, tuple[float, float]]:
+    """(kevlar share, helmet share) by buy type, and "" for all hits (module doc)."""
+    shares = {"": _shares(train)}
+    for buy, hits in train.groupby("victim_buy"):
+        if len(hits) >= MIN_SHARE_HITS and buy:
+            shares[str(buy)] = _shares(hits)
+    return shares
+
+
+def _victim_state(
+    hit: pd.Series, shares: dict[str, tuple[float, float]], rng: np.random.Generator
+) -> tuple[bool, bool]:
+    """(kevlar, helmet) of the victim of a real hit (module doc)."""
+    armored_share, helmet_share = shares.get(hit["victim_buy"], shares[""])
+    costs_armour = bool(hit["armorDamage"] > 0)
+    if hit["group"] in ARMORED_GROUPS:
+        kevlar = costs_armour
+    elif hit["group"] == "Head" and costs_armour:
+        return True, True
+    else:
+        kevlar = bool(rng.random() < armored_share)
+    return kevlar, kevlar and bool(rng.random() < helmet_share)
+
+
+def evaluate_rules(rounds: Sequence[Round], seed: int = 0) -> RulesEvaluation:
+    """Leave-rounds-out evaluation of the rules-grounded model on the rounds' damage events
+    (module doc)."""
+    tables = [
+        r.damages.assign(round=f"{r.match_id}:{r.round_num}", victim_buy=_victim_buy(r))
+        for r in rounds
+    ]
+    hits, _ = firearm_hits(pd.concat(tables, ignore_index=True))
+    hits = hits.assign(group=[rule_group(g) for g in hits["hitGroup"]])
+    rng = np.random.default_rng(seed)
+    round_keys = np.array(sorted(hits["round"].unique()))
+    folds = np.arange(len(round_keys)) % FOLDS
+    fold_of = dict(zip(rng.permutation(round_keys), folds, strict=True))
+    hits["fold"] = hits["round"].map(fold_of)
+    generated_rows = []
+    fold_means = []
+    for fold in range(FOLDS):
+        train, test = hits[hits["fold"] != fold], hits[hits["fold"] == fold]
+        if not len(test):
+            continue
+        model = HitGroupModel.fit(train["weapon"], train["distance"], train["group"])
+        shares = _armour_shares(train)
+        rows = []
+        for _, hit in test.iterrows():
+            kevlar, helmet = _victim_state(hit, shares, rng)
+            for group in model.sample(rng, [hit["weapon"]] * DRAWS, [hit["distance"]] * DRAWS):
+                damage = shot_damage(
+                    hit["weapon"], group, hit["distance"], armor=100 if kevlar else 0, helmet=helmet
+                ).health
+                rows.append((hit["weapon"], group, min(damage, MAX_DAMAGE_HP)))
+        generated = pd.DataFrame(rows, columns=["weapon", "group", "damage"])
+        generated_rows.append(generated)
+        cells = _cells(test, generated)
+        if len(cells):
+            fold_means.append(float(cells["wasserstein_hp"].mean()))
+    generated = pd.concat(generated_rows, ignore_index=True)
+    cells = _cells(hits, generated)
+    return RulesEvaluation(
+        hits=len(hits),
+        rounds=len(round_keys),
+        cells=cells,
+        mean_wasserstein_hp=float(cells["wasserstein_hp"].mean()) if len(cells) else np.nan,
+        max_wasserstein_hp=float(cells["wasserstein_hp"].max()) if len(cells) else np.nan,
+        fold_mean_wasserstein_hp=fold_means,
+        group_tv=_group_tv(hits, generated),
+        armour_shares=_armour_shares(hits),
+    )
+
+
+def _victim_buy(round_: Round) -> pd.Series:
+    """The buy type of each damage row's victim side ("" when unknown)."""
+    sides = round_.damages.get("victimSide", pd.Series(dtype=object))
+    return sides.map(lambda side: round_.buy_types.get(str(side), "")).fillna("")
+
+
+def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
+    """Wasserstein per (weapon, group) cell with at least `MIN_CELL` real hits."""
+    weapons = sorted(set(real["weapon"]))
+    codes = {w: i for i, w in enumerate(weapons)}
+    found = wasserstein_cells(
+        real["weapon"].map(codes).to_numpy(),
+        real["group"].map(GROUPS.index).to_numpy(),
+        real["hpDamage"].clip(upper=MAX_DAMAGE_HP).to_numpy(np.float64),
+        generated["weapon"].map(codes).to_numpy(),
+        generated["group"].map(GROUPS.index).to_numpy(),
+        generated["damage"].to_numpy(np.float64),
+        min_cell=MIN_CELL,
+    )
+    rows = [
+        (weapons[int(c.weapon)], c.hit_group, c.real, c.generated, c.wasserstein_hp) for c in found
+    ]
+    return pd.DataFrame(rows, columns=["weapon", "group", "real", "generated", "wasserstein_hp"])
+
+
+def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
+    """Per weapon with enough hits: total variation between real and drawn group shares."""
+    rows = []
+    for weapon, group in real.groupby("weapon"):
+        if len(group) < MIN_WEAPON_HITS:
+            continue
+        p = group["group"].value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
+        drawn = generated[generated["weapon"] == weapon]["group"]
+        q = drawn.value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
+        rows.append({"weapon": weapon, "hits": len(group), "tv": 0.5 * float((p - q).abs().sum())})
+        rows[-1] |= {f"real_{g}": float(p[g]) for g in GROUPS}
+        rows[-1] |= {f"drawn_{g}": float(q[g]) for g in GROUPS}
+    return pd.DataFrame(rows)
