@@ -131,6 +131,14 @@ def dip_table(metrics: dict[str, Any], title: str) -> Table:
     for name in ("accuracy", "precision", "recall", "f1", "roc_auc", "average_precision"):
         table.add_row(name, _number(metrics[name]), _number(PAPER_DIP.get(name)))
     table.add_row("threshold", _number(metrics["threshold"]), _number(PAPER_DIP["threshold"]))
+    for name, label in (
+        ("brier", "Brier score"),
+        ("ece", "expected calibration error"),
+        ("brier_calibrated", "Brier score, calibrated"),
+        ("ece_calibrated", "expected calibration error, calibrated"),
+    ):
+        if name in metrics:
+            table.add_row(label, _number(metrics[name]), "–")
     table.add_row(
         "samples (positive / negative)",
         f"{metrics['positives']:,} / {metrics['negatives']:,}",

@@ -89,6 +89,59 @@ def import_decoy(
     )
 
 
+@app.command("calibrate")
+def calibrate(
+    model_folder: Path = typer.Argument(..., help="A model folder with dip.pt/json."),
+    data: list[Path] = typer.Argument(..., help=DATA_HELP),
+    method: str = typer.Option(
+        "platt", "--method", help="platt (two parameters), temperature (one) or none."
+    ),
+    split: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
+    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
+    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
+    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
+    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+) -> None:
+    """Calibrate a folder's DIP on the validation part of the split (Platt or temperature
+    scaling) and write dip_calibration.json into the folder; prints the Brier score and the
+    expected calibration error before and after on the validation and test parts (the same
+    split options as training give the same parts)."""
+    from decoy_cli.damage.folder_calibration import calibrate_dip_folder
+
+    choice = SampleChoice(
+        data=data,
+        mode=mode,
+        window_s=window,
+        split_by=split,
+        seed=seed,
+        val_fraction=val_fraction,
+        test_fraction=test_fraction,
+    )
+    bars, on_file, _ = progress_bars()
+    with bars:
+        result = calibrate_dip_folder(
+            folder=model_folder, choice=choice, kind=method, on_file=on_file
+        )
+    console = make_console()
+    table = Table(title=f"DIP calibration ({result.calibration.kind}) of {model_folder}")
+    for column in ("part", "samples (hits)", "Brier", "Brier after", "ECE", "ECE after"):
+        table.add_column(column, justify="left" if column == "part" else "right")
+    for part, s in result.scores.items():
+        table.add_row(
+            part,
+            f"{s['samples']:.0f} ({s['positives']:.0f})",
+            *(f"{s[k]:.3f}" for k in ("brier", "brier_calibrated", "ece", "ece_calibrated")),
+        )
+    console.print(table)
+    c = result.calibration
+    console.print(
+        f"p' = sigmoid({c.a:.4f} * logit(p) + {c.b:.4f}); threshold {c.threshold:.3f} on the "
+        f"calibrated scale; written to {result.path}",
+        highlight=False,
+    )
+
+
 @app.command("evaluate")
 def evaluate(
     model_folder: Path = typer.Argument(

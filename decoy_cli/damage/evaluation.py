@@ -3,7 +3,9 @@ metrics of what they say (the numbers themselves: scores.py; the figures:
 evaluation_figures.py).
 
 DIP (a classifier of "does the attacker damage the victim in this step"): accuracy, precision,
-recall and F1 at the decision threshold, ROC AUC and average precision over all thresholds.
+recall and F1 at the decision threshold, ROC AUC and average precision over all thresholds, and
+how calibrated its probabilities are: Brier score and expected calibration error
+(decoy_cli/damage/calibration.py).
 The threshold of a trained DIP is chosen on the validation split by `best_f1_threshold`.
 
 DOG (a conditional VAE of the damage and hit group of a damaging pair):
@@ -32,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from decoy_cli.damage.calibration import brier_score, expected_calibration_error
 from decoy_cli.damage.features import HIT_GROUPS
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
 from decoy_cli.damage.scores import (
@@ -100,11 +103,14 @@ def evaluate_dip(dip: LoadedDip, samples: Samples, threshold: float | None = Non
         raise ValueError("no samples to evaluate DIP on")
     probabilities = dip_probabilities(dip, samples)
     chosen = dip.threshold if threshold is None else threshold
-    return DipEvaluation(
-        classification_metrics(samples.hit, probabilities, chosen),
-        samples.hit.copy(),
-        probabilities,
-    )
+    metrics = classification_metrics(samples.hit, probabilities, chosen)
+    metrics["brier"] = brier_score(samples.hit, probabilities)
+    metrics["ece"] = expected_calibration_error(samples.hit, probabilities)
+    if dip.calibration is not None:
+        calibrated = dip.calibration.apply(probabilities)
+        metrics["brier_calibrated"] = brier_score(samples.hit, calibrated)
+        metrics["ece_calibrated"] = expected_calibration_error(samples.hit, calibrated)
+    return DipEvaluation(metrics, samples.hit.copy(), probabilities)
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from typing import Any
 import torch
 from torch import nn
 
+from decoy_cli.damage.calibration import Calibration
 from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
@@ -45,6 +46,8 @@ class LoadedDip:
     spec: FeatureSpec
     threshold: float
     metadata: dict[str, Any] = field(default_factory=dict)
+    calibration: Calibration | None = None
+    """The folder's `dip_calibration.json` (`decoy models calibrate`), when it has one."""
 
 
 @dataclass
@@ -126,7 +129,29 @@ def load_dip(folder: str | Path) -> LoadedDip:
         FeatureSpec.from_json(description["features"]),
         float(threshold),
         description["metadata"],
+        load_calibration(Path(folder)),
     )
+
+
+CALIBRATION_FILE = "dip_calibration.json"
+
+
+def load_calibration(folder: Path) -> Calibration | None:
+    """The folder's DIP calibration, None without one; an unreadable one is a ModelError."""
+    path = folder / CALIBRATION_FILE
+    if not path.is_file():
+        return None
+    try:
+        return Calibration.from_json(path.read_text())
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ModelError(f"{path}: not a DIP calibration ({error})") from None
+
+
+def save_calibration(folder: Path, calibration: Calibration) -> Path:
+    """Write the DIP calibration into the model folder."""
+    path = Path(folder) / CALIBRATION_FILE
+    write_atomic(path, calibration.to_json().encode())
+    return path
 
 
 def load_dog(folder: str | Path) -> LoadedDog:

@@ -1,0 +1,154 @@
+"""How well DIP's probabilities mean what they say, and the maps that make them mean it.
+
+A classifier's probability p is calibrated when, among the pairs it gives p, a share p is hit.
+Measures (all over held-out samples):
+
+* `brier_score`: mean (p − y)²; 0 is perfect, 0.25 is a coin;
+* `expected_calibration_error`: over `BINS` equal-width bins of p, the sample-weighted mean of
+  |share hit − mean p| in the bin;
+* `reliability_curve`: per bin, the mean p, the share hit and the count (the reliability diagram).
+
+Recalibration, fitted on the validation split (never on the test samples):
+
+* `Platt`: p' = σ(a·logit(p) + b), the two parameters minimising the log loss;
+* `Temperature`: p' = σ(logit(p) / T), one parameter (a = 1/T, b = 0).
+
+Both keep the order of the probabilities, so ROC AUC and average precision do not change; the
+threshold that gave the best F1 moves with them (`Calibration.threshold`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+BINS = 10
+"""Equal-width probability bins of the ECE and the reliability curve."""
+
+_EPS = 1e-6
+
+
+def _arrays(labels: np.ndarray, probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    y = np.asarray(labels, dtype=bool)
+    p = np.asarray(probabilities, dtype=np.float64)
+    if y.shape != p.shape or y.ndim != 1:
+        raise ValueError(f"labels and probabilities must be (K,) arrays, got {y.shape}, {p.shape}")
+    if len(p) and not (np.isfinite(p).all() and (p >= 0).all() and (p <= 1).all()):
+        raise ValueError("probabilities must be finite and within [0, 1]")
+    return y, p
+
+
+def brier_score(labels: np.ndarray, probabilities: np.ndarray) -> float:
+    """Mean squared difference of probability and outcome (NaN without samples)."""
+    y, p = _arrays(labels, probabilities)
+    return float(np.mean((p - y) ** 2)) if len(p) else math.nan
+
+
+def reliability_curve(
+    labels: np.ndarray, probabilities: np.ndarray, bins: int = BINS
+) -> list[dict[str, float]]:
+    """Per non-empty bin: its edges, the mean probability, the share hit and the count."""
+    y, p = _arrays(labels, probabilities)
+    index = np.minimum((p * bins).astype(np.int64), bins - 1)
+    rows = []
+    for b in range(bins):
+        inside = index == b
+        if inside.any():
+            rows.append(
+                {
+                    "low": b / bins,
+                    "high": (b + 1) / bins,
+                    "mean_probability": float(p[inside].mean()),
+                    "hit_share": float(y[inside].mean()),
+                    "count": int(inside.sum()),
+                }
+            )
+    return rows
+
+
+def expected_calibration_error(
+    labels: np.ndarray, probabilities: np.ndarray, bins: int = BINS
+) -> float:
+    """Sample-weighted mean gap between the share hit and the mean probability per bin."""
+    y, p = _arrays(labels, probabilities)
+    if not len(p):
+        return math.nan
+    curve = reliability_curve(y, p, bins)
+    return float(
+        sum(r["count"] * abs(r["hit_share"] - r["mean_probability"]) for r in curve) / len(p)
+    )
+
+
+def _logit(p: np.ndarray) -> np.ndarray:
+    q = np.clip(p, _EPS, 1 - _EPS)
+    return np.log(q / (1 - q))
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """p' = σ(a·logit(p) + b), its kind ("platt", "temperature" or "none") and the decision
+    threshold on the calibrated probability."""
+
+    kind: str
+    a: float
+    b: float
+    threshold: float
+
+    def apply(self, probabilities: np.ndarray) -> np.ndarray:
+        """The calibrated probabilities."""
+        if self.kind == "none":
+            return np.asarray(probabilities, dtype=np.float64)
+        z = self.a * _logit(np.asarray(probabilities, dtype=np.float64)) + self.b
+        return 1.0 / (1.0 + np.exp(-z))
+
+    def to_json(self) -> str:
+        return json.dumps(
+            {"kind": self.kind, "a": self.a, "b": self.b, "threshold": self.threshold}
+        )
+
+    @classmethod
+    def from_json(cls, text: str) -> Calibration:
+        """A calibration written by `to_json`; anything else is a ValueError."""
+        data = json.loads(text)
+        if data.get("kind") not in ("platt", "temperature", "none"):
+            raise ValueError(f"not a DIP calibration: kind {data.get('kind')!r}")
+        values = [float(data[k]) for k in ("a", "b", "threshold")]
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError("a DIP calibration with non-finite parameters")
+        return cls(data["kind"], *values)
+
+
+def _log_loss(y: np.ndarray, z: np.ndarray) -> float:
+    # mean of log(1 + exp(-z)) for hits and log(1 + exp(z)) for misses, computed stably
+    signed = np.where(y, z, -z)
+    return float(np.mean(np.logaddexp(0.0, -signed)))
+
+
+def fit_calibration(
+    labels: np.ndarray, probabilities: np.ndarray, kind: str, threshold: float
+) -> Calibration:
+    """Fit Platt or temperature scaling on validation samples by minimising the log loss;
+    `threshold` (the raw model's) is carried over to the calibrated scale."""
+    from scipy.optimize import minimize
+
+    y, p = _arrays(labels, probabilities)
+    if kind == "none":
+        return Calibration("none", 1.0, 0.0, threshold)
+    if kind not in ("platt", "temperature"):
+        raise ValueError(f"unknown calibration {kind!r}: platt, temperature or none")
+    if len(p) < 2 or y.all() or not y.any():
+        raise ValueError("calibration needs validation samples of both classes")
+    x = _logit(p)
+    if kind == "platt":
+        fitted = minimize(lambda v: _log_loss(y, v[0] * x + v[1]), x0=[1.0, 0.0], method="BFGS")
+        a, b = float(fitted.x[0]), float(fitted.x[1])
+    else:
+        fitted = minimize(lambda v: _log_loss(y, v[0] * x), x0=[1.0], method="BFGS")
+        a, b = float(fitted.x[0]), 0.0
+    raw = Calibration("none", 1.0, 0.0, threshold)
+    scaled = Calibration(kind, a, b, threshold)
+    moved = float(scaled.apply(np.array([raw.threshold]))[0])
+    return Calibration(kind, a, b, moved)
