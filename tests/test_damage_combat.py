@@ -376,3 +376,29 @@ def test_environment_takes_a_model_loader(tmp_path: Path) -> None:
         assert "damage" in kinds and "kill" in kinds
     finally:
         env.close()
+
+
+def test_a_calibrated_dip_decides_by_its_rule(folder: Path, tmp_path: Path) -> None:
+    import shutil
+
+    from decoy_cli.damage.calibration import Calibration
+    from decoy_cli.damage.model_folder import save_calibration
+
+    calibrated = tmp_path / "calibrated"
+    shutil.copytree(folder, calibrated)
+    logit = float(np.log(0.3 / 0.7))
+    # a = 0: every pair's calibrated probability is 0.3, whatever the DIP says
+    save_calibration(calibrated, Calibration("platt", 0.0, logit, 0.5, "bernoulli"))
+    pairs = batch(4000, seed=5, weapons=["AK-47"] * 4000)
+    model = LearnedDamage(load_dip(calibrated), load_dog(calibrated))
+    hit = model(pairs, np.random.default_rng(9)).hit
+    assert abs(hit.mean() - 0.3) < 0.03
+    # the threshold rule on the same constant 0.3 < 0.5: nobody is hit
+    save_calibration(calibrated, Calibration("platt", 0.0, logit, 0.5, "threshold"))
+    model = LearnedDamage(load_dip(calibrated), load_dog(calibrated))
+    assert not model(pairs, np.random.default_rng(9)).hit.any()
+    # an explicit threshold overrides the calibration: the raw DIP decides
+    raw = LearnedDamage(load_dip(calibrated), load_dog(calibrated), threshold=0.5)
+    plain = LearnedDamage(load_dip(folder), load_dog(folder), threshold=0.5)
+    rng_a, rng_b = np.random.default_rng(2), np.random.default_rng(2)
+    np.testing.assert_array_equal(raw(pairs, rng_a).hit, plain(pairs, rng_b).hit)

@@ -96,6 +96,12 @@ def calibrate(
     method: str = typer.Option(
         "platt", "--method", help="platt (two parameters), temperature (one) or none."
     ),
+    decision: str = typer.Option(
+        "threshold",
+        "--decision",
+        help="How the combat step decides a hit from the calibrated probability: threshold "
+        "(the paper's rule) or bernoulli (a hit with that probability).",
+    ),
     split: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
     val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
@@ -121,7 +127,7 @@ def calibrate(
     bars, on_file, _ = progress_bars()
     with bars:
         result = calibrate_dip_folder(
-            folder=model_folder, choice=choice, kind=method, on_file=on_file
+            folder=model_folder, choice=choice, kind=method, decision=decision, on_file=on_file
         )
     console = make_console()
     table = Table(title=f"DIP calibration ({result.calibration.kind}) of {model_folder}")
@@ -137,7 +143,7 @@ def calibrate(
     c = result.calibration
     console.print(
         f"p' = sigmoid({c.a:.4f} * logit(p) + {c.b:.4f}); threshold {c.threshold:.3f} on the "
-        f"calibrated scale; written to {result.path}",
+        f"calibrated scale; combat decides by {c.decision}; written to {result.path}",
         highlight=False,
     )
 

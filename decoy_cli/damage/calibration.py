@@ -15,6 +15,11 @@ Recalibration, fitted on the validation split (never on the test samples):
 
 Both keep the order of the probabilities, so ROC AUC and average precision do not change; the
 threshold that gave the best F1 moves with them (`Calibration.threshold`).
+
+The combat step decides a pair's hit from the calibrated probability by `Calibration.decision`:
+"threshold" (the paper's rule: a hit when p' reaches the threshold, the same pairs as the raw
+model at its threshold) or "bernoulli" (a hit with probability p', so the share of pairs hit
+matches the data's in expectation).
 """
 
 from __future__ import annotations
@@ -87,15 +92,26 @@ def _logit(p: np.ndarray) -> np.ndarray:
     return np.log(q / (1 - q))
 
 
+DECISIONS = ("threshold", "bernoulli")
+
+
 @dataclass(frozen=True)
 class Calibration:
-    """p' = σ(a·logit(p) + b), its kind ("platt", "temperature" or "none") and the decision
-    threshold on the calibrated probability."""
+    """p' = σ(a·logit(p) + b), its kind ("platt", "temperature" or "none"), the decision
+    threshold on the calibrated probability and the combat step's decision rule."""
 
     kind: str
     a: float
     b: float
     threshold: float
+    decision: str = "threshold"
+
+    def decide(self, probabilities: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """(K,) bool: which pairs hit, by `decision` on the calibrated probabilities."""
+        calibrated = self.apply(probabilities)
+        if self.decision == "bernoulli":
+            return rng.random(len(calibrated)) < calibrated
+        return calibrated >= self.threshold
 
     def apply(self, probabilities: np.ndarray) -> np.ndarray:
         """The calibrated probabilities."""
@@ -106,7 +122,13 @@ class Calibration:
 
     def to_json(self) -> str:
         return json.dumps(
-            {"kind": self.kind, "a": self.a, "b": self.b, "threshold": self.threshold}
+            {
+                "kind": self.kind,
+                "a": self.a,
+                "b": self.b,
+                "threshold": self.threshold,
+                "decision": self.decision,
+            }
         )
 
     @classmethod
@@ -115,10 +137,13 @@ class Calibration:
         data = json.loads(text)
         if data.get("kind") not in ("platt", "temperature", "none"):
             raise ValueError(f"not a DIP calibration: kind {data.get('kind')!r}")
-        values = [float(data[k]) for k in ("a", "b", "threshold")]
-        if not all(math.isfinite(v) for v in values):
+        a, b, threshold = (float(data[k]) for k in ("a", "b", "threshold"))
+        if not all(math.isfinite(v) for v in (a, b, threshold)):
             raise ValueError("a DIP calibration with non-finite parameters")
-        return cls(data["kind"], *values)
+        decision = data.get("decision", "threshold")
+        if decision not in DECISIONS:
+            raise ValueError(f"unknown decision {decision!r}: threshold or bernoulli")
+        return cls(data["kind"], a, b, threshold, decision)
 
 
 def _log_loss(y: np.ndarray, z: np.ndarray) -> float:
@@ -128,15 +153,21 @@ def _log_loss(y: np.ndarray, z: np.ndarray) -> float:
 
 
 def fit_calibration(
-    labels: np.ndarray, probabilities: np.ndarray, kind: str, threshold: float
+    labels: np.ndarray,
+    probabilities: np.ndarray,
+    kind: str,
+    threshold: float,
+    decision: str = "threshold",
 ) -> Calibration:
     """Fit Platt or temperature scaling on validation samples by minimising the log loss;
     `threshold` (the raw model's) is carried over to the calibrated scale."""
+    if decision not in DECISIONS:
+        raise ValueError(f"unknown decision {decision!r}: threshold or bernoulli")
     from scipy.optimize import minimize
 
     y, p = _arrays(labels, probabilities)
     if kind == "none":
-        return Calibration("none", 1.0, 0.0, threshold)
+        return Calibration("none", 1.0, 0.0, threshold, decision)
     if kind not in ("platt", "temperature"):
         raise ValueError(f"unknown calibration {kind!r}: platt, temperature or none")
     if len(p) < 2 or y.all() or not y.any():
@@ -151,4 +182,4 @@ def fit_calibration(
     raw = Calibration("none", 1.0, 0.0, threshold)
     scaled = Calibration(kind, a, b, threshold)
     moved = float(scaled.apply(np.array([raw.threshold]))[0])
-    return Calibration(kind, a, b, moved)
+    return Calibration(kind, a, b, moved, decision)

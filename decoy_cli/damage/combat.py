@@ -119,7 +119,9 @@ def _stacked(features: Features) -> Tensor:
 
 class LearnedDamage:
     """A `DamageModel` from a loaded DIP and DOG; `threshold` overrides the DIP's own, and
-    `threads` is the torch thread count of the inference (None: torch's own setting)."""
+    `threads` is the torch thread count of the inference (None: torch's own setting). A DIP with
+    a calibration (`decoy models calibrate`) decides hits by its rule, threshold or Bernoulli
+    on the calibrated probability, unless a `threshold` is given."""
 
     def __init__(
         self,
@@ -134,6 +136,7 @@ class LearnedDamage:
         self.dog = dog
         self.threads = threads
         self.threshold = dip.threshold if threshold is None else float(threshold)
+        self.threshold_given = threshold is not None
         if not 0.0 <= self.threshold <= 1.0:
             raise ValueError(f"a DIP threshold is a probability, got {self.threshold}")
         with torch.no_grad():
@@ -174,7 +177,11 @@ class LearnedDamage:
         with self._inference():
             probability = torch.sigmoid(self._dip(_stacked(features))).numpy()
         armed = weapon_index(batch.attacker_weapon) >= 0
-        hit = armed & (probability >= self.threshold)
+        if self.dip.calibration is not None and not self.threshold_given:
+            decided = self.dip.calibration.decide(probability, np.random.default_rng(seed))
+            hit = armed & decided
+        else:
+            hit = armed & (probability >= self.threshold)
         rows = np.flatnonzero(hit)
         if len(rows):
             if self.dog.spec != self.dip.spec:

@@ -38,7 +38,12 @@ class CalibrationResult:
 
 
 def calibrate_dip_folder(
-    *, folder: Path, choice: SampleChoice, kind: str, on_file: FileCallback | None = None
+    *,
+    folder: Path,
+    choice: SampleChoice,
+    kind: str,
+    decision: str = "threshold",
+    on_file: FileCallback | None = None,
 ) -> CalibrationResult:
     """Fit the DIP calibration of `folder` on the validation samples and save it (module doc).
     A folder without a DIP or a part without both classes is one ModelError line."""
@@ -58,7 +63,9 @@ def calibrate_dip_folder(
             raise ModelError(f"the {part} samples lack hits or misses: no calibration")
         parts[part] = (labels, dip_probabilities(dip, samples.take(index)))
     try:
-        calibration = fit_calibration(*parts["val"], kind=kind, threshold=dip.threshold)
+        calibration = fit_calibration(
+            *parts["val"], kind=kind, threshold=dip.threshold, decision=decision
+        )
     except ValueError as error:
         raise ModelError(str(error)) from None
     scores = {}
