@@ -402,3 +402,42 @@ def test_a_calibrated_dip_decides_by_its_rule(folder: Path, tmp_path: Path) -> N
     plain = LearnedDamage(load_dip(folder), load_dog(folder), threshold=0.5)
     rng_a, rng_b = np.random.default_rng(2), np.random.default_rng(2)
     np.testing.assert_array_equal(raw(pairs, rng_a).hit, plain(pairs, rng_b).hit)
+
+
+def test_rules_damage_is_the_rules_per_bullet(firing: Path) -> None:
+    from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
+    from decoy_cli.damage.rules import shot_damage
+    from decoy_cli.damage.rules_model import BulletCounts, RulesDamage, RulesFile
+
+    rng = np.random.default_rng(61)
+    groups = [GROUPS[i] for i in rng.integers(0, 6, 600)]
+    hit_groups = HitGroupModel.fit(["AK-47"] * 600, rng.uniform(100, 2000, 600), groups)
+    single = BulletCounts()
+    single.add("AK-47", 1)  # every damaging step lands one bullet
+    model = RulesDamage(load_dip(firing), RulesFile(hit_groups, single))
+    pairs = batch(300, seed=6, weapons=["AK-47"] * 299 + ["Knife"])
+    first = model(pairs, np.random.default_rng(4))
+    again = model(pairs, np.random.default_rng(4))
+    np.testing.assert_array_equal(first.damage, again.damage)
+    assert first.hit[:299].all() and not first.hit[299]  # the knife never hits here
+    assert first.armor_damage is not None
+    for k in np.flatnonzero(first.hit):
+        bullet = shot_damage(
+            "AK-47",
+            HIT_GROUPS[first.hit_group[k]],
+            pairs.distance[k] / HAMMER_TO_M,
+            armor=int(pairs.victim_armor[k]),
+            helmet=bool(pairs.victim_helmet[k]),
+        )
+        assert first.damage[k] == min(max(bullet.health, 1), max(int(pairs.victim_hp[k]), 1))
+        assert first.armor_damage[k] == min(bullet.armor, int(pairs.victim_armor[k]))
+
+
+def test_the_shipped_rules_are_a_models_choice() -> None:
+    from decoy_cli.damage.rules_model import RulesDamage
+
+    if not shipped_models_installed():
+        pytest.skip("no shipped models")
+    model = load_damage_model("rules")
+    assert isinstance(model, RulesDamage)
+    assert model.rules.provenance["hits"] == 396

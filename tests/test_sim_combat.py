@@ -449,3 +449,21 @@ def test_a_step_is_deterministic_for_a_seed(physics: PhysicsWorld) -> None:
         runs.append((events, agents.hp.copy()))
     assert runs[0][0] == runs[1][0] and np.array_equal(runs[0][1], runs[1][1])
     assert any(e.kind == "damage" for e in runs[0][0])
+
+
+def test_armour_goes_down_by_the_result_and_stays_at_or_above_zero() -> None:
+    agents = _agents(["T", "T", "CT"], [(0, 0, 0), (1, 0, 0), (2, 0, 0)])
+    agents.armor[2] = 10
+    batch = _batch(agents, [(0, 2), (1, 2)])
+    result = DamageResult(
+        np.array([27, 20]), np.array([CHEST, CHEST]), np.array([True, True]), np.array([4, 8])
+    )
+    apply_damage(agents, batch, result, 30)
+    assert agents.armor[2] == 0 and agents.hp[2] == 100 - 47
+    agents.armor[2] = 50
+    apply_damage(agents, batch, _result([5, 5]), 60)  # a model of HP only leaves armour alone
+    assert agents.armor[2] == 50
+    with pytest.raises(ValueError, match="armor_damage"):
+        DamageResult(np.array([5]), np.array([2]), np.array([True]), np.array([-1]))
+    with pytest.raises(ValueError, match="armor_damage"):
+        DamageResult(np.array([0]), np.array([-1]), np.array([False]), np.array([3]))

@@ -89,6 +89,31 @@ def import_decoy(
     )
 
 
+@app.command("fit-rules")
+def fit_rules_command(
+    model_folder: Path = typer.Argument(..., help="A model folder with the DIP to pair with."),
+    data: list[Path] = typer.Argument(..., help=DATA_HELP),
+) -> None:
+    """Learn the parts of the rules-grounded damage model from real hits (where shots land, by
+    weapon and distance; how many land in one 0.5 s step, by weapon class) and write rules.json
+    into the folder: with its DIP, `--models FOLDER` then damages by the game's rules."""
+    from decoy_cli.damage.rules_model import fit_rules
+    from decoy_cli.esta import collect_match_files, read_match
+
+    if not (model_folder / "dip.json").is_file():
+        raise DecoyError(f"{model_folder}: holds no dip.json to pair the rules with")
+    files, _ = collect_match_files(data)
+    rounds = [r for f in files for r in read_match(f).rounds]
+    rules = fit_rules(rounds)
+    rules.provenance["data"] = [f.name for f in files]
+    path = rules.save(model_folder)
+    make_console().print(
+        f"rules fitted on {rules.provenance['hits']} firearm hits of "
+        f"{rules.provenance['rounds']} rounds; written to {path}",
+        highlight=False,
+    )
+
+
 @app.command("calibrate")
 def calibrate(
     model_folder: Path = typer.Argument(..., help="A model folder with dip.pt/json."),

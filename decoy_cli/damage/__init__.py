@@ -29,7 +29,8 @@ SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
 CHOICES_HELP = (
-    '"shipped" (the DIP and DOG shipped with decoy), "none" (no shooting) or a model folder'
+    '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIP with damage by '
+    'the game\'s rules), "none" (no shooting) or a model folder'
 )
 
 
@@ -39,14 +40,15 @@ def shipped_models_installed() -> bool:
 
 
 def load_damage_model(choice: str) -> DamageModel | None:
-    """The damage model a user chose: "shipped", "none" (None: no shooting) or the path of a
-    model folder holding both DIP and DOG (e.g. written by `decoy models import-decoy`).
+    """The damage model a user chose: "shipped", "rules", "none" (None: no shooting) or the
+    path of a model folder holding a DIP and a DOG (e.g. written by `decoy models import-decoy`)
+    or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's rules).
 
     A missing or incompatible folder is one ModelError line.
     """
     if choice == "none":
         return None
-    if choice == "shipped":
+    if choice in ("shipped", "rules"):
         folder = SHIPPED_MODELS
         if not shipped_models_installed():
             raise ModelError(
@@ -59,7 +61,11 @@ def load_damage_model(choice: str) -> DamageModel | None:
             raise ModelError(f"{choice}: no such model folder (expected {CHOICES_HELP})")
     from decoy_cli.damage.combat import LearnedDamage
     from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.rules_model import RULES_FILE, RulesDamage, RulesFile
 
+    rules_only = (folder / RULES_FILE).is_file() and not (folder / "dog.json").is_file()
+    if choice == "rules" or rules_only:
+        return RulesDamage(load_dip(folder), RulesFile.load(folder))
     return LearnedDamage(load_dip(folder), load_dog(folder))
 
 

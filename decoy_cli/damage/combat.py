@@ -117,23 +117,20 @@ def _stacked(features: Features) -> Tensor:
     return torch.from_numpy(np.concatenate(blocks, axis=1))
 
 
-class LearnedDamage:
-    """A `DamageModel` from a loaded DIP and DOG; `threshold` overrides the DIP's own, and
-    `threads` is the torch thread count of the inference (None: torch's own setting). A DIP with
-    a calibration (`decoy models calibrate`) decides hits by its rule, threshold or Bernoulli
-    on the calibrated probability, unless a `threshold` is given."""
+class DipDecision:
+    """DIP's part of a damage model: the batched probability that each attacker damages its
+    victim in the step, and the decision. `threshold` overrides the DIP's own; a DIP with a
+    calibration (`decoy models calibrate`) decides by its rule, threshold or Bernoulli on the
+    calibrated probability, unless a `threshold` is given. Only armed attackers (a firearm of
+    the vocabulary) hit. `threads` is the torch thread count of the inference (None: torch's
+    own setting)."""
 
     def __init__(
-        self,
-        dip: LoadedDip,
-        dog: LoadedDog,
-        threshold: float | None = None,
-        threads: int | None = 1,
+        self, dip: LoadedDip, threshold: float | None = None, threads: int | None = 1
     ) -> None:
         if threads is not None and threads < 1:
             raise ValueError(f"threads must be >= 1 or None, got {threads}")
         self.dip = dip
-        self.dog = dog
         self.threads = threads
         self.threshold = dip.threshold if threshold is None else float(threshold)
         self.threshold_given = threshold is not None
@@ -141,10 +138,9 @@ class LearnedDamage:
             raise ValueError(f"a DIP threshold is a probability, got {self.threshold}")
         with torch.no_grad():
             self._dip = _FoldedDip(dip.net)
-            self._dog = _FoldedDogDecoder(dog.net)
 
     @contextmanager
-    def _inference(self) -> Iterator[None]:
+    def inference(self) -> Iterator[None]:
         """torch inference mode on `self.threads` threads, restored afterwards."""
         previous = torch.get_num_threads()
         threads = self.threads
@@ -158,13 +154,46 @@ class LearnedDamage:
             if change:
                 torch.set_num_threads(previous)
 
-    def hit_probability(self, batch: CombatBatch) -> np.ndarray:
+    def hit_probability(self, batch: CombatBatch, features: Features | None = None) -> np.ndarray:
         """(K,) DIP's probability that each attacker damages its victim in this step."""
         if len(batch) == 0:
             return np.zeros(0)
-        with self._inference():
-            logits = self._dip(_stacked(encode(batch, self.dip.spec)))
+        if features is None:
+            features = encode(batch, self.dip.spec)
+        with self.inference():
+            logits = self._dip(_stacked(features))
         return torch.sigmoid(logits).numpy().astype(np.float64)
+
+    def hits(self, batch: CombatBatch, features: Features, seed: int) -> np.ndarray:
+        """(K,) bool: the pairs that hit (class doc); `seed` drives Bernoulli decisions."""
+        probability = self.hit_probability(batch, features)
+        armed = weapon_index(batch.attacker_weapon) >= 0
+        if self.dip.calibration is not None and not self.threshold_given:
+            return armed & self.dip.calibration.decide(probability, np.random.default_rng(seed))
+        return armed & (probability >= self.threshold)
+
+
+class LearnedDamage:
+    """A `DamageModel` from a loaded DIP and DOG: DIP decides who hits (`DipDecision`, which
+    takes `threshold` and `threads`), DOG how much and where."""
+
+    def __init__(
+        self,
+        dip: LoadedDip,
+        dog: LoadedDog,
+        threshold: float | None = None,
+        threads: int | None = 1,
+    ) -> None:
+        self.decision = DipDecision(dip, threshold, threads)
+        self.dip = dip
+        self.dog = dog
+        self.threshold = self.decision.threshold
+        with torch.no_grad():
+            self._dog = _FoldedDogDecoder(dog.net)
+
+    def hit_probability(self, batch: CombatBatch) -> np.ndarray:
+        """(K,) DIP's probability that each attacker damages its victim in this step."""
+        return self.decision.hit_probability(batch)
 
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
         k = len(batch)
@@ -174,20 +203,13 @@ class LearnedDamage:
         if k == 0:
             return DamageResult(damage, group, np.zeros(0, dtype=bool))
         features = encode(batch, self.dip.spec)
-        with self._inference():
-            probability = torch.sigmoid(self._dip(_stacked(features))).numpy()
-        armed = weapon_index(batch.attacker_weapon) >= 0
-        if self.dip.calibration is not None and not self.threshold_given:
-            decided = self.dip.calibration.decide(probability, np.random.default_rng(seed))
-            hit = armed & decided
-        else:
-            hit = armed & (probability >= self.threshold)
+        hit = self.decision.hits(batch, features, seed)
         rows = np.flatnonzero(hit)
         if len(rows):
             if self.dog.spec != self.dip.spec:
                 features = encode(batch, self.dog.spec)
             generator = torch.Generator().manual_seed(seed)
-            with self._inference():
+            with self.decision.inference():
                 # z first, as DogNet.generate draws it
                 z = torch.randn((len(rows), LATENT), generator=generator)
                 hp, logits = self._dog(_stacked(features.take(rows)), z)

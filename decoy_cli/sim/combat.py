@@ -116,12 +116,14 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class DamageResult:
     """A damage model's answer for K pairs: whether the attacker hits, the HP it removes from
-    the victim (after armor; 0 for a miss) and the hit group code (0..5, HIT_GROUPS; -1 for a
-    miss). Checked on construction: a model that returns garbage fails loudly."""
+    the victim (after armor; 0 for a miss), the hit group code (0..5, HIT_GROUPS; -1 for a
+    miss) and the armor it removes (None: none, as a model of HP damage after armor says).
+    Checked on construction: a model that returns garbage fails loudly."""
 
     damage: np.ndarray  # (K,) int64, >= 0
     hit_group: np.ndarray  # (K,) int8, -1..5
     hit: np.ndarray  # (K,) bool
+    armor_damage: np.ndarray | None = None  # (K,) int64, >= 0, 0 for a miss
 
     def __post_init__(self) -> None:
         damage, group, hit = (np.asarray(x) for x in (self.damage, self.hit_group, self.hit))
@@ -139,9 +141,17 @@ class DamageResult:
             raise ValueError("a miss must have damage 0 and hit group -1")
         if np.any((group[hit] < 0) | (group[hit] >= len(HIT_GROUPS))):
             raise ValueError(f"a hit needs a hit group in 0..{len(HIT_GROUPS) - 1}")
+        armor = (
+            np.zeros_like(damage) if self.armor_damage is None else np.asarray(self.armor_damage)
+        )
+        if armor.shape != damage.shape or not np.issubdtype(armor.dtype, np.integer):
+            raise ValueError("armor_damage must be integers, one per pair")
+        if np.any(armor < 0) or np.any(armor[~hit] != 0):
+            raise ValueError("armor_damage must not be negative, and 0 for a miss")
         object.__setattr__(self, "damage", damage.astype(np.int64))
         object.__setattr__(self, "hit_group", group.astype(np.int8))
         object.__setattr__(self, "hit", hit)
+        object.__setattr__(self, "armor_damage", armor.astype(np.int64))
 
     def __len__(self) -> int:
         return len(self.damage)
@@ -163,7 +173,8 @@ def apply_damage(
 
     Each victim loses the sum of the damage of all its attackers (HP stays an integer, clipped
     at 0); a victim at 0 HP dies. Every attacker fires on the state before the step, so two
-    agents can kill each other. Armor is not worn down (the models give HP damage after armor).
+    agents can kill each other. Armor goes down by the result's armor damage (clipped at 0; the
+    learned DIP + DOG give none: their damage is HP after armor).
 
     Events, in this order: "damage" per hit pair in batch order (agent = attacker, other =
     victim; data: damage, hit_group, weapon, hp_after = the victim's HP after the whole step),
@@ -185,6 +196,12 @@ def apply_damage(
     died = np.flatnonzero(agents.alive & (total > 0) & (hp_after == 0))
     agents.hp[:] = hp_after.astype(agents.hp.dtype)
     agents.alive[died] = False
+    armor_lost = np.zeros(agents.count, dtype=np.int64)
+    assert result.armor_damage is not None  # filled in on construction
+    np.add.at(armor_lost, batch.victim, result.armor_damage)
+    agents.armor[:] = np.maximum(agents.armor.astype(np.int64) - armor_lost, 0).astype(
+        agents.armor.dtype
+    )
     events = [
         SimEvent(
             tick,

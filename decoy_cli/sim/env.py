@@ -123,9 +123,10 @@ class DecoyParallelEnv(ParallelEnv):
 
     Combat: `damage_model` is a `DamageModel` (decoy_cli/sim/combat.py), or a function that
     loads one (called once, here), e.g. `lambda: load_damage_model("shipped")` with
-    `decoy_cli.damage.load_damage_model` ("shipped", "none" or the path of a model folder such
-    as `decoy models import-decoy` writes). None: no combat, and agents never die. `combat`
-    False keeps the model but turns shooting off; `bomb` False takes the bomb out of the round.
+    `decoy_cli.damage.load_damage_model` ("shipped", "rules", "none" or the path of a model
+    folder such as `decoy models import-decoy` writes). None: no combat, and agents never die.
+    `combat` False keeps the model but turns shooting off; `bomb` False takes the bomb out of the
+    round.
 
     pybullet: the physics mover and combat (`damage_model`) need a pybullet client with the
     world (`world`, default the built-in nav world); it is created at each reset and the

@@ -1,0 +1,198 @@
+"""`RulesDamage`: the simulator's damage model grounded in the game's rules (issue 13).
+
+Per combat step, over every visible ordered pair at once:
+
+1. DIP decides which attackers hit their victim in this 0.5 s step (`DipDecision`: its threshold,
+   or its calibration's rule);
+2. for each hitting pair, the number of bullets that land in the step is drawn from a
+   distribution learned from real hits per weapon class (`BulletCounts`), each bullet's hit group
+   from `HitGroupModel` (weapon and distance), and each bullet's health and armour damage from
+   the rules (decoy_cli/damage/rules.py) against the victim's armour and helmet, the armour worn
+   down bullet by bullet;
+3. the pair's damage is the bullets' health damage summed, at least 1 and at most the victim's
+   HP (as ESTA's hpDamageTaken), its armour damage the armour they took, its hit group that of
+   the bullet that did the most.
+
+The learned parts (`RulesFile`: hit groups and bullet counts) live in a model folder's
+`rules.json` beside the DIP (`decoy models fit-rules`). An attacker whose weapon the rules lack
+(a knife, grenade, Zeus or C4) never hits here, as with the learned DOG.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
+from decoy_cli.damage.rules import WEAPON_RULES, rule_group, shot_damage
+from decoy_cli.damage.rules_check import firearm_hits
+from decoy_cli.errors import ModelError
+from decoy_cli.esta import Round
+from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
+
+if TYPE_CHECKING:
+    from decoy_cli.damage.model_folder import LoadedDip
+
+RULES_FILE = "rules.json"
+STEP_S = 0.5
+"""The combat step: hits of one pair within this much time count as one step's bullets."""
+MAX_BULLETS = 10
+"""Bullet counts above this are counted as this many."""
+PRIOR_STEPS = 5.0
+"""Pseudo-steps pulling a class's bullet counts toward all classes'."""
+
+
+@dataclass
+class BulletCounts:
+    """How many bullets of one pair land in one damaging step, by weapon class (module doc)."""
+
+    by_class: dict[str, list[float]] = field(default_factory=dict)
+    every: list[float] = field(default_factory=lambda: [0.0] * MAX_BULLETS)
+
+    def add(self, weapon: str, bullets: int) -> None:
+        n = min(max(bullets, 1), MAX_BULLETS) - 1
+        self.by_class.setdefault(weapon_class(weapon), [0.0] * MAX_BULLETS)[n] += 1
+        self.every[n] += 1
+
+    def probabilities(self, weapon: str) -> np.ndarray:
+        """(MAX_BULLETS,) P(1..MAX_BULLETS bullets); one bullet when nothing was counted."""
+        every = np.asarray(self.every, np.float64)
+        if every.sum() == 0:
+            p = np.zeros(MAX_BULLETS)
+            p[0] = 1.0
+            return p
+        p = every / every.sum()
+        counts = np.asarray(self.by_class.get(weapon_class(weapon), [0.0] * MAX_BULLETS))
+        return (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
+
+
+@dataclass
+class RulesFile:
+    """The learned parts of the rules-grounded model (a model folder's `rules.json`)."""
+
+    hit_groups: HitGroupModel
+    bullets: BulletCounts
+    provenance: dict[str, object] = field(default_factory=dict)
+
+    def save(self, folder: Path) -> Path:
+        path = Path(folder) / RULES_FILE
+        text = json.dumps(
+            {
+                "hit_groups": json.loads(self.hit_groups.to_json()),
+                "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
+                "provenance": self.provenance,
+            },
+            indent=1,
+            sort_keys=True,
+        )
+        path.write_text(text + "\n")
+        return path
+
+    @classmethod
+    def load(cls, folder: Path) -> RulesFile:
+        """The folder's `rules.json`; a missing or unreadable one is one ModelError line."""
+        path = Path(folder) / RULES_FILE
+        try:
+            data = json.loads(path.read_text())
+            hit_groups = HitGroupModel.from_json(json.dumps(data["hit_groups"]))
+            bullets = BulletCounts(
+                {str(k): [float(v) for v in c] for k, c in data["bullets"]["by_class"].items()},
+                [float(v) for v in data["bullets"]["every"]],
+            )
+        except OSError as error:
+            raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
+        except (ValueError, KeyError, TypeError, AttributeError) as error:
+            raise ModelError(f"{path}: not a rules file ({error})") from None
+        if len(bullets.every) != MAX_BULLETS or any(
+            len(c) != MAX_BULLETS for c in bullets.by_class.values()
+        ):
+            raise ModelError(f"{path}: bullet counts of another length than {MAX_BULLETS}")
+        return cls(hit_groups, bullets, dict(data.get("provenance", {})))
+
+
+def fit_rules(rounds: Sequence[Round]) -> RulesFile:
+    """Learn the hit groups and the bullets per step from the rounds' firearm hits."""
+    tables = [
+        r.damages.assign(round=f"{r.match_id}:{r.round_num}", tick_rate=r.tick_rate)
+        for r in rounds
+        if len(r.damages)
+    ]
+    if not tables:
+        raise ModelError("no damage events in the data: nothing to learn the rules' parts from")
+    hits, left_out = firearm_hits(pd.concat(tables, ignore_index=True))
+    if not len(hits):
+        raise ModelError("no firearm hits between enemies in the data")
+    model = HitGroupModel.fit(hits["weapon"], hits["distance"], hits["hitGroup"])
+    bullets = BulletCounts()
+    for _, pair in hits.groupby(["round", "attackerName", "victimName"], sort=False):
+        ticks = pair["tick"].to_numpy(np.float64)
+        order = np.argsort(ticks, kind="stable")
+        window = STEP_S * float(pair["tick_rate"].iloc[0])
+        start, count, weapon = ticks[order[0]], 0, str(pair["weapon"].iloc[order[0]])
+        for k in order:
+            if ticks[k] - start >= window:
+                bullets.add(weapon, count)
+                start, count, weapon = ticks[k], 0, str(pair["weapon"].iloc[k])
+            count += 1
+        bullets.add(weapon, count)
+    provenance = {"hits": len(hits), "rounds": len(tables), "left_out": left_out}
+    return RulesFile(model, bullets, provenance)
+
+
+class RulesDamage:
+    """A `DamageModel`: DIP decides who hits, the rules how much and where (module doc)."""
+
+    def __init__(
+        self,
+        dip: LoadedDip,
+        rules: RulesFile,
+        threshold: float | None = None,
+        threads: int | None = 1,
+    ) -> None:
+        from decoy_cli.damage.combat import DipDecision
+
+        self.decision = DipDecision(dip, threshold, threads)
+        self.dip = dip
+        self.rules = rules
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        from decoy_cli.damage.features import encode
+
+        k = len(batch)
+        seed = int(rng.integers(2**63))  # drawn every call: the stream does not depend on hits
+        damage = np.zeros(k, dtype=np.int64)
+        armor_damage = np.zeros(k, dtype=np.int64)
+        group = np.full(k, NO_HIT, dtype=np.int8)
+        if k == 0:
+            return DamageResult(damage, group, np.zeros(0, dtype=bool), armor_damage)
+        known = np.array([w in WEAPON_RULES for w in batch.attacker_weapon], dtype=bool)
+        hit = known & self.decision.hits(batch, encode(batch, self.dip.spec), seed)
+        draw = np.random.default_rng(seed)
+        for row in np.flatnonzero(hit):
+            weapon = str(batch.attacker_weapon[row])
+            distance_u = float(batch.distance[row]) / HAMMER_TO_M
+            p = self.rules.bullets.probabilities(weapon)
+            count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
+            groups = self.rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
+            armor = int(batch.victim_armor[row])
+            helmet = bool(batch.victim_helmet[row])
+            health, taken, largest, largest_group = 0, 0, -1, groups[0]
+            for name in groups:
+                bullet = shot_damage(weapon, name, distance_u, armor=armor, helmet=helmet)
+                health += bullet.health
+                taken += bullet.armor
+                armor = max(armor - bullet.armor, 0)
+                if bullet.health > largest:
+                    largest, largest_group = bullet.health, name
+            most = max(int(batch.victim_hp[row]), 1)
+            damage[row] = min(max(health, 1), most)
+            armor_damage[row] = min(taken, int(batch.victim_armor[row]))
+            group[row] = GROUPS.index(rule_group(largest_group))
+        return DamageResult(damage, group, hit, armor_damage)

@@ -1,0 +1,46 @@
+"""`decoy models fit-rules`: the rules-grounded model's learned parts from real hits."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.damage import load_damage_model
+from decoy_cli.damage.rules_model import MAX_BULLETS, RulesDamage
+
+runner = CliRunner()
+ROOT = Path(__file__).resolve().parents[1]
+EVENTS = ROOT.parent / "shared" / "data" / "esta_dust2_events"
+
+
+@pytest.mark.skipif(not EVENTS.is_dir(), reason="needs ../shared/data/esta_dust2_events")
+def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
+    folder = tmp_path / "rules"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    result = runner.invoke(app, ["models", "fit-rules", str(folder), str(EVENTS)])
+    assert result.exit_code == 0, result.output
+    assert "396 firearm hits of 18 rounds" in result.output
+    data = json.loads((folder / "rules.json").read_text())
+    assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
+    # the shipped rules.json is this very fit
+    assert data["bullets"] == json.loads((ROOT / "models" / "rules.json").read_text())["bullets"]
+    assert isinstance(load_damage_model(str(folder)), RulesDamage)  # a DIP and rules, no DOG
+
+
+def test_bad_folders_are_one_error_line(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["models", "fit-rules", str(tmp_path), str(tmp_path)])
+    assert result.exit_code != 0 and "holds no dip.json" in result.output
+    folder = tmp_path / "broken"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    (folder / "rules.json").write_text("{not json")
+    with pytest.raises(Exception, match="not a rules file"):
+        load_damage_model(str(folder))
