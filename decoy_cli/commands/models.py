@@ -26,6 +26,7 @@ from decoy_cli.commands._damage_output import (
     print_samples,
     progress_bars,
 )
+from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
 from decoy_cli.damage.provenance import SampleChoice
@@ -86,6 +87,33 @@ def import_decoy(
     console.print(
         f"DIP threshold {result.threshold}, Hammer-unit features; model folder written to "
         f"{result.folder}\nuse it with: decoy replay FILE:ROUND --models {result.folder}"
+    )
+
+
+@app.command("download-decoy")
+def download_decoy(
+    out: Path = typer.Option(
+        DEFAULT_IMPORT_OUT, "--out", help="Model folder to write (dip.pt/json, dog.pt/json)."
+    ),
+    base_url: str = typer.Option(
+        PAPER_BASE_URL, "--base-url", help="Where the repository's files are served (a mirror)."
+    ),
+    timeout: float = typer.Option(60.0, "--timeout", min=1.0, help="Seconds to wait for data."),
+) -> None:
+    """Download the DECOY paper's published DIP and DOG (HATS-ICT/decoy at a fixed commit),
+    check every file's SHA-256, and import them into a model folder for --models (as
+    import-decoy does). The downloaded files are kept in OUT/checkpoints."""
+    from decoy_cli.damage.download_paper import download_paper_files
+    from decoy_cli.damage.paper import import_paper
+
+    check_folder_writable(out)
+    files = download_paper_files(out / "checkpoints", base_url, timeout)
+    result = import_paper(out / "checkpoints", out)
+    make_console().print(
+        f"{len(files)} files of {PAPER_REPOSITORY}@{PAPER_COMMIT[:7]} verified; model folder "
+        f"written to {result.folder}\nuse it with: decoy replay FILE:ROUND --models "
+        f"{result.folder}",
+        highlight=False,
     )
 
 

@@ -221,17 +221,18 @@ def _fetch_first(
     """Stream the first URL that has the match into `out`: (url, sha256, first bytes)."""
     urls = match_urls(ref, base_url)
     for url in urls:
-        response = _open(url, match_id, timeout)
+        response = open_url(url, match_id, timeout)
         if response is None:
             continue
         with response:
-            digest, head = _stream(response, url, match_id, out, timeout, on_progress)
+            digest, head = stream_body(response, url, match_id, out, timeout, on_progress)
         return url, digest, head
     raise DownloadError(f"{match_id}: not found (HTTP 404) at {' or '.join(urls)}")
 
 
-def _open(url: str, match_id: str, timeout: float) -> Response | None:
-    """The open response, or None when the server has no such file."""
+def open_url(url: str, label: str, timeout: float) -> Response | None:
+    """The open response, or None when the server has no such file; failures are one
+    DownloadError line that starts with `label` (what is being fetched)."""
     request = urllib.request.Request(url, headers={"User-Agent": f"decoy/{__version__}"})
     try:
         return urllib.request.urlopen(request, timeout=timeout)
@@ -239,29 +240,30 @@ def _open(url: str, match_id: str, timeout: float) -> Response | None:
         error.close()
         if error.code == 404:
             return None
-        raise DownloadError(f"{match_id}: HTTP {error.code} {error.reason} from {url}") from None
+        raise DownloadError(f"{label}: HTTP {error.code} {error.reason} from {url}") from None
     except urllib.error.URLError as error:
         if isinstance(error.reason, FileNotFoundError):  # file:// base URL
             return None
         if isinstance(error.reason, TimeoutError):
-            raise DownloadError(f"{match_id}: no answer from {url} within {timeout:g} s") from None
+            raise DownloadError(f"{label}: no answer from {url} within {timeout:g} s") from None
         reason = getattr(error.reason, "strerror", None) or error.reason
-        raise DownloadError(f"{match_id}: cannot reach {_host(url)}: {reason}") from None
+        raise DownloadError(f"{label}: cannot reach {_host(url)}: {reason}") from None
     except TimeoutError:
-        raise DownloadError(f"{match_id}: no answer from {url} within {timeout:g} s") from None
+        raise DownloadError(f"{label}: no answer from {url} within {timeout:g} s") from None
     except (http.client.HTTPException, OSError) as error:
-        raise DownloadError(f"{match_id}: {url}: {_describe(error)}") from None
+        raise DownloadError(f"{label}: {url}: {_describe(error)}") from None
 
 
-def _stream(
+def stream_body(
     response: Response,
     url: str,
-    match_id: str,
+    label: str,
     out: BinaryIO,
     timeout: float,
     on_progress: ProgressCallback | None,
 ) -> tuple[str, bytes]:
-    """Copy the body to `out`, hashing it; a short or stalled body raises DownloadError."""
+    """Copy the body to `out`, hashing it: (sha256, first bytes); a short or stalled body raises
+    DownloadError."""
     length = response.headers.get("Content-Length")
     total = int(length) if length and length.isdigit() else None
     digest = hashlib.sha256()
@@ -279,19 +281,19 @@ def _stream(
     except http.client.IncompleteRead as error:
         received += len(error.partial)
         raise DownloadError(
-            f"{match_id}: download cut short after {received:,} bytes from {url}"
+            f"{label}: download cut short after {received:,} bytes from {url}"
         ) from None
     except TimeoutError:
         raise DownloadError(
-            f"{match_id}: {url} stopped sending for {timeout:g} s after {received:,} bytes"
+            f"{label}: {url} stopped sending for {timeout:g} s after {received:,} bytes"
         ) from None
     except (http.client.HTTPException, ConnectionError) as error:
         raise DownloadError(
-            f"{match_id}: download from {url} failed after {received:,} bytes: {_describe(error)}"
+            f"{label}: download from {url} failed after {received:,} bytes: {_describe(error)}"
         ) from None
     if total is not None and received != total:
         raise DownloadError(
-            f"{match_id}: download cut short: {received:,} of {total:,} bytes from {url}"
+            f"{label}: download cut short: {received:,} of {total:,} bytes from {url}"
         )
     return digest.hexdigest(), head
 
