@@ -126,7 +126,10 @@ def check_damage_model(choice: str) -> ModelStatus:
         )
     if model is None:
         return ModelStatus(choice, False, "none: line of sight only, no inference")
-    return ModelStatus(choice, True, f"learned DIP + DOG ({choice})")
+    from decoy_cli.damage.rules_model import RulesDamage
+
+    outcome = "the game's damage rules" if isinstance(model, RulesDamage) else "DOG"
+    return ModelStatus(choice, True, f"learned DIP + {outcome} ({choice})")
 
 
 def run_section(name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None):
