@@ -98,3 +98,22 @@ def test_the_real_hits_leave_rounds_out() -> None:
     assert len(result.fold_mean_wasserstein_hp) == 5
     assert result.mean_wasserstein_hp <= 5.0  # issue 13's target, half the paper's 9.87
     assert (result.group_tv["tv"] <= 0.15).all()  # every weapon with 30 or more hits
+
+
+@pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
+def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
+    from decoy_cli.damage import SHIPPED_MODELS
+    from decoy_cli.damage.fold_comparison import FOLDS, compare_on_folds
+    from decoy_cli.damage.samples import build_samples
+
+    samples, _ = build_samples([EVENTS])
+    rules, shipped = compare_on_folds(
+        read_match(EVENTS).rounds, samples, {"shipped": SHIPPED_MODELS}, seed=0, draws=4
+    )
+    assert rules.name.startswith("rules") and shipped.name == "shipped"
+    for scores in (rules, shipped):
+        assert scores.cells > 0 and np.isfinite(scores.mean_wasserstein_hp)
+        assert len(scores.fold_means) == FOLDS
+        assert set(scores.group_tv) == {"AK-47", "M4A4", "USP-S"}
+    # the game's rules beat the DOG trained on most of these very rounds
+    assert rules.mean_wasserstein_hp < shipped.mean_wasserstein_hp

@@ -146,6 +146,62 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     return RulesFile(model, bullets, provenance)
 
 
+def pair_outcome(
+    rules: RulesFile,
+    weapon: str,
+    distance_u: float,
+    armor: int,
+    helmet: bool,
+    draw: np.random.Generator,
+) -> tuple[int, int, str]:
+    """One damaging step of one pair (module doc, step 2): (health damage summed over the
+    bullets, armour they took, the hit group of the bullet that did the most)."""
+    p = rules.bullets.probabilities(weapon)
+    count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
+    groups = rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
+    health, taken, largest, largest_group = 0, 0, -1, groups[0]
+    for name in groups:
+        bullet = shot_damage(weapon, name, distance_u, armor=armor - taken, helmet=helmet)
+        health += bullet.health
+        taken += bullet.armor
+        if bullet.health > largest:
+            largest, largest_group = bullet.health, name
+    return health, taken, rule_group(largest_group)
+
+
+def rules_generate(
+    rules: RulesFile,
+    weapons: Sequence[str],
+    distances_m: np.ndarray,
+    armor: np.ndarray,
+    helmet: np.ndarray,
+    seed: int,
+    draws: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`draws` outcomes of K damaging pair-steps, as the DOG's generative mode gives them:
+    (draws, K) damage in HP (summed, in [1, 100]) and hit-group codes. A weapon the rules lack
+    raises `UnknownWeaponError`."""
+    draw = np.random.default_rng(seed)
+    damage = np.zeros((draws, len(weapons)))
+    group = np.zeros((draws, len(weapons)), dtype=np.int64)
+    for d in range(draws):
+        for k, weapon in enumerate(weapons):
+            if weapon not in WEAPON_RULES:
+                damage[d, k], group[d, k] = 1, GROUPS.index("Chest")
+                continue
+            health, _, name = pair_outcome(
+                rules,
+                weapon,
+                float(distances_m[k]) / HAMMER_TO_M,
+                int(armor[k]),
+                bool(helmet[k]),
+                draw,
+            )
+            damage[d, k] = min(max(health, 1), 100)
+            group[d, k] = GROUPS.index(name)
+    return damage, group
+
+
 class RulesDamage:
     """A `DamageModel`: DIP decides who hits, the rules how much and where (module doc)."""
 
@@ -176,23 +232,15 @@ class RulesDamage:
         hit = known & self.decision.hits(batch, encode(batch, self.dip.spec), seed)
         draw = np.random.default_rng(seed)
         for row in np.flatnonzero(hit):
-            weapon = str(batch.attacker_weapon[row])
-            distance_u = float(batch.distance[row]) / HAMMER_TO_M
-            p = self.rules.bullets.probabilities(weapon)
-            count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
-            groups = self.rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
-            armor = int(batch.victim_armor[row])
-            helmet = bool(batch.victim_helmet[row])
-            health, taken, largest, largest_group = 0, 0, -1, groups[0]
-            for name in groups:
-                bullet = shot_damage(weapon, name, distance_u, armor=armor, helmet=helmet)
-                health += bullet.health
-                taken += bullet.armor
-                armor = max(armor - bullet.armor, 0)
-                if bullet.health > largest:
-                    largest, largest_group = bullet.health, name
-            most = max(int(batch.victim_hp[row]), 1)
-            damage[row] = min(max(health, 1), most)
-            armor_damage[row] = min(taken, int(batch.victim_armor[row]))
-            group[row] = GROUPS.index(rule_group(largest_group))
+            health, taken, name = pair_outcome(
+                self.rules,
+                str(batch.attacker_weapon[row]),
+                float(batch.distance[row]) / HAMMER_TO_M,
+                int(batch.victim_armor[row]),
+                bool(batch.victim_helmet[row]),
+                draw,
+            )
+            damage[row] = min(max(health, 1), max(int(batch.victim_hp[row]), 1))
+            armor_damage[row] = taken
+            group[row] = GROUPS.index(name)
         return DamageResult(damage, group, hit, armor_damage)

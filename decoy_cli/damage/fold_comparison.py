@@ -1,0 +1,151 @@
+"""Damage outcome models side by side on the same leave-rounds-out folds of real damaging steps.
+
+The unit is the DOG's: one damaging (attacker, victim, 0.5 s step) sample of the events mode, its
+damage summed over the step's hits (capped at 100 HP) and its hit group that of the largest hit.
+The rounds are dealt into `FOLDS` folds; each fold's samples are generated (`DRAWS` draws each)
+by each model:
+
+* "rules": the rules-grounded model (decoy_cli/damage/rules_model.py) with its learned parts
+  fitted on the other folds' rounds only;
+* a model folder's DOG (e.g. the paper's checkpoint, trained on other matches): the same network
+  for every fold, honest on rounds it never saw.
+
+Pooled over the folds (every sample a test sample once): the mean Wasserstein distance per
+(weapon, hit group) cell with at least `MIN_CELL` real samples (the paper's generative protocol,
+`decoy_cli/damage/scores.wasserstein_cells`) and its largest cell, the hit-group total variation
+per weapon with at least `MIN_WEAPON_SAMPLES` samples, and the spread of the per-fold means.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.damage.features import HIT_GROUPS
+from decoy_cli.damage.rules_model import fit_rules, rules_generate
+from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
+from decoy_cli.damage.scores import wasserstein_cells
+from decoy_cli.esta import Round
+
+FOLDS = 5
+DRAWS = 10
+MIN_CELL = 5
+MIN_WEAPON_SAMPLES = 30
+
+
+@dataclass(frozen=True)
+class ModelScores:
+    """One model's pooled and per-fold results."""
+
+    name: str
+    mean_wasserstein_hp: float
+    max_wasserstein_hp: float
+    cells: int
+    fold_means: list[float]
+    group_tv: dict[str, float]
+    """weapon -> total variation of the real and generated hit-group shares."""
+
+
+def _group_key(samples: Samples) -> np.ndarray:
+    return np.asarray(samples.group, dtype=object)
+
+
+def _score(
+    name: str,
+    real: Samples,
+    damage: np.ndarray,
+    group: np.ndarray,
+    fold_of_sample: np.ndarray,
+) -> ModelScores:
+    """Metrics of (draws, K) generated damage and groups against the K real samples."""
+    draws = damage.shape[0]
+    weapon = np.asarray(real.attacker_weapon, dtype=object)
+
+    def cells(index: np.ndarray) -> list:
+        return wasserstein_cells(
+            weapon[index],
+            real.hit_group[index],
+            np.minimum(real.damage[index], MAX_DAMAGE_HP),
+            np.tile(weapon[index], draws),
+            group[:, index].ravel(),
+            damage[:, index].ravel(),
+            min_cell=MIN_CELL,
+        )
+
+    pooled = cells(np.arange(len(real)))
+    fold_means = []
+    for fold in np.unique(fold_of_sample):
+        found = cells(np.flatnonzero(fold_of_sample == fold))
+        if found:
+            fold_means.append(float(np.mean([c.wasserstein_hp for c in found])))
+    tv = {}
+    for name_w in sorted(set(weapon)):
+        rows = weapon == name_w
+        if rows.sum() < MIN_WEAPON_SAMPLES:
+            continue
+        p = np.bincount(real.hit_group[rows], minlength=len(HIT_GROUPS)) / rows.sum()
+        generated = group[:, rows].ravel()
+        q = np.bincount(generated, minlength=len(HIT_GROUPS)) / len(generated)
+        tv[str(name_w)] = 0.5 * float(np.abs(p - q).sum())
+    values = [c.wasserstein_hp for c in pooled]
+    return ModelScores(
+        name,
+        float(np.mean(values)) if values else float("nan"),
+        float(np.max(values)) if values else float("nan"),
+        len(values),
+        fold_means,
+        tv,
+    )
+
+
+def compare_on_folds(
+    rounds: Sequence[Round],
+    samples: Samples,
+    model_folders: dict[str, Path],
+    seed: int = 0,
+    draws: int = DRAWS,
+) -> list[ModelScores]:
+    """Every model's scores on the same folds of the damaging samples (module doc)."""
+    from decoy_cli.damage.damage_rows import group_id
+    from decoy_cli.damage.evaluation import dog_generate
+    from decoy_cli.damage.model_folder import load_dog
+
+    positives = samples.take(np.flatnonzero(samples.hit))
+    groups = _group_key(positives)
+    keys = np.array(sorted(set(groups)))
+    rng = np.random.default_rng(seed)
+    fold_of_group = dict(zip(rng.permutation(keys), np.arange(len(keys)) % FOLDS, strict=True))
+    fold = np.array([fold_of_group[g] for g in groups])
+    round_of_group = {group_id(r): r for r in rounds}
+    results = []
+
+    damage = np.zeros((draws, len(positives)))
+    group = np.zeros((draws, len(positives)), dtype=np.int64)
+    distance = np.linalg.norm(positives.victim_position - positives.attacker_position, axis=1)
+    for k in range(FOLDS):
+        test = np.flatnonzero(fold == k)
+        if not len(test):
+            continue
+        train_rounds = [
+            round_of_group[g] for g in keys if fold_of_group[g] != k and g in round_of_group
+        ]
+        rules = fit_rules(train_rounds)
+        damage[:, test], group[:, test] = rules_generate(
+            rules,
+            list(positives.attacker_weapon[test]),
+            distance[test],
+            positives.victim_armor[test],
+            positives.victim_helmet[test],
+            seed + k,
+            draws,
+        )
+    results.append(_score("rules (fitted per fold)", positives, damage, group, fold))
+
+    for name, folder in model_folders.items():
+        dog = load_dog(folder)
+        damage, group = dog_generate(dog, positives, seed, draws)
+        results.append(_score(name, positives, damage, group, fold))
+    return results
