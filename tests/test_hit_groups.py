@@ -117,3 +117,14 @@ def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
         assert set(scores.group_tv) == {"AK-47", "M4A4", "USP-S"}
     # the game's rules beat the DOG trained on most of these very rounds
     assert rules.mean_wasserstein_hp < shipped.mean_wasserstein_hp
+
+
+def test_hit_group_tv_on_hand_cases() -> None:
+    from decoy_cli.damage.scores import hit_group_tv
+
+    weapons = np.array(["AK-47"] * 40 + ["AWP"] * 5, dtype=object)
+    real = np.array([0] * 20 + [2] * 20 + [2] * 5)
+    same = hit_group_tv(weapons, real, weapons, real)
+    assert same == {"AK-47": 0.0}  # the AWP has too few samples
+    generated = np.array([2] * 40 + [2] * 5)
+    assert hit_group_tv(weapons, real, weapons, generated) == {"AK-47": 0.5}

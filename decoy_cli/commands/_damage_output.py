@@ -175,6 +175,8 @@ def dog_table(metrics: dict[str, Any], title: str) -> Table:
         "–",
     )
     table.add_row("damaging samples", f"{metrics['samples']:,}", "–")
+    for weapon, tv in metrics.get("hit_group_tv", {}).items():
+        table.add_row(f"hit-group total variation, {weapon}", _number(tv, 3), "–")
     return table
 
 

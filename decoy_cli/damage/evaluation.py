@@ -41,6 +41,7 @@ from decoy_cli.damage.scores import (
     MIN_CELL,
     Cell,
     classification_metrics,
+    hit_group_tv,
     regression_metrics,
     wasserstein_cells,
 )
@@ -221,6 +222,9 @@ def evaluate_dog(
         if cells
         else math.nan,
         "wasserstein_cells": len(cells),
+        "hit_group_tv": hit_group_tv(
+            positives.attacker_weapon, real_group, generated_weapon, generated_group.ravel()
+        ),
         "min_cell": min_cell,
         "draws": draws,
         "cells": [c.__dict__ for c in cells],

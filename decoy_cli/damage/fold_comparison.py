@@ -13,7 +13,7 @@ by each model:
 Pooled over the folds (every sample a test sample once): the mean Wasserstein distance per
 (weapon, hit group) cell with at least `MIN_CELL` real samples (the paper's generative protocol,
 `decoy_cli/damage/scores.wasserstein_cells`) and its largest cell, the hit-group total variation
-per weapon with at least `MIN_WEAPON_SAMPLES` samples, and the spread of the per-fold means.
+per weapon with at least 30 samples (`scores.hit_group_tv`), and the spread of the per-fold means.
 """
 
 from __future__ import annotations
@@ -24,16 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.features import HIT_GROUPS
 from decoy_cli.damage.rules_model import fit_rules, rules_generate
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
-from decoy_cli.damage.scores import wasserstein_cells
+from decoy_cli.damage.scores import hit_group_tv, wasserstein_cells
 from decoy_cli.esta import Round
 
 FOLDS = 5
 DRAWS = 10
 MIN_CELL = 5
-MIN_WEAPON_SAMPLES = 30
 
 
 @dataclass(frozen=True)
@@ -81,15 +79,7 @@ def _score(
         found = cells(np.flatnonzero(fold_of_sample == fold))
         if found:
             fold_means.append(float(np.mean([c.wasserstein_hp for c in found])))
-    tv = {}
-    for name_w in sorted(set(weapon)):
-        rows = weapon == name_w
-        if rows.sum() < MIN_WEAPON_SAMPLES:
-            continue
-        p = np.bincount(real.hit_group[rows], minlength=len(HIT_GROUPS)) / rows.sum()
-        generated = group[:, rows].ravel()
-        q = np.bincount(generated, minlength=len(HIT_GROUPS)) / len(generated)
-        tv[str(name_w)] = 0.5 * float(np.abs(p - q).sum())
+    tv = hit_group_tv(weapon, real.hit_group, np.tile(weapon, draws), group.ravel())
     values = [c.wasserstein_hp for c in pooled]
     return ModelScores(
         name,

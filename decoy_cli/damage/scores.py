@@ -173,3 +173,30 @@ def wasserstein_cells(
                 distance = float(wasserstein_distance(real, generated))
                 cells.append(Cell(str(weapon), name, len(real), len(generated), distance))
     return sorted(cells, key=lambda c: (-c.real, c.weapon, c.hit_group))
+
+
+MIN_WEAPON_SAMPLES = 30
+"""Fewest real samples of a weapon for its hit-group total variation."""
+
+
+def hit_group_tv(
+    real_weapon: np.ndarray,
+    real_group: np.ndarray,
+    generated_weapon: np.ndarray,
+    generated_group: np.ndarray,
+    min_samples: int = MIN_WEAPON_SAMPLES,
+) -> dict[str, float]:
+    """Per weapon with at least `min_samples` real samples: the total variation distance
+    between the real and the generated hit-group shares (0: the same, 1: disjoint)."""
+    out = {}
+    for weapon in sorted(set(np.asarray(real_weapon, dtype=object).tolist())):
+        real = np.asarray(real_group)[np.asarray(real_weapon, dtype=object) == weapon]
+        generated = np.asarray(generated_group)[
+            np.asarray(generated_weapon, dtype=object) == weapon
+        ]
+        if len(real) < min_samples or not len(generated):
+            continue
+        p = np.bincount(real, minlength=len(HIT_GROUPS)) / len(real)
+        q = np.bincount(generated, minlength=len(HIT_GROUPS)) / len(generated)
+        out[str(weapon)] = 0.5 * float(np.abs(p - q).sum())
+    return out
