@@ -17,9 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.damage import SHIPPED_MODELS
-from decoy_cli.damage.fold_comparison import compare_on_folds
+from decoy_cli.damage.fold_comparison import CvaeTraining, compare_on_folds
+from decoy_cli.damage.model_folder import load_dog
 from decoy_cli.damage.paper import import_paper
 from decoy_cli.damage.samples import build_samples
+from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import collect_match_files, read_match
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -30,6 +32,9 @@ def main() -> None:
     parser.add_argument("inputs", nargs="*", type=Path, default=[SHARED / "esta_dust2_events"])
     parser.add_argument("--paper", type=Path, default=SHARED / "decoy_checkpoints")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--no-cvae", action="store_true", help="skip training the project's CVAE per fold"
+    )
     args = parser.parse_args()
     files, _ = collect_match_files(args.inputs)
     rounds = [r for f in files for r in read_match(f).rounds]
@@ -40,7 +45,12 @@ def main() -> None:
         if args.paper.is_dir():
             import_paper(args.paper, Path(scratch) / "paper")
             folders = {"paper DOG (imported checkpoint)": Path(scratch) / "paper", **folders}
-        results = compare_on_folds(rounds, samples, folders, seed=args.seed)
+        cvae = None
+        if not args.no_cvae:  # the shipped DOG's training (models/DOG_CARD.md)
+            options = TrainOptions(epochs=1000, batch_size=32, learning_rate=1e-3, patience=100)
+            spec = load_dog(SHIPPED_MODELS).spec
+            cvae = CvaeTraining(options, DogLossWeights(kl=0.05), spec)
+        results = compare_on_folds(rounds, samples, folders, seed=args.seed, cvae=cvae)
     print(f"{'model':<46} {'mean W':>7} {'max W':>7} {'cells':>5} {'per fold':>14}  hit-group TV")
     for r in results:
         folds = np.array(r.fold_means)

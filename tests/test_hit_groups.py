@@ -103,15 +103,28 @@ def test_the_real_hits_leave_rounds_out() -> None:
 @pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
 def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
     from decoy_cli.damage import SHIPPED_MODELS
-    from decoy_cli.damage.fold_comparison import FOLDS, compare_on_folds
+    from decoy_cli.damage.fold_comparison import FOLDS, CvaeTraining, compare_on_folds
+    from decoy_cli.damage.model_folder import load_dog
     from decoy_cli.damage.samples import build_samples
+    from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 
     samples, _ = build_samples([EVENTS])
-    rules, shipped = compare_on_folds(
-        read_match(EVENTS).rounds, samples, {"shipped": SHIPPED_MODELS}, seed=0, draws=4
+    quick = CvaeTraining(
+        TrainOptions(epochs=3, batch_size=32, patience=2),
+        DogLossWeights(),
+        load_dog(SHIPPED_MODELS).spec,
+    )
+    rules, cvae, shipped = compare_on_folds(
+        read_match(EVENTS).rounds,
+        samples,
+        {"shipped": SHIPPED_MODELS},
+        seed=0,
+        draws=4,
+        cvae=quick,
     )
     assert rules.name.startswith("rules") and shipped.name == "shipped"
-    for scores in (rules, shipped):
+    assert cvae.name == "project CVAE (trained per fold)"
+    for scores in (rules, cvae, shipped):
         assert scores.cells > 0 and np.isfinite(scores.mean_wasserstein_hp)
         assert len(scores.fold_means) == FOLDS
         assert set(scores.group_tv) == {"AK-47", "M4A4", "USP-S"}

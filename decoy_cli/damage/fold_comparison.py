@@ -8,7 +8,10 @@ by each model:
 * "rules": the rules-grounded model (decoy_cli/damage/rules_model.py) with its learned parts
   fitted on the other folds' rounds only;
 * a model folder's DOG (e.g. the paper's checkpoint, trained on other matches): the same network
-  for every fold, honest on rounds it never saw.
+  for every fold, honest on rounds it never saw;
+* with `cvae` given (training options, loss weights, features), the project's CVAE trained anew
+  for every fold on three of the other folds, the fourth stopping it early, as `decoy train dog`
+  trains the shipped one.
 
 Pooled over the folds (every sample a test sample once): the mean Wasserstein distance per
 (weapon, hit group) cell with at least `MIN_CELL` real samples (the paper's generative protocol,
@@ -24,14 +27,59 @@ from pathlib import Path
 
 import numpy as np
 
+from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.rules_model import fit_rules, rules_generate
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
 from decoy_cli.damage.scores import hit_group_tv, wasserstein_cells
+from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
 
 FOLDS = 5
 DRAWS = 10
 MIN_CELL = 5
+
+
+@dataclass(frozen=True)
+class CvaeTraining:
+    """How to train the project's CVAE in each fold (module doc)."""
+
+    options: TrainOptions
+    weights: DogLossWeights
+    spec: FeatureSpec
+
+
+def _cvae_per_fold(
+    positives: Samples, fold: np.ndarray, cvae: CvaeTraining, seed: int, draws: int
+) -> tuple[np.ndarray, np.ndarray]:
+    from typing import cast
+
+    from decoy_cli.damage.evaluation import dog_generate
+    from decoy_cli.damage.model_folder import LoadedDog
+    from decoy_cli.damage.networks import DogNet
+    from decoy_cli.damage.training import train_dog
+
+    damage = np.zeros((draws, len(positives)))
+    group = np.zeros((draws, len(positives)), dtype=np.int64)
+    for k in range(FOLDS):
+        test = np.flatnonzero(fold == k)
+        if not len(test):
+            continue
+        val = np.flatnonzero(fold == (k + 1) % FOLDS)
+        train = np.flatnonzero((fold != k) & (fold != (k + 1) % FOLDS))
+        t, v = positives.take(train), positives.take(val)
+        trained = train_dog(
+            t.features(cvae.spec),
+            t.damage,
+            t.hit_group,
+            v.features(cvae.spec),
+            v.damage,
+            v.hit_group,
+            cvae.options,
+            cvae.weights,
+        )
+        model = LoadedDog(cast(DogNet, trained.net), cvae.spec)
+        damage[:, test], group[:, test] = dog_generate(model, positives.take(test), seed + k, draws)
+    return damage, group
 
 
 @dataclass(frozen=True)
@@ -97,6 +145,7 @@ def compare_on_folds(
     model_folders: dict[str, Path],
     seed: int = 0,
     draws: int = DRAWS,
+    cvae: CvaeTraining | None = None,
 ) -> list[ModelScores]:
     """Every model's scores on the same folds of the damaging samples (module doc)."""
     from decoy_cli.damage.damage_rows import group_id
@@ -133,6 +182,10 @@ def compare_on_folds(
             draws,
         )
     results.append(_score("rules (fitted per fold)", positives, damage, group, fold))
+
+    if cvae is not None:
+        damage, group = _cvae_per_fold(positives, fold, cvae, seed, draws)
+        results.append(_score("project CVAE (trained per fold)", positives, damage, group, fold))
 
     for name, folder in model_folders.items():
         dog = load_dog(folder)
