@@ -35,6 +35,7 @@ from decoy_cli.damage.rules import WEAPON_RULES, rule_group, shot_damage
 from decoy_cli.damage.rules_check import firearm_hits
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
+from decoy_cli.files import write_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
@@ -82,18 +83,13 @@ class RulesFile:
     provenance: dict[str, object] = field(default_factory=dict)
 
     def save(self, folder: Path) -> Path:
-        path = Path(folder) / RULES_FILE
-        text = json.dumps(
-            {
-                "hit_groups": json.loads(self.hit_groups.to_json()),
-                "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
-                "provenance": self.provenance,
-            },
-            indent=1,
-            sort_keys=True,
-        )
-        path.write_text(text + "\n")
-        return path
+        """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
+        data = {
+            "hit_groups": json.loads(self.hit_groups.to_json()),
+            "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
+            "provenance": self.provenance,
+        }
+        return write_json(Path(folder) / RULES_FILE, data)
 
     @classmethod
     def load(cls, folder: Path) -> RulesFile:
