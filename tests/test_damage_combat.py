@@ -441,3 +441,44 @@ def test_the_shipped_rules_are_a_models_choice() -> None:
     model = load_damage_model("rules")
     assert isinstance(model, RulesDamage)
     assert model.rules.provenance["hits"] == 396
+
+
+def test_rules_bullets_wear_armour_down_one_after_another() -> None:
+    from decoy_cli.damage.hit_groups import HitGroupModel
+    from decoy_cli.damage.rules_model import BulletCounts, RulesFile, pair_outcome
+
+    three = BulletCounts()
+    three.add("AK-47", 3)
+    hit_groups = HitGroupModel.fit(["AK-47"], [800.0], ["Chest"])
+    hit_groups.sample = lambda rng, weapons, distances: ["Chest"] * len(weapons)  # type: ignore[method-assign]
+    rules = RulesFile(hit_groups, three)
+    # AK-47 chest at 800 u does 34.86: with 5 armour 27 HP and 3 armour, then with 2 armour
+    # left 34.86 - 2 / 0.5 = 30 HP and 2 armour, then 34 HP bare
+    health, taken, group = pair_outcome(rules, "AK-47", 800.0, 5, False, np.random.default_rng(0))
+    assert (health, taken, group) == (27 + 30 + 34, 5, "Chest")
+
+
+def test_bernoulli_hits_and_rules_outcomes_draw_from_separate_streams(firing: Path) -> None:
+    import shutil
+
+    from decoy_cli.damage.calibration import Calibration
+    from decoy_cli.damage.model_folder import save_calibration
+    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
+
+    if not shipped_models_installed():
+        pytest.skip("no shipped models")
+    rules = RulesFile.load(decoy_cli.damage.SHIPPED_MODELS)
+    folder = Path(str(firing) + "-bernoulli")
+    shutil.copytree(firing, folder, dirs_exist_ok=True)
+    save_calibration(folder, Calibration("platt", 0.0, 0.0, 0.5, "bernoulli"))  # p' = 0.5
+    model = RulesDamage(load_dip(folder), rules)
+    pairs = batch(1, seed=3, weapons=["AK-47"])
+    pairs.victim_hp[:] = 100
+    pairs.victim_armor[:] = 0
+    rng = np.random.default_rng(11)
+    damage = [model(pairs, rng).damage[0] for _ in range(3000)]
+    hits = np.array(damage)[np.array(damage) > 0]
+    assert 0.45 < len(hits) / 3000 < 0.55
+    # more than one bullet lands in some steps, as the fitted counts say (a shared stream made
+    # every Bernoulli hit a one-bullet step)
+    assert np.mean(hits > 40) > 0.1

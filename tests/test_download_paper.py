@@ -74,19 +74,22 @@ def test_a_wrong_checksum_or_a_cut_download_imports_nothing(
     body = repository.files[path]
     repository.files[path] = body[:-10] + b"0123456789"  # same size, other bytes
     result = run(repository.base_url, tmp_path / "a")
-    assert result.exit_code != 0 and "not the published file" in result.output
+    assert result.exit_code == 1 and "not the published file" in result.output
     assert not (tmp_path / "a" / "dog.json").exists()
     assert not list((tmp_path / "a" / "checkpoints").glob("*.part"))
     repository.files[path] = body
     repository.behaviours[path] = "truncated"
     result = run(repository.base_url, tmp_path / "b")
-    assert result.exit_code != 0 and "cut short" in result.output
+    assert result.exit_code == 1 and "cut short" in result.output
+    assert not (tmp_path / "b" / "dog.json").exists()
+    assert not list((tmp_path / "b" / "checkpoints").glob("*.part"))
     assert "Traceback" not in result.output
 
 
 def test_no_network_is_one_line(tmp_path: Path) -> None:
     result = run("http://127.0.0.1:9", tmp_path / "paper")  # nothing listens on port 9
-    assert result.exit_code != 0
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert not (tmp_path / "paper").exists()  # no empty folders left behind
     assert "error: dip_best_model.pth: cannot reach 127.0.0.1:9" in result.output
 
 

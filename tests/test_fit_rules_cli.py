@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model
 from decoy_cli.damage.rules_model import MAX_BULLETS, RulesDamage
+from decoy_cli.errors import ModelError
 
 runner = CliRunner()
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,11 +37,17 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
 
 def test_bad_folders_are_one_error_line(tmp_path: Path) -> None:
     result = runner.invoke(app, ["models", "fit-rules", str(tmp_path), str(tmp_path)])
-    assert result.exit_code != 0 and "holds no dip.json" in result.output
+    assert result.exit_code == 1 and "error: " in result.output
+    assert "holds no dip.json" in result.output
+    with_dog = runner.invoke(app, ["models", "fit-rules", str(ROOT / "models"), str(tmp_path)])
+    assert with_dog.exit_code == 1 and "holds a DOG" in with_dog.output
     folder = tmp_path / "broken"
     folder.mkdir()
     for name in ("dip.pt", "dip.json"):
         shutil.copy(ROOT / "models" / name, folder / name)
     (folder / "rules.json").write_text("{not json")
-    with pytest.raises(Exception, match="not a rules file"):
+    with pytest.raises(ModelError, match="not a rules file"):
+        load_damage_model(str(folder))
+    (folder / "rules.json").write_text('{"hit_groups": {}, "bullets": {}, "provenance": "x"}')
+    with pytest.raises(ModelError, match="not a rules file"):
         load_damage_model(str(folder))

@@ -141,3 +141,27 @@ def test_hit_group_tv_on_hand_cases() -> None:
     assert same == {"AK-47": 0.0}  # the AWP has too few samples
     generated = np.array([2] * 40 + [2] * 5)
     assert hit_group_tv(weapons, real, weapons, generated) == {"AK-47": 0.5}
+
+
+@pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
+def test_the_rules_of_each_fold_never_see_its_test_rounds(monkeypatch: pytest.MonkeyPatch) -> None:
+    import decoy_cli.damage.fold_comparison as comparison
+    from decoy_cli.damage.damage_rows import group_id
+    from decoy_cli.damage.samples import build_samples
+
+    seen: list[set[str]] = []
+    real_fit = comparison.fit_rules
+
+    def recording_fit(rounds):  # type: ignore[no-untyped-def]
+        seen.append({group_id(r) for r in rounds})
+        return real_fit(rounds)
+
+    monkeypatch.setattr(comparison, "fit_rules", recording_fit)
+    samples, _ = build_samples([EVENTS])
+    rounds = read_match(EVENTS).rounds
+    comparison.compare_on_folds(rounds, samples, {}, seed=0, draws=2)
+    everything = {group_id(r) for r in rounds if r.damages is not None and len(r.damages)}
+    held_out = [everything - fitted for fitted in seen]
+    assert len(seen) == comparison.FOLDS and all(held_out)
+    # the held-out rounds of the folds partition the rounds: each is a test round exactly once
+    assert sum(len(h) for h in held_out) == len(set().union(*held_out))

@@ -124,12 +124,19 @@ def fit_rules_command(
 ) -> None:
     """Learn the parts of the rules-grounded damage model from real hits (where shots land, by
     weapon and distance; how many land in one 0.5 s step, by weapon class) and write rules.json
-    into the folder: with its DIP, `--models FOLDER` then damages by the game's rules."""
+    into a folder that holds a DIP and no DOG: `--models FOLDER` then damages by the game's
+    rules. (A folder with a DOG keeps damaging by its DOG: copy its dip.* to a new folder.)"""
     from decoy_cli.damage.rules_model import fit_rules
     from decoy_cli.esta import collect_match_files, read_match
 
     if not (model_folder / "dip.json").is_file():
         raise DecoyError(f"{model_folder}: holds no dip.json to pair the rules with")
+    if (model_folder / "dog.json").is_file():
+        raise DecoyError(
+            f"{model_folder}: holds a DOG, which --models would use instead of the rules; "
+            "copy dip.pt and dip.json to a folder of their own and fit the rules there"
+        )
+    check_folder_writable(model_folder)
     files, _ = collect_match_files(data)
     rounds = [r for f in files for r in read_match(f).rounds]
     rules = fit_rules(rounds)
@@ -166,8 +173,16 @@ def calibrate(
     scaling) and write dip_calibration.json into the folder; prints the Brier score and the
     expected calibration error before and after on the validation and test parts (the same
     split options as training give the same parts)."""
+    from decoy_cli.damage.calibration import DECISIONS, KINDS
     from decoy_cli.damage.folder_calibration import calibrate_dip_folder
 
+    if method not in KINDS or decision not in DECISIONS:
+        raise DecoyError(
+            f"--method {method!r} / --decision {decision!r}: the methods are "
+            f"{', '.join(KINDS)}, the decisions {', '.join(DECISIONS)}"
+        )
+    if (model_folder / "dip.json").is_file():
+        check_folder_writable(model_folder)
     choice = SampleChoice(
         data=data,
         mode=mode,

@@ -3,8 +3,13 @@
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
-* paper.py: import of the paper's published checkpoints;
-* combat.py: `LearnedDamage`, the simulator's `DamageModel` over a DIP and a DOG;
+* paper.py, download_paper.py: import of the paper's published checkpoints, and their download;
+* combat.py: `DipDecision` (who hits) and `LearnedDamage`, the simulator's `DamageModel` over a
+  DIP and a DOG;
+* rules.py, rules_check.py: CS:GO's damage rules and their check against real hits;
+  hit_groups.py, rules_model.py: `RulesDamage`, the DIP with damage by the rules (`rules.json`);
+  rules_evaluation.py, fold_comparison.py: the models on leave-rounds-out folds of real hits;
+* calibration.py, folder_calibration.py: how calibrated DIP is, and its recalibration;
 * samples.py: training samples from ESTA rounds (with sample_set.py, damage_rows.py,
   frames_mode.py, events_mode.py, split.py);
 * train_options.py, training.py, training_run.py, provenance.py: training a model and writing

@@ -93,6 +93,7 @@ def _logit(p: np.ndarray) -> np.ndarray:
 
 
 DECISIONS = ("threshold", "bernoulli")
+KINDS = ("platt", "temperature", "none")
 
 
 @dataclass(frozen=True)
@@ -135,11 +136,11 @@ class Calibration:
     def from_json(cls, text: str) -> Calibration:
         """A calibration written by `to_json`; anything else is a ValueError."""
         data = json.loads(text)
-        if data.get("kind") not in ("platt", "temperature", "none"):
+        if not isinstance(data, dict) or data.get("kind") not in KINDS:
             raise ValueError(f"not a DIP calibration: kind {data.get('kind')!r}")
         a, b, threshold = (float(data[k]) for k in ("a", "b", "threshold"))
-        if not all(math.isfinite(v) for v in (a, b, threshold)):
-            raise ValueError("a DIP calibration with non-finite parameters")
+        if not all(math.isfinite(v) for v in (a, b, threshold)) or not 0 <= threshold <= 1:
+            raise ValueError("a DIP calibration with non-finite parameters or threshold")
         decision = data.get("decision", "threshold")
         if decision not in DECISIONS:
             raise ValueError(f"unknown decision {decision!r}: threshold or bernoulli")
@@ -168,7 +169,7 @@ def fit_calibration(
     y, p = _arrays(labels, probabilities)
     if kind == "none":
         return Calibration("none", 1.0, 0.0, threshold, decision)
-    if kind not in ("platt", "temperature"):
+    if kind not in KINDS:
         raise ValueError(f"unknown calibration {kind!r}: platt, temperature or none")
     if len(p) < 2 or y.all() or not y.any():
         raise ValueError("calibration needs validation samples of both classes")
@@ -179,6 +180,11 @@ def fit_calibration(
     else:
         fitted = minimize(lambda v: _log_loss(y, v[0] * x), x0=[1.0], method="BFGS")
         a, b = float(fitted.x[0]), 0.0
+    if not a > 0:
+        raise ValueError(
+            f"the fitted scaling reverses the probabilities (a = {a:.3g}): DIP ranks the "
+            "validation samples worse than chance; no calibration"
+        )
     raw = Calibration("none", 1.0, 0.0, threshold)
     scaled = Calibration(kind, a, b, threshold)
     moved = float(scaled.apply(np.array([raw.threshold]))[0])

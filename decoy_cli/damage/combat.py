@@ -164,7 +164,9 @@ class DipDecision:
             logits = self._dip(_stacked(features))
         return torch.sigmoid(logits).numpy().astype(np.float64)
 
-    def hits(self, batch: CombatBatch, features: Features, seed: int) -> np.ndarray:
+    def hits(
+        self, batch: CombatBatch, features: Features, seed: int | np.random.SeedSequence
+    ) -> np.ndarray:
         """(K,) bool: the pairs that hit (class doc); `seed` drives Bernoulli decisions."""
         probability = self.hit_probability(batch, features)
         armed = weapon_index(batch.attacker_weapon) >= 0

@@ -9,6 +9,7 @@ under temporary names and renamed only when verified.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import tempfile
@@ -63,10 +64,21 @@ def download_paper_files(
     """Fetch and verify every file of `PAPER_FILES` into `dest` (module doc); files already
     there with the right checksum are kept. One DownloadError or OutputError line on failure."""
     dest = Path(dest)
+    created = [p for p in (dest.parent, dest) if not p.exists()]
     try:
         dest.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise OutputError(f"cannot write to {dest}: {error.strerror or error}") from None
+    try:
+        return _download_all(dest, base_url, timeout)
+    except BaseException:
+        for folder in reversed(created):  # leave no empty folders behind a failed download
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
+
+
+def _download_all(dest: Path, base_url: str, timeout: float) -> list[Path]:
     written = []
     for name, expected in PAPER_FILES.items():
         target = dest / name

@@ -120,4 +120,11 @@ class HitGroupModel:
             or tuple(data.get("distance_bands_u", ())) != DISTANCE_BANDS_U
         ):
             raise ValueError("a hit-group model of other groups or distance bands")
+        shape = (len(DISTANCE_BANDS_U) + 1, len(GROUPS))
+        tables = [data["band_counts"], *data["weapon_counts"].values()]
+        tables += list(data["class_counts"].values())
+        for table in tables:
+            counts = np.asarray(table, dtype=np.float64)
+            if counts.shape != shape or not (np.isfinite(counts).all() and (counts >= 0).all()):
+                raise ValueError(f"hit counts must be {shape[0]} x {shape[1]} and not negative")
         return cls(data["weapon_counts"], data["class_counts"], data["band_counts"])

@@ -143,7 +143,7 @@ def load_calibration(folder: Path) -> Calibration | None:
         return None
     try:
         return Calibration.from_json(path.read_text())
-    except (OSError, ValueError, KeyError, TypeError) as error:
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise ModelError(f"{path}: not a DIP calibration ({error})") from None
 
 

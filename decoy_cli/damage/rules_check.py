@@ -50,6 +50,8 @@ def firearm_hits(damages: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, int]]:
     drop(world, "no attacker")
     rows = rows[~world]
     friendly = rows["isFriendlyFire"].fillna(False).astype(bool)
+    if "victimSide" in rows and "attackerSide" in rows:
+        friendly |= rows["attackerSide"].eq(rows["victimSide"]) & rows["victimSide"].notna()
     drop(friendly, "friendly fire")
     rows = rows[~friendly]
     generic = rows["hitGroup"].isin(["Generic"]) | rows["hitGroup"].isna()
@@ -59,6 +61,7 @@ def firearm_hits(damages: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, int]]:
     drop(unknown, "not a firearm of the rule table")
     rows = rows[~unknown]
     missing = rows[["hpDamage", "armorDamage", "distance"]].isna().any(axis=1)
+    missing |= ~(pd.to_numeric(rows["hpDamage"], errors="coerce") > 0)
     drop(missing, "no damage, armour or distance value")
     return rows[~missing].reset_index(drop=True), left_out
 

@@ -60,7 +60,8 @@ class RulesEvaluation:
     group_tv: pd.DataFrame
     """weapon, hits, tv, and the real and drawn shares of every group."""
     armour_shares: dict[str, tuple[float, float]]
-    """(kevlar share, helmet share) by the victim side's buy type, over all training folds."""
+    """(kevlar share, helmet share) by the victim side's buy type over all hits, for the report
+    (each fold's draws use the shares of its training folds only)."""
 
 
 def _shares(hits: pd.DataFrame) -> tuple[float, float]:

@@ -27,12 +27,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
 from decoy_cli.damage.rules import WEAPON_RULES, rule_group, shot_damage
-from decoy_cli.damage.rules_check import firearm_hits
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
 from decoy_cli.files import write_json
@@ -102,6 +100,7 @@ class RulesFile:
                 {str(k): [float(v) for v in c] for k, c in data["bullets"]["by_class"].items()},
                 [float(v) for v in data["bullets"]["every"]],
             )
+            provenance = dict(data.get("provenance", {}))
         except OSError as error:
             raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
         except (ValueError, KeyError, TypeError, AttributeError) as error:
@@ -110,35 +109,49 @@ class RulesFile:
             len(c) != MAX_BULLETS for c in bullets.by_class.values()
         ):
             raise ModelError(f"{path}: bullet counts of another length than {MAX_BULLETS}")
-        return cls(hit_groups, bullets, dict(data.get("provenance", {})))
+        return cls(hit_groups, bullets, provenance)
 
 
 def fit_rules(rounds: Sequence[Round]) -> RulesFile:
-    """Learn the hit groups and the bullets per step from the rounds' firearm hits."""
-    tables = [
-        r.damages.assign(round=f"{r.match_id}:{r.round_num}", tick_rate=r.tick_rate)
-        for r in rounds
-        if len(r.damages)
-    ]
-    if not tables:
-        raise ModelError("no damage events in the data: nothing to learn the rules' parts from")
-    hits, left_out = firearm_hits(pd.concat(tables, ignore_index=True))
-    if not len(hits):
-        raise ModelError("no firearm hits between enemies in the data")
-    model = HitGroupModel.fit(hits["weapon"], hits["distance"], hits["hitGroup"])
+    """Learn the hit groups and the bullets per step from the rounds' firearm hits: the damage
+    rows the DOG's samples use (`damage_rows`), counted per (attacker, victim) and virtual 2 Hz
+    step exactly as the events mode aggregates them, so a step here is a sample's step."""
+    from decoy_cli.damage.damage_rows import damage_rows
+    from decoy_cli.damage.sample_set import SampleStats
+
+    stats = SampleStats()
+    weapons: list[str] = []
+    distances: list[float] = []
+    groups: list[str] = []
     bullets = BulletCounts()
-    for _, pair in hits.groupby(["round", "attackerName", "victimName"], sort=False):
-        ticks = pair["tick"].to_numpy(np.float64)
-        order = np.argsort(ticks, kind="stable")
-        window = STEP_S * float(pair["tick_rate"].iloc[0])
-        start, count, weapon = ticks[order[0]], 0, str(pair["weapon"].iloc[order[0]])
-        for k in order:
-            if ticks[k] - start >= window:
-                bullets.add(weapon, count)
-                start, count, weapon = ticks[k], 0, str(pair["weapon"].iloc[k])
-            count += 1
-        bullets.add(weapon, count)
-    provenance = {"hits": len(hits), "rounds": len(tables), "left_out": left_out}
+    used_rounds = 0
+    for round_ in rounds:
+        rows = damage_rows(round_, stats)
+        usable = np.flatnonzero(rows.usable & np.isfinite(round_.damages["distance"].to_numpy()))
+        if not len(usable):
+            continue
+        used_rounds += 1
+        table = round_.damages.iloc[usable]
+        weapons += [str(w) for w in table["weapon"]]
+        distances += [float(d) for d in table["distance"]]
+        groups += [str(g) for g in table["hitGroup"]]
+        step_ticks = max(1, round(round_.tick_rate * STEP_S))
+        origin = round_.start_tick if round_.start_tick is not None else 0
+        steps: dict[tuple[int, object, object], list[str]] = {}
+        for r in usable:
+            step = int(np.rint((rows.tick[r] - origin) / step_ticks))
+            steps.setdefault((step, rows.attacker[r], rows.victim[r]), []).append(rows.weapon[r])
+        for hits in steps.values():
+            bullets.add(hits[0], len(hits))
+    if not weapons:
+        raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
+    model = HitGroupModel.fit(weapons, distances, groups)
+    provenance = {
+        "hits": len(weapons),
+        "steps": int(sum(bullets.every)),
+        "rounds": used_rounds,
+        "left_out": dict(stats.excluded),
+    }
     return RulesFile(model, bullets, provenance)
 
 
@@ -225,8 +238,10 @@ class RulesDamage:
         if k == 0:
             return DamageResult(damage, group, np.zeros(0, dtype=bool), armor_damage)
         known = np.array([w in WEAPON_RULES for w in batch.attacker_weapon], dtype=bool)
-        hit = known & self.decision.hits(batch, encode(batch, self.dip.spec), seed)
-        draw = np.random.default_rng(seed)
+        # two independent streams: the hit decisions' and the outcomes'
+        decide_seed, outcome_seed = np.random.SeedSequence(seed).spawn(2)
+        hit = known & self.decision.hits(batch, encode(batch, self.dip.spec), decide_seed)
+        draw = np.random.default_rng(outcome_seed)
         for row in np.flatnonzero(hit):
             health, taken, name = pair_outcome(
                 self.rules,
