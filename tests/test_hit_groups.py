@@ -68,6 +68,14 @@ def test_events_made_by_the_rules_are_reproduced() -> None:
             hit = shot_damage(weapon, group, distance, armor=100, helmet=True)
             rows.append(
                 {
+                    # the columns the reader gives every damage row
+                    "tick": 1000 + 64 * len(rows),
+                    "attackerSteamID": 1,
+                    "attackerName": "a",
+                    "victimSteamID": 2,
+                    "victimName": "v",
+                    "weaponClass": "Rifle",
+                    "hpDamageTaken": hit.health,
                     "attackerSide": "T",
                     "victimSide": "CT",
                     "isFriendlyFire": False,

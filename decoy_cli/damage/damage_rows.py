@@ -24,20 +24,14 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.damage.features import WEAPONS
+from decoy_cli.damage.rules import HIT_GROUP_ALIASES
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, SampleStats
 from decoy_cli.esta import Round
+from decoy_cli.sim.combat import HIT_GROUPS
 
 _HIT_GROUP_CODE = {
-    "Head": 0,
-    "Neck": 1,
-    "Chest": 2,
-    "Stomach": 3,
-    "LeftArm": 4,
-    "RightArm": 4,
-    "Arm": 4,
-    "LeftLeg": 5,
-    "RightLeg": 5,
-    "Leg": 5,
+    name: HIT_GROUPS.index(HIT_GROUP_ALIASES.get(name, name))
+    for name in (*HIT_GROUPS, *HIT_GROUP_ALIASES)
 }
 
 VOCABULARY = frozenset(WEAPONS)
@@ -86,8 +80,13 @@ class DamageRows:
 
 
 def damage_rows(round_: Round, stats: SampleStats) -> DamageRows:
-    """Classify every damage row (module docstring) and count the reasons for leaving one out."""
-    table = round_.damages
+    """Classify every damage row of the round (module docstring), counting the reasons."""
+    return classify_damages(round_.damages, stats)
+
+
+def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
+    """Classify every row of an ESTA damages table (module docstring) and count the reasons
+    for leaving one out."""
     attacker = player_keys(table, "attacker")
     victim = player_keys(table, "victim")
     weapon = strings(table, "weapon")
@@ -154,6 +153,13 @@ def aggregate(
             group = int(damages.group_code[r])
         out[key] = (total + value, group, first)
     return {k: (min(v[0], MAX_DAMAGE_HP), v[1], v[2]) for k, v in out.items()}
+
+
+def step_clock(round_: Round) -> tuple[int, int]:
+    """(origin tick, ticks per step) of the round's virtual 2 Hz steps, the simulator's combat
+    step: a tick's step is rint((tick - origin) / ticks per step)."""
+    origin = round_.start_tick if round_.start_tick is not None else 0
+    return origin, max(1, round(round_.tick_rate / 2))
 
 
 def group_id(round_: Round) -> str:

@@ -34,6 +34,7 @@ from decoy_cli.damage.damage_rows import (
     group_id,
     ints,
     player_keys,
+    step_clock,
     strings,
 )
 from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
@@ -95,8 +96,7 @@ class _EventRound:
     def __init__(self, round_: Round, damages: DamageRows) -> None:
         self.round = round_
         self.damages = damages
-        self.step_ticks = max(1, round(round_.tick_rate / 2))
-        self.origin = round_.start_tick if round_.start_tick is not None else 0
+        self.origin, self.step_ticks = step_clock(round_)
         kills = round_.kills
         self.kill_tick = ints(kills, "tick")
         self.kill_victim = player_keys(kills, "victim")

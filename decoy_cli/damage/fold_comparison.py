@@ -27,16 +27,17 @@ from pathlib import Path
 
 import numpy as np
 
+from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.rules_model import fit_rules, rules_generate
-from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
+from decoy_cli.damage.sample_set import Samples
 from decoy_cli.damage.scores import hit_group_tv, wasserstein_cells
+from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
 
-FOLDS = 5
-DRAWS = 10
 MIN_CELL = 5
+"""Fewest real samples of a cell in the Wasserstein mean (issue 13's protocol)."""
 
 
 @dataclass(frozen=True)
@@ -95,10 +96,6 @@ class ModelScores:
     """weapon -> total variation of the real and generated hit-group shares."""
 
 
-def _group_key(samples: Samples) -> np.ndarray:
-    return np.asarray(samples.group, dtype=object)
-
-
 def _score(
     name: str,
     real: Samples,
@@ -114,7 +111,7 @@ def _score(
         return wasserstein_cells(
             weapon[index],
             real.hit_group[index],
-            np.minimum(real.damage[index], MAX_DAMAGE_HP),
+            real.damage[index],  # capped at 100 HP when the samples were made
             np.tile(weapon[index], draws),
             group[:, index].ravel(),
             damage[:, index].ravel(),
@@ -153,11 +150,8 @@ def compare_on_folds(
     from decoy_cli.damage.model_folder import load_dog
 
     positives = samples.take(np.flatnonzero(samples.hit))
-    groups = _group_key(positives)
-    keys = np.array(sorted(set(groups)))
-    rng = np.random.default_rng(seed)
-    fold_of_group = dict(zip(rng.permutation(keys), np.arange(len(keys)) % FOLDS, strict=True))
-    fold = np.array([fold_of_group[g] for g in groups])
+    fold_of_group = deal_folds(positives.group.tolist(), np.random.default_rng(seed))
+    fold = np.array([fold_of_group[g] for g in positives.group])
     round_of_group = {group_id(r): r for r in rounds}
     results = []
 
@@ -169,7 +163,7 @@ def compare_on_folds(
         if not len(test):
             continue
         train_rounds = [
-            round_of_group[g] for g in keys if fold_of_group[g] != k and g in round_of_group
+            round_of_group[g] for g, f in fold_of_group.items() if f != k and g in round_of_group
         ]
         rules = fit_rules(train_rounds)
         damage[:, test], group[:, test] = rules_generate(

@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from decoy_cli.damage.rules import rule_group
+from decoy_cli.sim.combat import HIT_GROUPS
 from decoy_cli.weapons import WEAPONS
 
-GROUPS = ("Head", "Neck", "Chest", "Stomach", "Arm", "Leg")
-"""The hit groups of the rules, in the model's order."""
+GROUPS = HIT_GROUPS
+"""The hit groups, in the simulator's order (the rules name them the same way)."""
 
 DISTANCE_BANDS_U = (500.0, 1000.0, 1500.0)
 """Upper edges of the distance bands (Hammer units); a last band takes everything beyond."""

@@ -1,13 +1,14 @@
 """The damage rules against recorded hits: does each weapon's table entry explain real damage?
 
-For every firearm hit between enemies in ESTA `damages` rows (grenades, fire, the bomb, knives
-and weapons the rules lack are left out and counted), the rules predict the health damage from
-the weapon, the hit group, the distance and whether the victim's armour took part (`armorDamage`
-> 0: the frames that would say what armour the victim wore are not always there, and a hit on a
-protected group with armour always costs armour). Per weapon: how many hits the rules reproduce
-exactly and within 1 HP, and the base damage each hit implies (its median should sit just below
-the table's value: the game truncates). Hits through walls (penetration) and hits after the
-armour ran out do less or more than predicted and show as the misses.
+For every firearm hit between enemies in ESTA `damages` rows (the rows the DOG's samples use;
+grenades, fire, the bomb, knives, friendly fire and world damage are left out and counted), the
+rules predict the health damage from the weapon, the hit group, the distance and whether the
+victim's armour took part (`armorDamage` > 0: the frames that would say what armour the victim
+wore are not always there, and a hit on a protected group with armour always costs armour). Per
+weapon: how many hits the rules reproduce exactly and within 1 HP, and the base damage each hit
+implies (its median should sit just below the table's value: the game truncates). Hits through
+walls (penetration) and hits after the armour ran out do less or more than predicted and show as
+the misses.
 """
 
 from __future__ import annotations
@@ -15,12 +16,14 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from decoy_cli.damage.damage_rows import classify_damages
 from decoy_cli.damage.rules import (
     WEAPON_RULES,
     implied_base_damage,
     rule_group,
     shot_damage,
 )
+from decoy_cli.damage.sample_set import SampleStats
 
 CHECK_COLUMNS = (
     "weapon",
@@ -38,32 +41,16 @@ FULL_ARMOR = 100
 
 
 def firearm_hits(damages: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, int]]:
-    """The rows the rules apply to, and the count of the rows left out by reason."""
-    left_out: dict[str, int] = {}
-
-    def drop(mask: pd.Series, reason: str) -> None:
-        if int(mask.sum()):
-            left_out[reason] = left_out.get(reason, 0) + int(mask.sum())
-
-    rows = damages
-    world = rows["attackerSide"].isna() if "attackerSide" in rows else pd.Series(False, rows.index)
-    drop(world, "no attacker")
-    rows = rows[~world]
-    friendly = rows["isFriendlyFire"].fillna(False).astype(bool)
-    if "victimSide" in rows and "attackerSide" in rows:
-        friendly |= rows["attackerSide"].eq(rows["victimSide"]) & rows["victimSide"].notna()
-    drop(friendly, "friendly fire")
-    rows = rows[~friendly]
-    generic = rows["hitGroup"].isin(["Generic"]) | rows["hitGroup"].isna()
-    drop(generic, "grenade, fire or bomb (hit group Generic)")
-    rows = rows[~generic]
-    unknown = ~rows["weapon"].isin(list(WEAPON_RULES))
-    drop(unknown, "not a firearm of the rule table")
-    rows = rows[~unknown]
-    missing = rows[["hpDamage", "armorDamage", "distance"]].isna().any(axis=1)
-    missing |= ~(pd.to_numeric(rows["hpDamage"], errors="coerce") > 0)
-    drop(missing, "no damage, armour or distance value")
-    return rows[~missing].reset_index(drop=True), left_out
+    """The rows the rules apply to: the firearm damage between enemies the DOG's samples use
+    (`damage_rows.classify_damages`) that has a distance; and the rows left out by reason."""
+    stats = SampleStats()
+    rows = classify_damages(damages, stats)
+    distance = pd.to_numeric(damages["distance"], errors="coerce").to_numpy(np.float64)
+    usable = rows.usable & np.isfinite(distance)
+    left_out = dict(stats.excluded)
+    if int((rows.usable & ~usable).sum()):
+        left_out["no distance"] = int((rows.usable & ~usable).sum())
+    return damages[usable].reset_index(drop=True), left_out
 
 
 def check_rules(damages: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, int]]:

@@ -9,7 +9,7 @@ saw the other folds only, so every hit is a test hit once. On the pooled predict
 * mean Wasserstein distance between generated and real damage per (weapon, hit group) cell with
   at least `MIN_CELL` real hits (the real cell by real group, the generated one by drawn group,
   as `decoy_cli/damage/scores.wasserstein_cells` defines it), and its largest cell;
-* per weapon with at least `MIN_WEAPON_HITS` hits, the total variation distance between the real
+* per weapon with at least `MIN_WEAPON_SAMPLES` hits, the total variation distance between the real
   and the drawn hit-group distributions;
 
 and per fold the mean Wasserstein over the cells the fold has (mean and spread over folds).
@@ -31,17 +31,16 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from decoy_cli.damage.evaluation import DRAWS
+from decoy_cli.damage.fold_comparison import MIN_CELL
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import ARMORED_GROUPS, rule_group, shot_damage
 from decoy_cli.damage.rules_check import firearm_hits
-from decoy_cli.damage.scores import wasserstein_cells
+from decoy_cli.damage.sample_set import MAX_DAMAGE_HP
+from decoy_cli.damage.scores import MIN_WEAPON_SAMPLES, wasserstein_cells
+from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.esta import Round
 
-FOLDS = 5
-DRAWS = 10
-MIN_CELL = 5
-MIN_WEAPON_HITS = 30
-MAX_DAMAGE_HP = 100
 MIN_SHARE_HITS = 5
 """Fewest training hits of a buy type for its own armour shares; fewer use all hits'."""
 
@@ -106,9 +105,7 @@ def evaluate_rules(rounds: Sequence[Round], seed: int = 0) -> RulesEvaluation:
     hits, _ = firearm_hits(pd.concat(tables, ignore_index=True))
     hits = hits.assign(group=[rule_group(g) for g in hits["hitGroup"]])
     rng = np.random.default_rng(seed)
-    round_keys = np.array(sorted(hits["round"].unique()))
-    folds = np.arange(len(round_keys)) % FOLDS
-    fold_of = dict(zip(rng.permutation(round_keys), folds, strict=True))
+    fold_of = deal_folds(hits["round"].tolist(), rng)
     hits["fold"] = hits["round"].map(fold_of)
     generated_rows = []
     fold_means = []
@@ -135,7 +132,7 @@ def evaluate_rules(rounds: Sequence[Round], seed: int = 0) -> RulesEvaluation:
     cells = _cells(hits, generated)
     return RulesEvaluation(
         hits=len(hits),
-        rounds=len(round_keys),
+        rounds=len(fold_of),
         cells=cells,
         mean_wasserstein_hp=float(cells["wasserstein_hp"].mean()) if len(cells) else np.nan,
         max_wasserstein_hp=float(cells["wasserstein_hp"].max()) if len(cells) else np.nan,
@@ -153,20 +150,16 @@ def _victim_buy(round_: Round) -> pd.Series:
 
 def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
     """Wasserstein per (weapon, group) cell with at least `MIN_CELL` real hits."""
-    weapons = sorted(set(real["weapon"]))
-    codes = {w: i for i, w in enumerate(weapons)}
     found = wasserstein_cells(
-        real["weapon"].map(codes).to_numpy(),
+        real["weapon"].to_numpy(dtype=object),
         real["group"].map(GROUPS.index).to_numpy(),
         real["hpDamage"].clip(upper=MAX_DAMAGE_HP).to_numpy(np.float64),
-        generated["weapon"].map(codes).to_numpy(),
+        generated["weapon"].to_numpy(dtype=object),
         generated["group"].map(GROUPS.index).to_numpy(),
         generated["damage"].to_numpy(np.float64),
         min_cell=MIN_CELL,
     )
-    rows = [
-        (weapons[int(c.weapon)], c.hit_group, c.real, c.generated, c.wasserstein_hp) for c in found
-    ]
+    rows = [(c.weapon, c.hit_group, c.real, c.generated, c.wasserstein_hp) for c in found]
     return pd.DataFrame(rows, columns=["weapon", "group", "real", "generated", "wasserstein_hp"])
 
 
@@ -174,7 +167,7 @@ def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
     """Per weapon with enough hits: total variation between real and drawn group shares."""
     rows = []
     for weapon, group in real.groupby("weapon"):
-        if len(group) < MIN_WEAPON_HITS:
+        if len(group) < MIN_WEAPON_SAMPLES:
             continue
         p = group["group"].value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
         drawn = generated[generated["weapon"] == weapon]["group"]

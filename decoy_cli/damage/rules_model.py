@@ -14,8 +14,9 @@ Per combat step, over every visible ordered pair at once:
    the bullet that did the most.
 
 The learned parts (`RulesFile`: hit groups and bullet counts) live in a model folder's
-`rules.json` beside the DIP (`decoy models fit-rules`). An attacker whose weapon the rules lack
-(a knife, grenade, Zeus or C4) never hits here, as with the learned DOG.
+`rules.json` beside the DIP (`decoy models fit-rules`). Only an attacker with a firearm of the
+models' vocabulary hits (`DipDecision`), as with the learned DOG; the rule table covers exactly
+that vocabulary (a test checks), so a knife, grenade, Zeus or C4 never hits here.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
-from decoy_cli.damage.rules import WEAPON_RULES, rule_group, shot_damage
+from decoy_cli.damage.rules import shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
 from decoy_cli.files import write_json
@@ -40,8 +41,6 @@ if TYPE_CHECKING:
     from decoy_cli.damage.model_folder import LoadedDip
 
 RULES_FILE = "rules.json"
-STEP_S = 0.5
-"""The combat step: hits of one pair within this much time count as one step's bullets."""
 MAX_BULLETS = 10
 """Bullet counts above this are counted as this many."""
 PRIOR_STEPS = 5.0
@@ -116,7 +115,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     """Learn the hit groups and the bullets per step from the rounds' firearm hits: the damage
     rows the DOG's samples use (`damage_rows`), counted per (attacker, victim) and virtual 2 Hz
     step exactly as the events mode aggregates them, so a step here is a sample's step."""
-    from decoy_cli.damage.damage_rows import damage_rows
+    from decoy_cli.damage.damage_rows import damage_rows, step_clock
     from decoy_cli.damage.sample_set import SampleStats
 
     stats = SampleStats()
@@ -135,8 +134,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         weapons += [str(w) for w in table["weapon"]]
         distances += [float(d) for d in table["distance"]]
         groups += [str(g) for g in table["hitGroup"]]
-        step_ticks = max(1, round(round_.tick_rate * STEP_S))
-        origin = round_.start_tick if round_.start_tick is not None else 0
+        origin, step_ticks = step_clock(round_)
         steps: dict[tuple[int, object, object], list[str]] = {}
         for r in usable:
             step = int(np.rint((rows.tick[r] - origin) / step_ticks))
@@ -175,7 +173,7 @@ def pair_outcome(
         taken += bullet.armor
         if bullet.health > largest:
             largest, largest_group = bullet.health, name
-    return health, taken, rule_group(largest_group)
+    return health, taken, largest_group
 
 
 def rules_generate(
@@ -195,9 +193,6 @@ def rules_generate(
     group = np.zeros((draws, len(weapons)), dtype=np.int64)
     for d in range(draws):
         for k, weapon in enumerate(weapons):
-            if weapon not in WEAPON_RULES:
-                damage[d, k], group[d, k] = 1, GROUPS.index("Chest")
-                continue
             health, _, name = pair_outcome(
                 rules,
                 weapon,
@@ -237,10 +232,9 @@ class RulesDamage:
         group = np.full(k, NO_HIT, dtype=np.int8)
         if k == 0:
             return DamageResult(damage, group, np.zeros(0, dtype=bool), armor_damage)
-        known = np.array([w in WEAPON_RULES for w in batch.attacker_weapon], dtype=bool)
         # two independent streams: the hit decisions' and the outcomes'
         decide_seed, outcome_seed = np.random.SeedSequence(seed).spawn(2)
-        hit = known & self.decision.hits(batch, encode(batch, self.dip.spec), decide_seed)
+        hit = self.decision.hits(batch, encode(batch, self.dip.spec), decide_seed)
         draw = np.random.default_rng(outcome_seed)
         for row in np.flatnonzero(hit):
             health, taken, name = pair_outcome(

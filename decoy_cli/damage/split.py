@@ -7,6 +7,7 @@ round's game state, so a split by sample would leak the test part into training.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,6 +79,20 @@ def split_samples(
     return Split(
         index["train"], index["val"], index["test"], {k: sorted(v) for k, v in parts.items()}
     )
+
+
+FOLDS = 5
+"""Folds of a leave-rounds-out evaluation."""
+
+
+def deal_folds(
+    units: Sequence[str], rng: np.random.Generator, folds: int = FOLDS
+) -> dict[str, int]:
+    """Deal the units (rounds), sorted then shuffled by `rng`, into `folds` folds in turn: each
+    unit is a test unit of exactly one fold, never cut in two (module doc)."""
+    ordered = np.array(sorted(set(units)), dtype=object)
+    shuffled = rng.permutation(ordered)
+    return {str(unit): k % folds for k, unit in enumerate(shuffled)}
 
 
 def balance(samples: Samples, index: np.ndarray, seed: int) -> np.ndarray:
