@@ -245,17 +245,17 @@ def side_by_side(
     for section in sections:
         runs[section] = {"current": [], "baseline": []}
         for repeat in range(repeats):
+            pair = {}
             for side, tree in (("current", current), ("baseline", baseline)):
                 on_run(section, side, repeat)
-                runs[section][side].append(run_in(tree, section, config, data, work))
-        same = {str(r["code"]) for r in runs[section]["current"] if "code" in r} & {
-            str(r["code"]) for r in runs[section]["baseline"] if "code" in r
-        }
-        if same:
-            raise DecoyError(
-                f"the baseline ran the same code as the current side ({min(same)}): give a "
-                "commit, or the Python of an environment with another version installed"
-            )
+                pair[side] = run_in(tree, section, config, data, work)
+                runs[section][side].append(pair[side])
+            code = {side: result.get("code") for side, result in pair.items()}
+            if code["current"] is not None and code["current"] == code["baseline"]:
+                raise DecoyError(  # found after the first pair, not after every repeat
+                    f"the baseline ran the same code as the current side ({code['current']}): "
+                    "give a commit, or the Python of an environment with another version installed"
+                )
         figures_c = [headlines(section, r) for r in runs[section]["current"]]
         figures_b = [headlines(section, r) for r in runs[section]["baseline"]]
         for figure in figures_c[0] if figures_c else {}:

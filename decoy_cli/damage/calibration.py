@@ -164,13 +164,13 @@ def fit_calibration(
     `threshold` (the raw model's) is carried over to the calibrated scale."""
     if decision not in DECISIONS:
         raise ValueError(f"unknown decision {decision!r}: threshold or bernoulli")
+    if kind not in KINDS:
+        raise ValueError(f"unknown calibration {kind!r}: platt, temperature or none")
     from scipy.optimize import minimize
 
     y, p = _arrays(labels, probabilities)
     if kind == "none":
         return Calibration("none", 1.0, 0.0, threshold, decision)
-    if kind not in KINDS:
-        raise ValueError(f"unknown calibration {kind!r}: platt, temperature or none")
     if len(p) < 2 or y.all() or not y.any():
         raise ValueError("calibration needs validation samples of both classes")
     x = _logit(p)
@@ -185,7 +185,21 @@ def fit_calibration(
             f"the fitted scaling reverses the probabilities (a = {a:.3g}): DIP ranks the "
             "validation samples worse than chance; no calibration"
         )
-    raw = Calibration("none", 1.0, 0.0, threshold)
-    scaled = Calibration(kind, a, b, threshold)
-    moved = float(scaled.apply(np.array([raw.threshold]))[0])
+    moved = float(Calibration(kind, a, b, threshold).apply(np.array([threshold]))[0])
     return Calibration(kind, a, b, moved, decision)
+
+
+def calibration_scores(
+    labels: np.ndarray, probabilities: np.ndarray, calibration: Calibration | None
+) -> dict[str, float]:
+    """Brier score and expected calibration error of the probabilities, and of the calibrated
+    ones (`brier_calibrated`, `ece_calibrated`) when there is a calibration."""
+    scores = {
+        "brier": brier_score(labels, probabilities),
+        "ece": expected_calibration_error(labels, probabilities),
+    }
+    if calibration is not None:
+        calibrated = calibration.apply(probabilities)
+        scores["brier_calibrated"] = brier_score(labels, calibrated)
+        scores["ece_calibrated"] = expected_calibration_error(labels, calibrated)
+    return scores

@@ -3,8 +3,10 @@
 Per combat step (decoy_cli/sim/combat.py calls it with every visible ordered pair):
 
 1. one batched DIP forward pass over all pairs gives the probability that the attacker damages
-   the victim in this 0.5 s step; a pair hits when it reaches the threshold (the model folder's,
-   0.444 for the paper's DIP) and the attacker holds a firearm of the vocabulary (the models know
+   the victim in this 0.5 s step (`DipDecision`, which `RulesDamage` shares); a pair hits when
+   it reaches the threshold (the model folder's, 0.444 for the paper's DIP), or by the rule of
+   the folder's calibration (decoy_cli/damage/calibration.py), and the attacker holds a firearm
+   of the vocabulary (the models know
    only firearm damage: a knife, grenade, C4, Zeus or empty hand deals none here);
 2. one batched DOG pass over the hitting pairs only: z ~ N(0, I) from a torch generator seeded
    by the simulator's numpy generator (so a seeded simulation is reproducible), decoded to a
@@ -133,7 +135,7 @@ class DipDecision:
         self.dip = dip
         self.threads = threads
         self.threshold = dip.threshold if threshold is None else float(threshold)
-        self.threshold_given = threshold is not None
+        self.calibration = dip.calibration if threshold is None else None
         if not 0.0 <= self.threshold <= 1.0:
             raise ValueError(f"a DIP threshold is a probability, got {self.threshold}")
         with torch.no_grad():
@@ -170,8 +172,8 @@ class DipDecision:
         """(K,) bool: the pairs that hit (class doc); `seed` drives Bernoulli decisions."""
         probability = self.hit_probability(batch, features)
         armed = weapon_index(batch.attacker_weapon) >= 0
-        if self.dip.calibration is not None and not self.threshold_given:
-            return armed & self.dip.calibration.decide(probability, np.random.default_rng(seed))
+        if self.calibration is not None:
+            return armed & self.calibration.decide(probability, np.random.default_rng(seed))
         return armed & (probability >= self.threshold)
 
 

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from decoy_cli.damage.calibration import brier_score, expected_calibration_error
+from decoy_cli.damage.calibration import calibration_scores
 from decoy_cli.damage.features import HIT_GROUPS
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
 from decoy_cli.damage.scores import (
@@ -105,12 +105,7 @@ def evaluate_dip(dip: LoadedDip, samples: Samples, threshold: float | None = Non
     probabilities = dip_probabilities(dip, samples)
     chosen = dip.threshold if threshold is None else threshold
     metrics = classification_metrics(samples.hit, probabilities, chosen)
-    metrics["brier"] = brier_score(samples.hit, probabilities)
-    metrics["ece"] = expected_calibration_error(samples.hit, probabilities)
-    if dip.calibration is not None:
-        calibrated = dip.calibration.apply(probabilities)
-        metrics["brier_calibrated"] = brier_score(samples.hit, calibrated)
-        metrics["ece_calibrated"] = expected_calibration_error(samples.hit, calibrated)
+    metrics |= calibration_scores(samples.hit, probabilities, dip.calibration)
     return DipEvaluation(metrics, samples.hit.copy(), probabilities)
 
 

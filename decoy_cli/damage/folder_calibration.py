@@ -13,12 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.calibration import (
-    Calibration,
-    brier_score,
-    expected_calibration_error,
-    fit_calibration,
-)
+from decoy_cli.damage.calibration import Calibration, calibration_scores, fit_calibration
 from decoy_cli.damage.provenance import FileCallback, SampleChoice
 from decoy_cli.damage.sample_set import SampleStats
 from decoy_cli.errors import ModelError
@@ -70,14 +65,10 @@ def calibrate_dip_folder(
         raise ModelError(str(error)) from None
     scores = {}
     for part, (labels, probabilities) in parts.items():
-        calibrated = calibration.apply(probabilities)
         scores[part] = {
             "samples": float(len(labels)),
             "positives": float(np.sum(labels)),
-            "brier": brier_score(labels, probabilities),
-            "ece": expected_calibration_error(labels, probabilities),
-            "brier_calibrated": brier_score(labels, calibrated),
-            "ece_calibrated": expected_calibration_error(labels, calibrated),
+            **calibration_scores(labels, probabilities, calibration),
         }
     path = save_calibration(folder, calibration)
     return CalibrationResult(calibration, path, scores, stats)

@@ -99,23 +99,21 @@ class HitGroupModel:
             out.append(GROUPS[min(int(np.searchsorted(cache[key], rng.random())), len(GROUPS) - 1)])
         return out
 
-    def to_json(self) -> str:
-        return json.dumps(
-            {
-                "groups": GROUPS,
-                "distance_bands_u": DISTANCE_BANDS_U,
-                "prior_hits": PRIOR_HITS,
-                "weapon_counts": self.weapon_counts,
-                "class_counts": self.class_counts,
-                "band_counts": self.band_counts,
-            },
-            sort_keys=True,
-        )
+    def to_dict(self) -> dict[str, object]:
+        """The counts with the groups, bands and prior they were counted under."""
+        return {
+            "groups": GROUPS,
+            "distance_bands_u": DISTANCE_BANDS_U,
+            "prior_hits": PRIOR_HITS,
+            "weapon_counts": self.weapon_counts,
+            "class_counts": self.class_counts,
+            "band_counts": self.band_counts,
+        }
 
     @classmethod
-    def from_json(cls, text: str) -> HitGroupModel:
-        """A model written by `to_json`; a file of other groups or bands is a ValueError."""
-        data = json.loads(text)
+    def from_dict(cls, data: dict) -> HitGroupModel:
+        """A model written by `to_dict`; other groups or bands, or counts of another shape or
+        negative, are a ValueError."""
         if (
             tuple(data.get("groups", ())) != GROUPS
             or tuple(data.get("distance_bands_u", ())) != DISTANCE_BANDS_U
@@ -129,3 +127,11 @@ class HitGroupModel:
             if counts.shape != shape or not (np.isfinite(counts).all() and (counts >= 0).all()):
                 raise ValueError(f"hit counts must be {shape[0]} x {shape[1]} and not negative")
         return cls(data["weapon_counts"], data["class_counts"], data["band_counts"])
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> HitGroupModel:
+        """`from_dict` of JSON text."""
+        return cls.from_dict(json.loads(text))

@@ -82,7 +82,7 @@ class RulesFile:
     def save(self, folder: Path) -> Path:
         """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
         data = {
-            "hit_groups": json.loads(self.hit_groups.to_json()),
+            "hit_groups": self.hit_groups.to_dict(),
             "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
             "provenance": self.provenance,
         }
@@ -94,7 +94,7 @@ class RulesFile:
         path = Path(folder) / RULES_FILE
         try:
             data = json.loads(path.read_text())
-            hit_groups = HitGroupModel.from_json(json.dumps(data["hit_groups"]))
+            hit_groups = HitGroupModel.from_dict(data["hit_groups"])
             bullets = BulletCounts(
                 {str(k): [float(v) for v in c] for k, c in data["bullets"]["by_class"].items()},
                 [float(v) for v in data["bullets"]["every"]],
