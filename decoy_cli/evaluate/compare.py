@@ -24,7 +24,7 @@ import pandas as pd
 
 from decoy_cli.errors import CompareError
 from decoy_cli.evaluate.intervals import round_codes
-from decoy_cli.metrics import ALL_METRIC_NAMES, FASTDTW_METRIC
+from decoy_cli.metrics import ALL_METRIC_NAMES, METRIC_NAMES
 from decoy_cli.metrics.bootstrap import RoundBootstrap
 
 KEY = ["match", "round", "player"]
@@ -121,7 +121,7 @@ def read_run(folder: Path) -> Run:
 def compare_runs(a: Run, b: Run, *, seed: int = 0) -> Comparison:
     """Pair the player-rounds both runs evaluated and compare them (module docstring)."""
     only = set(a.metrics) ^ set(b.metrics)
-    if only - {FASTDTW_METRIC}:
+    if only & set(METRIC_NAMES):  # an optional metric (paper_dtw_fastdtw) may be missing
         raise CompareError(
             f"{a.folder} and {b.folder} have different metric sets (only one has "
             f"{', '.join(sorted(only))}): runs of different versions cannot be paired"
