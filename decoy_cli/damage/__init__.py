@@ -33,6 +33,9 @@ if TYPE_CHECKING:
 SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
+SHIPPED_CHOICES = ("shipped", "rules")
+"""The `--models` choices that name the shipped folder (its DOG, or its rules)."""
+
 CHOICES_HELP = (
     '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIP with damage by '
     'the game\'s rules), "none" (no shooting) or a model folder'
@@ -53,7 +56,7 @@ def load_damage_model(choice: str) -> DamageModel | None:
     """
     if choice == "none":
         return None
-    if choice in ("shipped", "rules"):
+    if choice in SHIPPED_CHOICES:
         folder = SHIPPED_MODELS
         if not shipped_models_installed():
             raise ModelError(
@@ -74,4 +77,10 @@ def load_damage_model(choice: str) -> DamageModel | None:
     return LearnedDamage(load_dip(folder), load_dog(folder))
 
 
-__all__ = ["CHOICES_HELP", "SHIPPED_MODELS", "load_damage_model", "shipped_models_installed"]
+__all__ = [
+    "CHOICES_HELP",
+    "SHIPPED_CHOICES",
+    "SHIPPED_MODELS",
+    "load_damage_model",
+    "shipped_models_installed",
+]

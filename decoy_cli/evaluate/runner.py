@@ -120,12 +120,12 @@ def make_settings(
     check_mover(mover)
     models_fingerprint = ""
     if combat:
-        from decoy_cli.damage import SHIPPED_MODELS, load_damage_model
+        from decoy_cli.damage import SHIPPED_CHOICES, SHIPPED_MODELS, load_damage_model
 
-        if models not in ("shipped", "rules", "none"):  # a folder: absolute, for workers elsewhere
+        if models not in (*SHIPPED_CHOICES, "none"):  # a folder: absolute, for workers elsewhere
             models = str(Path(models).expanduser().resolve())
         if load_damage_model(models) is not None:
-            folder = SHIPPED_MODELS if models in ("shipped", "rules") else Path(models)
+            folder = SHIPPED_MODELS if models in SHIPPED_CHOICES else Path(models)
             models_fingerprint = folder_fingerprint(folder)
     return EvalSettings(
         map_name=name,
