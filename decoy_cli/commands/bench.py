@@ -24,7 +24,7 @@ from decoy_cli.bench import (
 )
 from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.damage import CHOICES_HELP, SHIPPED_CHOICES
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
 
@@ -182,7 +182,7 @@ def _side_by_side(
     Paths are made absolute: the runs start in folders of their own."""
     work = out.resolve().parent
     work.mkdir(parents=True, exist_ok=True)
-    if Path(config["models"]).exists():
+    if config["models"] not in (*SHIPPED_CHOICES, "none"):  # a folder, as the loader reads it
         config = config | {"models": str(Path(config["models"]).resolve())}
     data = bench_data.folder.resolve() if bench_data else None
     with baseline_tree(ref, work) as baseline:
