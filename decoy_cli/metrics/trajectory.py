@@ -160,11 +160,11 @@ def trajectory_metrics(
     )
     if outcome != OK:
         return _not_evaluable(_REASONS[outcome], fastdtw)
-    clock_total, clock_steps, values[4] = curve_kernel(o, s, 2)
-    paper_total, paper_steps, values[9] = curve_kernel(a, b, 2)
-    values[3] = clock_total / clock_steps
-    values[8] = paper_total / paper_steps
-    named = dict(zip(METRIC_NAMES, values.tolist(), strict=True))
+    named = dict(zip(METRIC_NAMES, values.tolist(), strict=True))  # curve distances NaN so far
+    clock_total, clock_steps, named["frechet_2d"] = curve_kernel(o, s, 2)
+    paper_total, paper_steps, named["paper_frechet_2d"] = curve_kernel(a, b, 2)
+    named["dtw"] = clock_total / clock_steps
+    named["paper_dtw"] = paper_total / paper_steps
     if fastdtw:
         named[FASTDTW_METRIC] = fastdtw_mean(a, b)
     return TrajectoryMetrics(values=named)
