@@ -9,7 +9,8 @@ Line of sight, and what Bullet does with rays that start inside a body (measured
 a hit at fraction 0 on that capsule when it points down. So the eye-to-eye test is split in two
 ray batches:
 
-* world rays, eye to eye, that see only the world mesh (`PhysicsWorld.line_of_sight`);
+* world segments, eye to eye, tested against the world mesh only, with Embree's occlusion
+  query (`PhysicsWorld.occlusion`, much faster than pybullet's closest-hit rays);
 * for the pairs the world lets through, body rays that see only this module's capsules. They
   start 1 mm past the point where the segment leaves the first agent's own capsule (computed
   exactly: the eye lies on the capsule's axis) and end at the second agent's eye, inside its
@@ -132,7 +133,7 @@ class LineOfSight:
         first = np.minimum(one, two).ravel()  # rays run from the lower to the higher index
         second = np.maximum(one, two).ravel()
         eyes = feet + np.array([0.0, 0.0, self.eye_height])
-        clear = self.physics.line_of_sight(eyes[first], eyes[second])
+        clear = self.physics.occlusion.clear(eyes[first], eyes[second])
         if np.any(clear) and np.count_nonzero(alive) > 2:
             self._place(feet, alive)
             ray = np.flatnonzero(clear)

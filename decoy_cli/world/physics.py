@@ -24,6 +24,7 @@ from typing import Self
 
 import numpy as np
 
+from decoy_cli.world.occlusion import OcclusionScene
 from decoy_cli.world.world import World
 
 WORLD_GROUP = 1
@@ -73,6 +74,7 @@ class PhysicsWorld:
         )
         self._capsules: list[int] = []
         self._capsule_shape: tuple[float, float] | None = None
+        self._occlusion: OcclusionScene | None = None
 
     def _load(self, world: World) -> int:
         p = self._p
@@ -98,6 +100,14 @@ class PhysicsWorld:
         return p.createMultiBody(
             baseMass=0, baseCollisionShapeIndex=shape, physicsClientId=self.client
         )
+
+    @property
+    def occlusion(self) -> OcclusionScene:
+        """The world in an Embree scene for fast segment occlusion tests (built on first use,
+        kept for the client's life): the simulator's line of sight."""
+        if self._occlusion is None:
+            self._occlusion = OcclusionScene(self.world)
+        return self._occlusion
 
     @property
     def pybullet(self) -> ModuleType:
