@@ -145,7 +145,7 @@ def test_the_test_constants_follow_the_rules() -> None:
 
 def test_a_round_nobody_wins_ends_target_saved_at_the_time_limit() -> None:
     sim = make_sim(t_and_ct())
-    sim.run(until=lambda s: s.tick == ROUND_TICKS - 1)
+    sim.run(to_tick=ROUND_TICKS - 1)
     assert not sim.done and sim.outcome is None
     assert sim.needs_decision.tolist() == [False, False]  # both stand in a STOP for good
     sim.run()
@@ -308,7 +308,7 @@ def test_an_impossible_move_holds_and_is_recorded() -> None:
     # node 0 is the west end of the line: there is no edge west
     policy = Script({0: [walk(W, hold_ticks=15)]})
     sim = make_sim(t_and_ct(), policy=policy)
-    sim.run(until=lambda s: s.tick == 16)
+    sim.run(to_tick=16)
     assert sim.events == [SimEvent(1, "invalid_action", 0, data={"action": W})]
     assert policy.ticks_of(0) == [1, 16]
     assert sim.agents.position[0].tolist() == [0.0, 0.0, 0.0]
@@ -327,7 +327,7 @@ class RelocatesFirst(Script):
 def test_a_relocation_inside_a_decision_moves_on_from_the_new_node() -> None:
     policy = RelocatesFirst({0: [walk(E)]})  # from node 3 (after the relocation) to node 4
     sim = make_sim(t_and_ct(), policy=policy)
-    sim.run(until=lambda s: s.tick == WALK_3 + 1)
+    sim.run(to_tick=WALK_3 + 1)
     assert sim.events == [SimEvent(1, "relocate", 0, data={"node": 3})]
     assert policy.ticks_of(0) == [1, WALK_3 + 1]
     assert sim.agents.node[0] == 4
@@ -342,7 +342,7 @@ def test_a_scripted_kill_of_the_carrier_drops_the_bomb_and_ends_its_decisions() 
     # the carrier walks east (x = 0.05 m per tick); the others are asked at 1 and at 31
     policy = Script({0: [walk(E)], 1: [stop(30)], 2: [stop(30)]})
     sim = make_sim(agents, policy=policy, bomb_carrier=0)
-    sim.run(until=lambda s: s.tick == 10)
+    sim.run(to_tick=10)
     assert sim.bomb.status == BombStatus.CARRIED
     sim.kill(0, "scripted")
     death, drop = sim.events
@@ -353,7 +353,7 @@ def test_a_scripted_kill_of_the_carrier_drops_the_bomb_and_ends_its_decisions() 
     assert (bool(sim.agents.alive[0]), int(sim.agents.hp[0])) == (False, 0)
     sim.kill(0, "again")  # a dead agent dies once
     assert len(sim.events) == 2
-    sim.run(until=lambda s: s.tick == 40)
+    sim.run(to_tick=40)
     assert sim.outcome is None  # a T is still alive
     assert [policy.ticks_of(a) for a in range(3)] == [[1], [1, 31], [1, 31]]
     assert sim.needs_decision.tolist() == [False, False, False]
@@ -364,7 +364,7 @@ def test_a_scripted_kill_of_the_carrier_drops_the_bomb_and_ends_its_decisions() 
 
 def test_killing_the_last_ct_ends_the_round_at_the_next_tick() -> None:
     sim = make_sim(t_and_ct())
-    sim.run(until=lambda s: s.tick == 10)
+    sim.run(to_tick=10)
     sim.kill(1, "scripted")
     assert not sim.done  # the outcome is checked by the tick
     sim.run()
@@ -379,7 +379,7 @@ def test_recording_at_requested_ticks_and_the_final_state_after_the_end() -> Non
     agents = make_agents(["T", "CT"], [0, 5], hp=np.array([100, 70]), yaw=np.array([90.0, 90.0]))
     policy = Script({0: [walk(E)] * 3})  # 0.05 m per tick, the whole round
     sim = make_sim(agents, policy=policy, record_ticks=[500, 10, 0, 30, 10, 31, 45])
-    sim.run(until=lambda s: s.tick == 30)
+    sim.run(to_tick=30)
     sim.kill(1, "scripted")  # the round ends at tick 31, with the T at x = 1.55 m
     rec = sim.run()
     assert sim.outcome == RoundOutcome("T", "TerroristsWin", 31)
@@ -415,10 +415,10 @@ def test_a_relocation_from_outside_a_decision_asks_the_agent_again() -> None:
     walk and is asked for a decision at the next tick, from the new node."""
     policy = Script({0: [walk(E), walk(W)]})
     sim = make_sim(t_and_ct(), policy=policy)
-    sim.run(until=lambda s: s.tick == 5)  # walking node 0 -> 1
+    sim.run(to_tick=5)  # walking node 0 -> 1
     sim.relocate(0, 3)
     assert sim.needs_decision.tolist() == [True, False]
     sim.step()
     assert policy.ticks_of(0) == [1, 6]
-    sim.run(until=lambda s: s.tick == 6 + WALK_3)
+    sim.run(to_tick=6 + WALK_3)
     assert sim.agents.node[0] == 2  # walked west from node 3

@@ -672,3 +672,9 @@ def test_physics_capsule_is_the_one_the_waypoint_builder_verified() -> None:
         assert mover.float_height == params.step_height + params.verify_clearance
         assert mover.graze == params.graze
         mover.close()
+
+
+def test_the_kernels_edge_kind_constants_are_the_graphs() -> None:
+    from decoy_cli.sim.movement import kernels
+
+    assert (kernels.JUMP_EDGE, kernels.DROP_EDGE) == (EdgeKind.JUMP, EdgeKind.DROP)

@@ -26,9 +26,9 @@ from typing import Protocol
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
-from decoy_cli.sim.movement import Mover
+from decoy_cli.sim.movement import Mover, MoveStep
 from decoy_cli.sim.rules import BombRules
-from decoy_cli.sim.state import Agents, Bomb, RoundOutcome, SimEvent
+from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
@@ -122,6 +122,7 @@ class Simulator:
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
+        self.decision_count = 0  # decisions.sum(), kept as they are made
         self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
@@ -140,6 +141,8 @@ class Simulator:
             events=self.events,
         )
         self._next_record = 0
+        self._alive_judged = b""  # who was alive (as bytes) when the outcome was judged
+        self._judged_as: tuple[BombStatus, bool] | None = None  # and the bomb and the clock
         self._filled_after_end = False
         # every loop is bounded: the round's time limit plus the bomb timer after a plant
         self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
@@ -163,7 +166,12 @@ class Simulator:
         start = len(self.events)
         self.tick += 1
         self._decide()
-        moving = self._move()
+        self._finish_tick(self._move())
+        return self.events[start:]
+
+    def _finish_tick(self, moving: np.ndarray) -> None:
+        """The rest of a tick after the decisions and the motion: the bomb rules, the combat
+        step, the outcome and the recording."""
         agents = self.agents
         self.events += self.rules.step(
             self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
@@ -173,7 +181,7 @@ class Simulator:
             self.events += self.combat.run(agents, self.tick, self.rng)
             for agent in np.nonzero(alive_before & ~agents.alive)[0]:
                 self._kill(int(agent))
-        self.outcome = self.rules.outcome(self.tick, agents, self.bomb)
+        self._judge()
         if self.outcome is not None:
             self.events.append(
                 SimEvent(
@@ -183,7 +191,6 @@ class Simulator:
                 )
             )
         self._record()
-        return self.events[start:]
 
     def _move_after_end(self) -> list[SimEvent]:
         """One tick of movement after the outcome (see `step`); returns its events (stuck,
@@ -195,10 +202,28 @@ class Simulator:
         self._record()
         return self.events[start:]
 
-    def run(self, until: Callable[[Simulator], bool] | None = None) -> Recording:
-        """Step until the round ends, the tick bound, or `until(sim)` says stop."""
-        while not self.done and not (until is not None and until(self)):
-            self.step()
+    def run(
+        self, until: Callable[[Simulator], bool] | None = None, *, to_tick: int | None = None
+    ) -> Recording:
+        """Play until the round ends (the tick bound), `to_tick` is reached, or `until(sim)`
+        says stop.
+
+        Event by event: after each tick's decisions, the ticks from there on at which nothing
+        but motion can happen are crossed by the mover in one call (`glide`), which stops at
+        the first arrival; every other tick is played whole, as `step` plays it.
+        The result is tick for tick what stepping every tick gives. `until` is asked after each
+        step and each glide, i.e. whenever anything but motion may have happened (a decision,
+        an arrival, an event, a combat step, a recorded tick): a predicate on decisions,
+        events, deaths or the bomb sees every change. To stop at a tick, give `to_tick`."""
+        end = self._max_tick if to_tick is None else int(to_tick)
+        while not self.done and self.tick < end and not (until is not None and until(self)):
+            self.tick += 1
+            self._decide()
+            last = min(self._quiet_until(self.tick - 1), end)
+            if last >= self.tick:
+                self._glide(last)
+            else:
+                self._finish_tick(self._move())
         return self.recording
 
     def relocate(self, agent: int, node: int) -> None:
@@ -239,24 +264,76 @@ class Simulator:
     # ---- internals ----------------------------------------------------------------------------
 
     def _move(self) -> np.ndarray:
-        """Move every agent one tick and note arrivals, stuck agents and teleports; returns the
-        (N,) mask of the agents that moved."""
-        moved = self.mover.step()
+        """Move every agent one tick; returns the (N,) mask of the agents that moved."""
+        return self._moved(self.mover.step())
+
+    def _moved(self, moved: MoveStep) -> np.ndarray:
+        """Take over what the mover did (positions, yaw) and note the last tick's arrivals,
+        stuck agents and teleports; returns the (N,) mask of the agents that moved then."""
         agents = self.agents
         agents.position[:] = self.mover.positions
-        moving = np.asarray(moved.moving, dtype=bool)
-        heading = np.asarray(self.mover.heading, dtype=np.float64)
-        agents.yaw[moving] = heading[moving]
-        arrived = np.asarray(moved.arrived, dtype=bool) & agents.alive
-        for agent in np.nonzero(arrived)[0]:
-            agents.node[agent] = self.goal_node[agent]
-            self.goal_node[agent] = -1
-            self.waiting[agent] = True
-        for agent in np.nonzero(np.asarray(moved.stuck, dtype=bool))[0]:
-            self.events.append(SimEvent(self.tick, "stuck", int(agent)))
-        for agent in np.nonzero(np.asarray(moved.teleported, dtype=bool))[0]:
-            self.events.append(SimEvent(self.tick, "teleport", int(agent)))
-        return moving
+        np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
+        if not moved.happened:
+            return moved.moving
+        if moved.arrived.any():
+            for agent in np.flatnonzero(moved.arrived & agents.alive).tolist():
+                agents.node[agent] = self.goal_node[agent]
+                self.goal_node[agent] = -1
+                self.waiting[agent] = True
+        for agent in np.flatnonzero(moved.stuck).tolist():
+            self.events.append(SimEvent(self.tick, "stuck", agent))
+        for agent in np.flatnonzero(moved.teleported).tolist():
+            self.events.append(SimEvent(self.tick, "teleport", agent))
+        return moved.moving
+
+    def _quiet_until(self, tick: int) -> int:
+        """The last tick through which nothing but motion can happen after `tick`, if no agent
+        arrives before: no decision falls due, no combat step, no recorded tick, the bomb rules
+        have nothing to do and the outcome cannot change (the clock, the detonation). Equal to
+        `tick` when the tick after it is not quiet. Asked once the decisions of the tick after
+        `tick` are made (they are the only part of that tick already played)."""
+        alive = self.agents.alive
+        if self.outcome is not None or (self.waiting & alive).any():
+            return tick
+        if alive.tobytes() != self._alive_judged:  # not judged yet, or a kill from outside
+            return tick
+        rules = self.rules.quiet_until(
+            tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, self.mover.standing
+        )
+        last = min(self._max_tick - 1, rules)
+        holding = (self.hold_until > 0) & alive
+        if holding.any():
+            last = min(last, int(self.hold_until[holding].min()) - 1)
+        if self.combat is not None:
+            last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
+        if self._next_record < len(self._record_at):
+            last = min(last, int(self._record_at[self._next_record]) - 1)
+        return max(tick, last)
+
+    def _glide(self, last: int) -> None:
+        """Play the motion of this tick (its decisions are made) and of the quiet ticks after it
+        up to `last` (`_quiet_until`) in one mover call; it stops after the first tick with an
+        arrival, a stuck agent or a teleport, which is then noted as `step` notes it. The bomb
+        rules have nothing to do on quiet ticks but follow the carrier, so stepping them once,
+        at the last tick, is the same as stepping them at every tick."""
+        ticks, moved = self.mover.glide(last - self.tick + 1)
+        self.tick += ticks - 1
+        moving = self._moved(moved)
+        self.events += self.rules.step(
+            self.tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, moving
+        )
+
+    def _judge(self) -> None:
+        """The outcome at this tick. It depends only on who is alive, the bomb's status and
+        whether the round clock has run out, so it is asked of the rules only when one of these
+        changed since the last judgement."""
+        clock_out = self.tick >= self.rules.config.round_ticks
+        alive = self.agents.alive.tobytes()
+        if alive == self._alive_judged and self._judged_as == (self.bomb.status, clock_out):
+            return
+        self.outcome = self.rules.outcome(self.tick, self.agents, self.bomb)
+        self._alive_judged = alive
+        self._judged_as = (self.bomb.status, clock_out)
 
     def _kill(self, agent: int) -> None:
         self.mover.remove(agent)
@@ -289,6 +366,7 @@ class Simulator:
             decision = self.policy.decide(self, agent)
             self._deciding = -1
             self.decisions[agent] += 1
+            self.decision_count += 1
             self.wants_plant[agent] = decision.plant
             self.wants_defuse[agent] = decision.defuse
             if decision.action == STOP_ACTION:

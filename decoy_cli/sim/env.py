@@ -305,8 +305,7 @@ class DecoyParallelEnv(ParallelEnv):
                 f"the simulator did not ask agents {sorted(self._policy.pending)} for the "
                 "decision the environment collected"
             )
-        while not sim.done and not self._due().any():
-            sim.step()
+        sim.run(until=lambda s: bool(s.needs_decision.any()))
 
         outcome = sim.outcome
         alive = sim.agents.alive

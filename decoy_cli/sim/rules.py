@@ -253,6 +253,45 @@ class BombRules:
             )
         return events
 
+    def quiet_until(
+        self,
+        tick: int,
+        agents: Agents,
+        bomb: Bomb,
+        wants_plant: np.ndarray,
+        wants_defuse: np.ndarray,
+        standing: np.ndarray,
+    ) -> int:
+        """The last tick through which `step` and `outcome` have nothing to do but let a carried
+        bomb follow its carrier, as long as no agent dies or changes what it wants and the
+        `standing` agents (no motion under way) stay put; `tick` when the next tick may matter
+        (a plant or a defuse under way or wanted where it can start, a dropped bomb that can be
+        picked up). The engine crosses such ticks in one go (`Simulator.run`)."""
+        last = 1 << 62
+        planted = False
+        if self.config.bomb_enabled:
+            if bomb.status == BombStatus.CARRIED and bomb.carrier >= 0:
+                carrier = bomb.carrier
+                if not agents.alive[carrier] or bomb.planter == carrier:
+                    return tick
+                if wants_plant[carrier] and (  # a plant starts once it stands in a zone
+                    not standing[carrier] or self.zones.site_of(agents.position[carrier])[0]
+                ):
+                    return tick
+            elif bomb.status == BombStatus.DROPPED:
+                if self.config.auto_pickup:
+                    return tick
+            elif bomb.status == BombStatus.PLANTED:
+                if bomb.defuser >= 0 or bool(np.any(wants_defuse & agents.alive)):
+                    return tick
+                planted = True
+                last = bomb.planted_tick + self.config.bomb_ticks - 1
+            elif bomb.status != BombStatus.CARRIED:
+                return tick
+        if not planted:
+            last = min(last, self.config.round_ticks - 1)
+        return max(tick, last)
+
     # ---- round end ----------------------------------------------------------------------------
 
     def outcome(self, tick: int, agents: Agents, bomb: Bomb) -> RoundOutcome | None:
@@ -291,7 +330,7 @@ class BombRules:
         moving: np.ndarray,
     ) -> list[SimEvent]:
         carrier = bomb.carrier
-        if bomb.planter != carrier and not wants_plant[carrier]:
+        if bomb.planter != carrier and (not wants_plant[carrier] or moving[carrier]):
             return []
         site = str(self.zones.site_of(agents.position[carrier])[0])
         if bomb.planter == carrier:

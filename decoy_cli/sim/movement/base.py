@@ -8,13 +8,12 @@ import numpy as np
 
 from decoy_cli.csgo import GRAVITY_M_S2, HAMMER_TO_M, JUMP_SPEED_M_S, TICK_RATE
 from decoy_cli.sim.movement.interface import MoveStep
+from decoy_cli.sim.movement.kernels import begin_edge
 from decoy_cli.sim.movement.layout import (
-    EPS,
     F_CARRY,
     F_HEADING,
     F_MAX_SPEED,
     F_SIDE,
-    F_SPEED,
     F_VZ,
     FALL,
     FLAG_ROWS,
@@ -29,13 +28,13 @@ from decoy_cli.sim.movement.layout import (
     I_TELEPORTS,
     IDLE,
     INT_SLOTS,
-    LINE,
     P_DT,
     P_GRAVITY,
     P_LOOKAHEAD,
     P_ON_LINE,
     PARAM_SLOTS,
     R_ARRIVED,
+    R_MOVED,
     R_MOVING,
     R_STUCK,
     R_TELEPORTED,
@@ -43,6 +42,8 @@ from decoy_cli.sim.movement.layout import (
 )
 from decoy_cli.waypoints.graph import EdgeKind
 from decoy_cli.weapons import KNIFE_SPEED
+
+_EDGE_KINDS = frozenset(int(kind) for kind in EdgeKind)
 
 DEFAULT_MAX_SPEED_M_S = KNIFE_SPEED * HAMMER_TO_M
 """Per-agent speed cap unless told otherwise: the knife, the fastest a CS:GO player runs."""
@@ -122,6 +123,12 @@ class MoverBase:
         return self._views["recoveries"]
 
     @property
+    def standing(self) -> np.ndarray:
+        """(N,) True for agents with no motion under way: they stay where they are until given
+        a goal (nothing pushes a standing agent)."""
+        return self._iv[:, I_PHASE] == IDLE
+
+    @property
     def alive(self) -> np.ndarray:
         """(N,) False for removed agents."""
         return self._iv[:, I_ALIVE] != 0
@@ -142,29 +149,22 @@ class MoverBase:
         max speed); the edge `kind` (EdgeKind) chooses walking, jumping or dropping."""
         i = self._agent(agent, alive=True)
         goal = np.asarray(target, dtype=np.float64).reshape(-1)
-        if goal.shape != (3,) or not np.all(np.isfinite(goal)):
+        if goal.shape != (3,):
+            raise ValueError(f"target must be a finite (3,) position, got {target!r}")
+        x, y, z = goal.tolist()
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
             raise ValueError(f"target must be a finite (3,) position, got {target!r}")
         if not (math.isfinite(speed) and speed >= 0.0):
             raise ValueError(f"speed must be a finite number >= 0 m/s, got {speed!r}")
-        kind = EdgeKind(kind)
-        if self._airborne(i):
+        if kind not in _EDGE_KINDS:
+            names = ", ".join(k.name for k in EdgeKind)
+            raise ValueError(f"{kind!r} is not an edge kind ({names})")
+        started = begin_edge(
+            i, x, y, z, int(kind), float(speed), self.jump_speed, self.gravity,
+            self._pos, self._target, self._fv, self._iv,
+        )  # fmt: skip
+        if not started:
             raise ValueError(f"agent {i} is in the air; give it a goal once it lands")
-        self._target[i] = goal
-        fv, iv = self._fv, self._iv
-        fv[i, F_SPEED] = min(float(speed), fv[i, F_MAX_SPEED])
-        fv[i, F_VZ] = 0.0
-        z = self._pos[i, 2]
-        if kind == EdgeKind.JUMP and goal[2] > z + EPS:
-            iv[i, I_PHASE] = RISE
-            fv[i, F_VZ] = max(self.jump_speed, math.sqrt(2.0 * self.gravity * (goal[2] - z)))
-        elif kind in (EdgeKind.JUMP, EdgeKind.DROP):
-            iv[i, I_PHASE] = GLIDE
-        else:
-            iv[i, I_PHASE] = LINE
-        dx, dy = goal[0] - self._pos[i, 0], goal[1] - self._pos[i, 1]
-        if dx * dx + dy * dy > 1e-18:
-            fv[i, F_HEADING] = math.degrees(math.atan2(dy, dx))
-        iv[i, [I_RECOVER, I_BLOCKED, I_ATTEMPTS]] = 0
 
     def clear_goal(self, agent: int) -> None:
         """Stand still. An agent on a jump or drop edge cannot stop in the air: it lands at its
@@ -202,8 +202,16 @@ class MoverBase:
     def _new_flags(self) -> tuple[np.ndarray, MoveStep]:
         flags = np.zeros((FLAG_ROWS, self.n), dtype=bool)
         return flags, MoveStep(
-            flags[R_ARRIVED], flags[R_MOVING], flags[R_STUCK], flags[R_TELEPORTED]
+            flags[R_ARRIVED], flags[R_MOVING], flags[R_STUCK], flags[R_TELEPORTED], flags[R_MOVED]
         )
+
+    def step(self) -> MoveStep:
+        """Advance every agent by one tick."""
+        return self.glide(1)[1]
+
+    def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
+        """Up to `max_ticks` ticks in one call (see `Mover.glide`); each mover computes it."""
+        raise NotImplementedError
 
 
 def read_only(array: np.ndarray) -> np.ndarray:

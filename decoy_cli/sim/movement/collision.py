@@ -2,8 +2,9 @@
 
 `physics_resolve` proposes every agent's move and resolves overlaps between agents;
 `physics_commit` applies the moves, detects arrivals and stuck agents and runs the bounded
-recovery. Between the two, `PhysicsMover` tests the few agents that left their edge line
-against the world. Slots of the packed arrays are named in `layout.py`.
+recovery; `physics_glide` runs whole ticks of both until one needs the world or an agent
+arrives, is stuck or teleported. Between the two, `PhysicsMover` tests the few agents that left
+their edge line against the world. Slots of the packed arrays are named in `layout.py`.
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ from decoy_cli.sim.movement.layout import (
     P_STUCK_TICKS,
     P_TWO_R,
     R_ARRIVED,
+    R_MOVED,
+    R_MOVING,
     R_STUCK,
     R_TELEPORTED,
     RISE,
@@ -245,3 +248,32 @@ def physics_commit(pos, start, target, fv, iv, prop, res, sf, si, flags, prm):
         else:
             iv[i, I_RECOVER] = int(prm[P_SIDESTEP_TICKS]) + iv[i, I_WAIT]
             fv[i, F_SIDE] = 1.0 if iv[i, I_ATTEMPTS] % 2 == 1 else -1.0
+
+
+@njit(cache=True)
+def physics_glide(pos, start, target, fv, iv, prop, res, sf, si, need_world, flags, prm, ticks):
+    """Up to `ticks` ticks of resolve and commit. Stops after a tick in which an agent arrives,
+    is stuck or is teleported, or at a tick whose resolved moves need a world test: that tick
+    is left uncommitted for the caller. Returns (ticks advanced, agents needing the world test
+    at the last tick (0 if it is committed), whether an agent arrived, was stuck or teleported
+    at the last tick). R_MOVED collects every agent that moved."""
+    n = pos.shape[0]
+    for k in range(ticks):
+        for i in range(n):
+            flags[R_ARRIVED, i] = False
+            flags[R_MOVING, i] = False
+            flags[R_STUCK, i] = False
+            flags[R_TELEPORTED, i] = False
+        count = physics_resolve(pos, start, target, fv, iv, prop, res, sf, si, need_world,
+                                flags, prm)  # fmt: skip
+        if count:
+            return k + 1, count, False
+        event = False
+        for i in range(n):
+            if flags[R_MOVING, i]:
+                flags[R_MOVED, i] = True
+            if flags[R_ARRIVED, i] or flags[R_STUCK, i] or flags[R_TELEPORTED, i]:
+                event = True
+        if event:
+            return k + 1, 0, True
+    return ticks, 0, False

@@ -16,6 +16,8 @@ class MoveStep:
     moving: np.ndarray  # bool: its feet moved this tick
     stuck: np.ndarray  # bool: newly declared stuck this tick (a recovery starts)
     teleported: np.ndarray  # bool: the last-resort recovery put it on its goal this tick
+    moved: np.ndarray  # bool: its feet moved at some tick of the call (`glide` spans several)
+    happened: bool = True  # some agent arrived, was declared stuck or teleported (else: none)
 
 
 class Mover(Protocol):
@@ -49,8 +51,20 @@ class Mover(Protocol):
         """Advance every agent by one tick."""
         ...
 
+    def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
+        """Advance up to `max_ticks` ticks in one call, stopping after the first tick in which an
+        agent arrives, is declared stuck or is teleported; returns the ticks advanced and that
+        last tick's `MoveStep` (`moved`: over all of them). Each tick is computed exactly as
+        `step` computes it."""
+        ...
+
     @property
     def positions(self) -> np.ndarray: ...
+
+    @property
+    def standing(self) -> np.ndarray:
+        """(N,) True for agents with no motion under way (they stay put until given a goal)."""
+        ...
 
     @property
     def heading(self) -> np.ndarray: ...

@@ -1,8 +1,9 @@
 """The edge motion both movers share, compiled with numba: one agent along one edge per call.
 
-`advance` is the motion itself (see the package docstring for the phases); `kinematic_step` is
-the kinematic mover's whole tick; `propose` and `move_to` are the pieces the physics mover's
-collision pass (`collision.py`) reuses. Slots of the packed arrays are named in `layout.py`.
+`advance` is the motion itself (see the package docstring for the phases); `begin_edge` starts
+an agent on an edge; `kinematic_step` is the kinematic mover's whole tick and `kinematic_glide`
+several ticks in one call; `propose` and `move_to` are the pieces the physics mover's collision
+pass (`collision.py`) reuses. Slots of the packed arrays are named in `layout.py`.
 """
 
 from __future__ import annotations
@@ -15,11 +16,15 @@ from decoy_cli.sim.movement.layout import (
     EPS,
     F_CARRY,
     F_HEADING,
+    F_MAX_SPEED,
     F_SPEED,
     F_VZ,
     FALL,
     GLIDE,
+    I_ATTEMPTS,
+    I_BLOCKED,
     I_PHASE,
+    I_RECOVER,
     IDLE,
     LINE,
     P_DT,
@@ -27,9 +32,15 @@ from decoy_cli.sim.movement.layout import (
     P_LOOKAHEAD,
     P_ON_LINE,
     R_ARRIVED,
+    R_MOVED,
     R_MOVING,
     RISE,
 )
+
+JUMP_EDGE = 2
+"""`EdgeKind.JUMP` (numba reads module ints as constants; `tests/test_sim_movement.py` checks)."""
+DROP_EDGE = 3
+"""`EdgeKind.DROP`."""
 
 
 @njit(cache=True)
@@ -141,3 +152,50 @@ def kinematic_step(pos, start, target, fv, iv, flags, prm):
         if arr:
             flags[R_ARRIVED, i] = True
             start[i, 0], start[i, 1], start[i, 2] = target[i, 0], target[i, 1], target[i, 2]
+
+
+@njit(cache=True)
+def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
+    """Up to `max_ticks` kinematic ticks, stopping after the first tick in which an agent
+    arrives; returns (ticks done, whether an agent arrived). `flags` hold that last tick's
+    rows, and R_MOVED every agent that moved at any of the ticks."""
+    n = pos.shape[0]
+    for k in range(max_ticks):
+        for i in range(n):
+            flags[R_ARRIVED, i] = False
+            flags[R_MOVING, i] = False
+        kinematic_step(pos, start, target, fv, iv, flags, prm)
+        arrived = False
+        for i in range(n):
+            if flags[R_MOVING, i]:
+                flags[R_MOVED, i] = True
+            if flags[R_ARRIVED, i]:
+                arrived = True
+        if arrived:
+            return k + 1, True
+    return max_ticks, False
+
+
+@njit(cache=True)
+def begin_edge(i, tx, ty, tz, kind, speed, jump_speed, gravity, pos, target, fv, iv):
+    """Start agent i on the edge to (tx, ty, tz) of `kind` (EdgeKind) at `speed` (capped by
+    its max speed): its phase, vertical speed and heading. Returns False, changing nothing, if
+    the agent is in the air (it lands first)."""
+    if iv[i, I_PHASE] in (RISE, GLIDE, FALL):
+        return False
+    target[i, 0], target[i, 1], target[i, 2] = tx, ty, tz
+    fv[i, F_SPEED] = min(speed, fv[i, F_MAX_SPEED])
+    fv[i, F_VZ] = 0.0
+    z = pos[i, 2]
+    if kind == JUMP_EDGE and tz > z + EPS:
+        iv[i, I_PHASE] = RISE
+        fv[i, F_VZ] = max(jump_speed, math.sqrt(2.0 * gravity * (tz - z)))
+    elif kind in (JUMP_EDGE, DROP_EDGE):
+        iv[i, I_PHASE] = GLIDE
+    else:
+        iv[i, I_PHASE] = LINE
+    dx, dy = tx - pos[i, 0], ty - pos[i, 1]
+    if dx * dx + dy * dy > 1e-18:
+        fv[i, F_HEADING] = math.degrees(math.atan2(dy, dx))
+    iv[i, I_RECOVER], iv[i, I_BLOCKED], iv[i, I_ATTEMPTS] = 0, 0, 0
+    return True

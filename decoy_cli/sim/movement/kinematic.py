@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import MoveStep
-from decoy_cli.sim.movement.kernels import kinematic_step
+from decoy_cli.sim.movement.kernels import kinematic_glide
 
 
 class KinematicMover(MoverBase):
@@ -14,10 +14,11 @@ class KinematicMover(MoverBase):
     `recoveries` stay zero.
     """
 
-    def step(self) -> MoveStep:
-        """Advance every agent by one tick."""
+    def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
+        """Up to `max_ticks` ticks in one compiled call, stopping after the first arrival."""
         flags, out = self._new_flags()
-        kinematic_step(
-            self._pos, self._start, self._target, self._fv, self._iv, flags, self._params
-        )
-        return out
+        ticks, out.happened = kinematic_glide(
+            self._pos, self._start, self._target, self._fv, self._iv, flags, self._params,
+            max(1, int(max_ticks)),
+        )  # fmt: skip
+        return int(ticks), out

@@ -57,7 +57,8 @@ R_ARRIVED = 0
 R_MOVING = 1
 R_STUCK = 2
 R_TELEPORTED = 3
-FLAG_ROWS = 4
+R_MOVED = 4  # moved at some tick of a glide (several ticks in one call); for one tick: R_MOVING
+FLAG_ROWS = 5
 
 # ---- the parameter vector `prm` (PARAM_SLOTS,), float64 ----
 P_DT = 0  # seconds per tick

@@ -12,7 +12,7 @@ from decoy_cli.csgo import (
     TICK_RATE,
 )
 from decoy_cli.sim.movement.base import MoverBase
-from decoy_cli.sim.movement.collision import physics_commit, physics_resolve
+from decoy_cli.sim.movement.collision import physics_commit, physics_glide
 from decoy_cli.sim.movement.interface import MoveStep
 from decoy_cli.sim.movement.layout import (
     I_WAIT,
@@ -25,6 +25,11 @@ from decoy_cli.sim.movement.layout import (
     P_SIDESTEP_TICKS,
     P_STUCK_TICKS,
     P_TWO_R,
+    R_ARRIVED,
+    R_MOVED,
+    R_MOVING,
+    R_STUCK,
+    R_TELEPORTED,
     S_MODIFIED,
     SCRATCH_FLOAT_SLOTS,
     SCRATCH_INT_SLOTS,
@@ -194,15 +199,20 @@ class PhysicsMover(MoverBase):
                 p.removeBody(body, physicsClientId=client)
         self._bodies = []
 
-    def step(self) -> MoveStep:
-        """Advance every agent by one tick (see the class docstring)."""
+    def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
+        """Up to `max_ticks` ticks (see the class docstring for one) in one compiled call; a tick
+        whose moves need the world test ends the call after the test and the commit."""
         flags, out = self._new_flags()
         args = (self._pos, self._start, self._target, self._fv, self._iv, self._prop, self._res)
-        count = physics_resolve(*args, self._sf, self._si, self._need_world, flags, self._params)
+        ticks, count, out.happened = physics_glide(
+            *args, self._sf, self._si, self._need_world, flags, self._params, max(1, max_ticks)
+        )
         if count:
             self._world_check(self._need_world[:count].tolist())
             physics_commit(*args, self._sf, self._si, flags, self._params)
-        return out
+            flags[R_MOVED] |= flags[R_MOVING]
+            out.happened = bool(flags[[R_ARRIVED, R_STUCK, R_TELEPORTED]].any())
+        return int(ticks), out
 
     def _world_check(self, agents: list[int]) -> None:
         """Cancel the moves of these agents (off their verified edge) that enter the world."""
