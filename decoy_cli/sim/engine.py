@@ -27,7 +27,9 @@ import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.sim.movement import Mover, MoveStep
+from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.rules import BombRules
+from decoy_cli.sim.schedule import due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -273,17 +275,14 @@ class Simulator:
         agents = self.agents
         agents.position[:] = self.mover.positions
         np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
-        if not moved.happened:
-            return moved.moving
-        if moved.arrived.any():
-            for agent in np.flatnonzero(moved.arrived & agents.alive).tolist():
-                agents.node[agent] = self.goal_node[agent]
-                self.goal_node[agent] = -1
-                self.waiting[agent] = True
-        for agent in np.flatnonzero(moved.stuck).tolist():
-            self.events.append(SimEvent(self.tick, "stuck", agent))
-        for agent in np.flatnonzero(moved.teleported).tolist():
-            self.events.append(SimEvent(self.tick, "teleport", agent))
+        if moved.happened & ARRIVAL:
+            note_arrivals(moved.arrived, agents.alive, agents.node, self.goal_node, self.waiting)
+        if moved.happened & STUCK:
+            for agent in np.flatnonzero(moved.stuck).tolist():
+                self.events.append(SimEvent(self.tick, "stuck", agent))
+        if moved.happened & TELEPORT:
+            for agent in np.flatnonzero(moved.teleported).tolist():
+                self.events.append(SimEvent(self.tick, "teleport", agent))
         return moved.moving
 
     def _quiet_until(self, tick: int) -> int:
@@ -293,17 +292,15 @@ class Simulator:
         `tick` when the tick after it is not quiet. Asked once the decisions of the tick after
         `tick` are made (they are the only part of that tick already played)."""
         alive = self.agents.alive
-        if self.outcome is not None or (self.waiting & alive).any():
+        due = next_due(self.waiting, alive, self.hold_until, tick)
+        if self.outcome is not None or due == tick + 1:
             return tick
         if alive.tobytes() != self._alive_judged:  # not judged yet, or a kill from outside
             return tick
         rules = self.rules.quiet_until(
             tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, self.mover.standing
         )
-        last = min(self._max_tick - 1, rules)
-        holding = (self.hold_until > 0) & alive
-        if holding.any():
-            last = min(last, int(self.hold_until[holding].min()) - 1)
+        last = min(self._max_tick - 1, rules, due - 1)
         if self.combat is not None:
             last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
         if self._next_record < len(self._record_at):
@@ -357,9 +354,7 @@ class Simulator:
 
     def _decide(self) -> None:
         agents = self.agents
-        due = self._due_at(self.tick)
-        for index in np.nonzero(due)[0]:
-            agent = int(index)
+        for agent in due_agents(self.waiting, agents.alive, self.hold_until, self.tick).tolist():
             self.hold_until[agent] = 0
             self.waiting[agent] = False
             self._deciding = agent
@@ -388,10 +383,9 @@ class Simulator:
                 else float(decision.max_speed)
             )
             speed = top if decision.speed is None else min(float(decision.speed), top)
-            self.mover.set_max_speed(agent, top)
             self.goal_node[agent] = target
             self.mover.set_goal(
-                agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed
+                agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
             )
 
     def _record(self) -> None:

@@ -143,6 +143,15 @@ class BombRules:
     def __init__(self, zones: SiteZones, config: RulesConfig | None = None) -> None:
         self.zones = zones
         self.config = config or RulesConfig()
+        self._site_seen: tuple[bytes, str] = (b"", "")  # the last carrier position looked up
+
+    def _site_at(self, position: np.ndarray) -> str:
+        """The bomb-site zone a carrier stands in ("" if none); a carrier standing still is
+        asked about at every tick, so the last answer is kept."""
+        key = np.asarray(position, dtype=np.float64).tobytes()
+        if key != self._site_seen[0]:
+            self._site_seen = (key, str(self.zones.site_of(position)[0]))
+        return self._site_seen[1]
 
     # ---- round start --------------------------------------------------------------------------
 
@@ -275,7 +284,7 @@ class BombRules:
                 if not agents.alive[carrier] or bomb.planter == carrier:
                     return tick
                 if wants_plant[carrier] and (  # a plant starts once it stands in a zone
-                    not standing[carrier] or self.zones.site_of(agents.position[carrier])[0]
+                    not standing[carrier] or self._site_at(agents.position[carrier])
                 ):
                     return tick
             elif bomb.status == BombStatus.DROPPED:
@@ -332,7 +341,7 @@ class BombRules:
         carrier = bomb.carrier
         if bomb.planter != carrier and (not wants_plant[carrier] or moving[carrier]):
             return []
-        site = str(self.zones.site_of(agents.position[carrier])[0])
+        site = self._site_at(agents.position[carrier])
         if bomb.planter == carrier:
             reason = _first_true(
                 ("stopped", not wants_plant[carrier]),

@@ -144,10 +144,23 @@ class MoverBase:
         """On a jump or drop edge: rising, gliding over the gap or box edge, or falling."""
         return self._iv[i, I_PHASE] in (RISE, GLIDE, FALL)
 
-    def set_goal(self, agent: int, target: np.ndarray, kind: int, speed: float) -> None:
+    def set_goal(
+        self,
+        agent: int,
+        target: np.ndarray,
+        kind: int,
+        speed: float,
+        max_speed: float | None = None,
+    ) -> None:
         """Cross the edge from the agent's node to `target` (3,) at `speed` m/s (capped by its
-        max speed); the edge `kind` (EdgeKind) chooses walking, jumping or dropping."""
+        max speed, first set to `max_speed` if given); the edge `kind` (EdgeKind) chooses
+        walking, jumping or dropping."""
         i = self._agent(agent, alive=True)
+        cap = -1.0  # keep the agent's cap
+        if max_speed is not None:
+            if not max_speed >= 0.0:
+                raise ValueError(f"max speed must be >= 0 m/s, got {max_speed!r}")
+            cap = float(max_speed)
         goal = np.asarray(target, dtype=np.float64).reshape(-1)
         if goal.shape != (3,):
             raise ValueError(f"target must be a finite (3,) position, got {target!r}")
@@ -160,7 +173,7 @@ class MoverBase:
             names = ", ".join(k.name for k in EdgeKind)
             raise ValueError(f"{kind!r} is not an edge kind ({names})")
         started = begin_edge(
-            i, x, y, z, int(kind), float(speed), self.jump_speed, self.gravity,
+            i, x, y, z, int(kind), float(speed), cap, self.jump_speed, self.gravity,
             self._pos, self._target, self._fv, self._iv,
         )  # fmt: skip
         if not started:

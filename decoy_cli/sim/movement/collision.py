@@ -255,8 +255,9 @@ def physics_glide(pos, start, target, fv, iv, prop, res, sf, si, need_world, fla
     """Up to `ticks` ticks of resolve and commit. Stops after a tick in which an agent arrives,
     is stuck or is teleported, or at a tick whose resolved moves need a world test: that tick
     is left uncommitted for the caller. Returns (ticks advanced, agents needing the world test
-    at the last tick (0 if it is committed), whether an agent arrived, was stuck or teleported
-    at the last tick). R_MOVED collects every agent that moved."""
+    at the last tick (0 if it is committed), the `MoveStep.happened` bits of the last tick: 1
+    an agent arrived, 2 one was stuck, 4 one was teleported). R_MOVED collects every agent that
+    moved."""
     n = pos.shape[0]
     for k in range(ticks):
         for i in range(n):
@@ -267,13 +268,17 @@ def physics_glide(pos, start, target, fv, iv, prop, res, sf, si, need_world, fla
         count = physics_resolve(pos, start, target, fv, iv, prop, res, sf, si, need_world,
                                 flags, prm)  # fmt: skip
         if count:
-            return k + 1, count, False
-        event = False
+            return k + 1, count, 0
+        happened = 0
         for i in range(n):
             if flags[R_MOVING, i]:
                 flags[R_MOVED, i] = True
-            if flags[R_ARRIVED, i] or flags[R_STUCK, i] or flags[R_TELEPORTED, i]:
-                event = True
-        if event:
-            return k + 1, 0, True
-    return ticks, 0, False
+            if flags[R_ARRIVED, i]:
+                happened |= 1
+            if flags[R_STUCK, i]:
+                happened |= 2
+            if flags[R_TELEPORTED, i]:
+                happened |= 4
+        if happened:
+            return k + 1, 0, happened
+    return ticks, 0, 0

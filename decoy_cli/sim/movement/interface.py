@@ -7,6 +7,9 @@ from typing import Protocol
 
 import numpy as np
 
+ARRIVAL, STUCK, TELEPORT = 1, 2, 4
+"""Bits of `MoveStep.happened`: some agent arrived, was declared stuck, was teleported."""
+
 
 @dataclass(slots=True)
 class MoveStep:
@@ -17,7 +20,7 @@ class MoveStep:
     stuck: np.ndarray  # bool: newly declared stuck this tick (a recovery starts)
     teleported: np.ndarray  # bool: the last-resort recovery put it on its goal this tick
     moved: np.ndarray  # bool: its feet moved at some tick of the call (`glide` spans several)
-    happened: bool = True  # some agent arrived, was declared stuck or teleported (else: none)
+    happened: int = ARRIVAL | STUCK | TELEPORT  # which of these happened to any agent (bits)
 
 
 class Mover(Protocol):
@@ -27,8 +30,16 @@ class Mover(Protocol):
         """Start over with agents standing at `positions` (N, 3) (waypoints), no goals."""
         ...
 
-    def set_goal(self, agent: int, target: np.ndarray, kind: int, speed: float) -> None:
-        """Move `agent` from its node to `target` (3,) across an edge of `kind` at `speed`."""
+    def set_goal(
+        self,
+        agent: int,
+        target: np.ndarray,
+        kind: int,
+        speed: float,
+        max_speed: float | None = None,
+    ) -> None:
+        """Move `agent` from its node to `target` (3,) across an edge of `kind` at `speed`
+        (capped by its speed cap, first changed to `max_speed` if given)."""
         ...
 
     def clear_goal(self, agent: int) -> None:

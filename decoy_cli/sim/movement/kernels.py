@@ -157,8 +157,8 @@ def kinematic_step(pos, start, target, fv, iv, flags, prm):
 @njit(cache=True)
 def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
     """Up to `max_ticks` kinematic ticks, stopping after the first tick in which an agent
-    arrives; returns (ticks done, whether an agent arrived). `flags` hold that last tick's
-    rows, and R_MOVED every agent that moved at any of the ticks."""
+    arrives; returns (ticks done, 1 if an agent arrived else 0: `MoveStep.happened`). `flags`
+    hold that last tick's rows, and R_MOVED every agent that moved at any of the ticks."""
     n = pos.shape[0]
     for k in range(max_ticks):
         for i in range(n):
@@ -172,17 +172,19 @@ def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
             if flags[R_ARRIVED, i]:
                 arrived = True
         if arrived:
-            return k + 1, True
-    return max_ticks, False
+            return k + 1, 1
+    return max_ticks, 0
 
 
 @njit(cache=True)
-def begin_edge(i, tx, ty, tz, kind, speed, jump_speed, gravity, pos, target, fv, iv):
+def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target, fv, iv):
     """Start agent i on the edge to (tx, ty, tz) of `kind` (EdgeKind) at `speed` (capped by
-    its max speed): its phase, vertical speed and heading. Returns False, changing nothing, if
-    the agent is in the air (it lands first)."""
+    its max speed, first set to `cap` unless that is negative): its phase, vertical speed and
+    heading. Returns False, changing nothing, if the agent is in the air (it lands first)."""
     if iv[i, I_PHASE] in (RISE, GLIDE, FALL):
         return False
+    if cap >= 0.0:
+        fv[i, F_MAX_SPEED] = cap
     target[i, 0], target[i, 1], target[i, 2] = tx, ty, tz
     fv[i, F_SPEED] = min(speed, fv[i, F_MAX_SPEED])
     fv[i, F_VZ] = 0.0

@@ -13,7 +13,7 @@ from decoy_cli.csgo import (
 )
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.collision import physics_commit, physics_glide
-from decoy_cli.sim.movement.interface import MoveStep
+from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT, MoveStep
 from decoy_cli.sim.movement.layout import (
     I_WAIT,
     P_ARRIVE_XY,
@@ -211,7 +211,11 @@ class PhysicsMover(MoverBase):
             self._world_check(self._need_world[:count].tolist())
             physics_commit(*args, self._sf, self._si, flags, self._params)
             flags[R_MOVED] |= flags[R_MOVING]
-            out.happened = bool(flags[[R_ARRIVED, R_STUCK, R_TELEPORTED]].any())
+            out.happened = (
+                ARRIVAL * bool(flags[R_ARRIVED].any())
+                | STUCK * bool(flags[R_STUCK].any())
+                | TELEPORT * bool(flags[R_TELEPORTED].any())
+            )
         return int(ticks), out
 
     def _world_check(self, agents: list[int]) -> None:
