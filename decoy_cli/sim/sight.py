@@ -129,9 +129,10 @@ class LineOfSight:
         feet = np.asarray(agents.position, dtype=np.float64)
         if not np.all(np.isfinite(feet[alive])):
             raise ValueError("an alive agent has a NaN or infinite position")
-        one, two = np.meshgrid(t_side, ct_side, indexing="ij")
-        first = np.minimum(one, two).ravel()  # rays run from the lower to the higher index
-        second = np.maximum(one, two).ravel()
+        one = np.repeat(t_side, len(ct_side))  # every (T, CT) pair, T-major
+        two = np.tile(ct_side, len(t_side))
+        first = np.minimum(one, two)  # rays run from the lower to the higher index
+        second = np.maximum(one, two)
         eyes = feet + np.array([0.0, 0.0, self.eye_height])
         clear = self.physics.occlusion.clear(eyes[first], eyes[second])
         if np.any(clear) and np.count_nonzero(alive) > 2:

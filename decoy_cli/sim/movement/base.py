@@ -162,7 +162,7 @@ class MoverBase:
                 raise ValueError(f"max speed must be >= 0 m/s, got {max_speed!r}")
             cap = float(max_speed)
         goal = np.asarray(target, dtype=np.float64).reshape(-1)
-        if goal.shape != (3,):
+        if len(goal) != 3:
             raise ValueError(f"target must be a finite (3,) position, got {target!r}")
         x, y, z = goal.tolist()
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):

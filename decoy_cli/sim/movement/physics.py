@@ -222,14 +222,18 @@ class PhysicsMover(MoverBase):
         """Cancel the moves of these agents (off their verified edge) that enter the world."""
         p, client, world = self.physics.pybullet, self.physics.client, self.physics.body
         self.world_checks += len(agents)
-        centres = self._res[agents] + self._lift
-        for k, i in enumerate(agents):
-            body = self._bodies[i]
-            p.resetBasePositionAndOrientation(
-                body, centres[k].tolist(), (0.0, 0.0, 0.0, 1.0), physicsClientId=client
+        centres = (self._res[agents] + self._lift).tolist()
+        graze = -self.graze
+        for i, centre in zip(agents, centres, strict=True):
+            # the capsule's shape at the centre, without moving its body (synced lazily)
+            points = p.getClosestPoints(
+                -1,
+                world,
+                0.0,
+                collisionShapeA=self._shape,
+                collisionShapePositionA=centre,
+                physicsClientId=client,
             )
-            self._synced[i] = self._res[i]
-            points = p.getClosestPoints(body, world, 0.0, physicsClientId=client)
-            if any(point[8] < -self.graze for point in points):
+            if any(point[8] < graze for point in points):
                 self._res[i] = self._pos[i]
                 self._si[i, S_MODIFIED] = 1
