@@ -405,8 +405,10 @@ def test_physics_mover_is_seeded_and_releases_its_client() -> None:
     first = run_random(env, seed=21, steps=100)
     physics = env.physics
     assert physics is not None and pybullet.isConnected(physics.client)
-    second = run_random(env, seed=21, steps=100)  # re-reset: a fresh client
-    assert physics.client is None  # the first round's client was disconnected
+    bodies = pybullet.getNumBodies(physicsClientId=physics.client)
+    second = run_random(env, seed=21, steps=100)  # re-reset: the same client, fresh bodies
+    assert env.physics is physics
+    assert pybullet.getNumBodies(physicsClientId=physics.client) == bodies
     assert all(np.array_equal(a, b) for a, b in zip(first, second, strict=True))
     client = env.physics.client
     env.close()

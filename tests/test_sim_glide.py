@@ -8,59 +8,15 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
+from busy_rounds import Shots, Wanderers, site_agents
 
-from decoy_cli.sim.combat import CombatBatch, DamageResult
-from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.setup import RoundSetup, open_round
-from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
 
 GRAPH = builtin_graph()
-
-
-class Shots:
-    """A damage model that hits a tenth of the visible pairs for 10 HP (drawn from the
-    engine's generator, so both runs must ask it at the same ticks in the same order)."""
-
-    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
-        hit = rng.random(len(batch)) < 0.1
-        groups = np.where(hit, 2, -1).astype(np.int8)
-        return DamageResult(np.where(hit, 10, 0).astype(np.int64), groups, hit)
-
-
-class Wanderers:
-    """Random valid moves; a STOP (a quarter of the decisions) holds a random time and plants
-    (a T) or defuses (a CT), so plants, aborts, pick-ups and defuses all happen."""
-
-    def __init__(self, seed: int) -> None:
-        self.rng = np.random.default_rng(seed)
-
-    def decide(self, sim: Simulator, agent: int) -> Decision:
-        mask = sim.graph.action_mask(int(sim.agents.node[agent]))
-        if self.rng.random() < 0.25:
-            t_side = sim.agents.side[agent] == "T"
-            hold = int(self.rng.integers(1, 400))
-            return Decision(STOP_ACTION, hold_ticks=hold, plant=t_side, defuse=not t_side)
-        moves = np.flatnonzero(mask[:STOP_ACTION])
-        return Decision(int(self.rng.choice(moves)), speed=float(self.rng.uniform(1.0, 6.0)))
-
-
-def _agents(graph: WaypointGraph, seed: int) -> Agents:
-    """Five T and five CT on one bomb site, close enough to see and shoot each other."""
-    rng = np.random.default_rng(seed)
-    site = graph.region_of("bombsite_a" if seed % 2 else "bombsite_b")
-    nodes = rng.choice(site, 10, replace=False)
-    return Agents.create(
-        names=[f"p{i}" for i in range(10)],
-        sides=["T"] * 5 + ["CT"] * 5,
-        positions=graph.positions[nodes],
-        nodes=nodes,
-        weapons=["AK-47"] * 5 + ["M4A4"] * 5,
-        has_defuser=np.array([False] * 5 + [True] * 5),
-    )
 
 
 def _play(
@@ -70,7 +26,7 @@ def _play(
     record = range(0, 8000, 7)  # recorded ticks that fall between combat steps too
     with open_round(
         setup,
-        _agents(GRAPH, seed),
+        site_agents(GRAPH, seed),
         Wanderers(seed),
         physics=physics,
         bomb_carrier=seed % 5,

@@ -129,8 +129,9 @@ class DecoyParallelEnv(ParallelEnv):
     round.
 
     pybullet: the physics mover and combat (`damage_model`) need a pybullet client with the
-    world (`world`, default the built-in nav world); it is created at each reset and the
-    previous round's client is disconnected, and `close()` disconnects it. Rounds are set up
+    world (`world`, default the built-in nav world); it is created at the first reset that
+    needs it and serves every later round (each round removes its own bodies at its end), and
+    `close()` disconnects it. Rounds are set up
     by `decoy_cli.sim.setup.open_round`, as every other user of the simulator does.
 
     Rendering: `render_mode="rgb_array"` gives a top-down matplotlib picture (waypoints grey,
@@ -221,6 +222,7 @@ class DecoyParallelEnv(ParallelEnv):
         """The pybullet client of the current round (None with the kinematic mover and no
         combat, or after `close()`)."""
         self._round = ExitStack()
+        self._world = ExitStack()  # the pybullet client, kept across rounds
         self._view: TopDownView | None = None
 
     # ---- PettingZoo API -----------------------------------------------------------------------
@@ -259,8 +261,8 @@ class DecoyParallelEnv(ParallelEnv):
         carrier = int(rng.integers(self.n_t)) if self.bomb and self.n_t else -1
         self._end_round()
         self._policy = _ChosenActions()
-        if self.setup.needs_physics:
-            self.physics = self._round.enter_context(self.setup.open_physics())
+        if self.setup.needs_physics and self.physics is None:
+            self.physics = self._world.enter_context(self.setup.open_physics())
         self._sim = self._round.enter_context(
             open_round(
                 self.setup,
@@ -272,7 +274,8 @@ class DecoyParallelEnv(ParallelEnv):
             )
         )
         self.agents = list(self.possible_agents)
-        return self._observe(self.agents), self._infos(self.agents)
+        due = self._due()
+        return self._observe(self.agents, due), self._infos(self.agents, due)
 
     def step(
         self, actions: Mapping[str, Any]
@@ -299,13 +302,13 @@ class DecoyParallelEnv(ParallelEnv):
                     raise ValueError(f"agent {name} needs a decision but was given no action")
                 pending[agent] = self._decision(agent, actions[name])
         self._policy.pending = pending
-        sim.step()
+        start = sim.tick  # the first tick takes the decisions, then on to the next ones
+        sim.run(until=lambda s: s.tick > start and bool(s.needs_decision.any()))
         if self._policy.pending:
             raise RuntimeError(
                 f"the simulator did not ask agents {sorted(self._policy.pending)} for the "
                 "decision the environment collected"
             )
-        sim.run(until=lambda s: bool(s.needs_decision.any()))
 
         outcome = sim.outcome
         alive = sim.agents.alive
@@ -317,8 +320,9 @@ class DecoyParallelEnv(ParallelEnv):
             name: bool(outcome is not None or not alive[self._index[name]]) for name in live
         }
         truncations = dict.fromkeys(live, False)
-        observations = self._observe(live)
-        infos = self._infos(live)
+        due = self._due()
+        observations = self._observe(live, due)
+        infos = self._infos(live, due)
         self.agents = [name for name in live if not terminations[name]]
         return observations, rewards, terminations, truncations, infos
 
@@ -335,6 +339,9 @@ class DecoyParallelEnv(ParallelEnv):
     def close(self) -> None:
         """Disconnect the pybullet client and drop the round; safe to call more than once."""
         self._end_round()
+        self._world.close()
+        self._world = ExitStack()
+        self.physics = None
         self.agents = []
         self._view = None
 
@@ -361,11 +368,10 @@ class DecoyParallelEnv(ParallelEnv):
         ]
 
     def _end_round(self) -> None:
-        """Release the current round's bodies and pybullet client (if any)."""
+        """Release the current round's bodies (the pybullet client stays for the next)."""
         self._round.close()
         self._round = ExitStack()
         self._sim = None
-        self.physics = None
 
     def _due(self) -> np.ndarray:
         """(N,) which agents the engine will ask for a decision at the next tick."""
@@ -385,18 +391,17 @@ class DecoyParallelEnv(ParallelEnv):
         is_t = self._sides[agent] == "T"
         return Decision(STOP_ACTION, hold_ticks=self.stop_ticks, plant=is_t, defuse=not is_t)
 
-    def _observe(self, names: list[str]) -> dict[str, dict[str, np.ndarray]]:
+    def _observe(self, names: list[str], due: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
         sim = self._require_sim()
-        vectors, masks = self._encoder.encode(sim, self._due())
+        vectors, masks = self._encoder.encode(sim, due)
         return {
             name: {"observation": vectors[k], "action_mask": masks[k]}
             for name in names
             for k in (self._index[name],)
         }
 
-    def _infos(self, names: list[str]) -> dict[str, dict[str, Any]]:
+    def _infos(self, names: list[str], due: np.ndarray) -> dict[str, dict[str, Any]]:
         sim = self._require_sim()
-        due = self._due()
         end = {}
         if sim.outcome is not None:
             end = {"winner": sim.outcome.winner, "reason": sim.outcome.reason}

@@ -7,9 +7,11 @@ its own; the environment asks an `ObservationEncoder` for the vectors and masks 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
+from numba import njit
 
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import RulesConfig
@@ -89,6 +91,8 @@ class ObservationEncoder:
         self.layout = observation_layout(slots - 1, slots)
         self.size = self.layout["bomb_time_left"].stop
         self._mates, self._enemies = slot_tables(sides, slots)
+        self._is_ct = np.asarray(sides) == "CT"
+        self._starts = np.array([self.layout[name].start for name in _PER_AGENT], dtype=np.int64)
         lo, hi = graph.positions.min(axis=0), graph.positions.max(axis=0)
         self._centre = (lo + hi) / 2
         self._half = (hi - lo) / 2 + POSITION_MARGIN_M
@@ -110,24 +114,14 @@ class ObservationEncoder:
         n = agents.count
         pos = agents.position
         obs = np.zeros((n, self.size), dtype=np.float64)
-        obs[:, layout["position"]] = np.clip((pos - self._centre) / self._half, -1.0, 1.0)
-        yaw = np.radians(agents.yaw)
-        obs[:, layout["yaw"]] = np.stack([np.sin(yaw), np.cos(yaw)], axis=1)
-        obs[:, layout["hp"].start] = agents.hp / 100.0
-        obs[:, layout["armor"].start] = agents.armor / 100.0
-        obs[:, layout["helmet"].start] = agents.helmet
-        obs[:, layout["defuse_kit"].start] = agents.has_defuser
-        has_bomb = self.bomb and bomb.status == BombStatus.CARRIED and bomb.carrier >= 0
-        if has_bomb:
-            obs[bomb.carrier, layout["has_bomb"].start] = 1.0
-        obs[:, layout["is_ct"].start] = agents.side == "CT"
-        obs[:, layout["needs_decision"].start] = due
-        obs[:, layout["teammates"]] = self._slots(self._mates, pos, agents.alive, agents.hp)
-        obs[:, layout["enemies"]] = self._slots(self._enemies, pos, agents.alive, agents.hp)
-        obs[:, layout["bomb_state"]] = np.eye(len(BOMB_STATES))[self._bomb_state(bomb)]
-        if self._bomb_state(bomb) != 0:
-            offset = (bomb.position - pos) / (2 * self._half)
-            obs[:, layout["bomb_offset"]] = np.clip(offset, -1.0, 1.0)
+        state = self._bomb_state(bomb)
+        carrier = bomb.carrier if state == 1 else -1
+        _agent_features(
+            obs, self._starts, pos, agents.yaw, agents.hp, agents.armor, agents.helmet,
+            agents.has_defuser, self._is_ct, due, agents.alive, self._mates, self._enemies,
+            self._centre, self._half, bomb.position, state != 0, carrier,
+        )  # fmt: skip
+        obs[:, layout["bomb_state"].start + state] = 1.0
         if bomb.site in BOMB_SITES:
             obs[:, layout["bomb_site"].start + BOMB_SITES.index(bomb.site)] = 1.0
         if bomb.planter >= 0:
@@ -137,12 +131,11 @@ class ObservationEncoder:
             needed = cfg.defuse_kit_ticks if kit else cfg.defuse_ticks
             obs[:, layout["defuse_progress"].start] = bomb.defuse_ticks / needed
         clock = bomb.planted_tick if bomb.planted_tick >= 0 else sim.tick
-        obs[:, layout["round_time_left"].start] = np.clip(
-            (cfg.round_ticks - clock) / cfg.round_ticks, 0.0, 1.0
-        )
+        round_left = (cfg.round_ticks - clock) / cfg.round_ticks
+        obs[:, layout["round_time_left"].start] = min(1.0, max(0.0, round_left))
         if bomb.status == BombStatus.PLANTED:
             left = (bomb.planted_tick + cfg.bomb_ticks - sim.tick) / cfg.bomb_ticks
-            obs[:, layout["bomb_time_left"].start] = np.clip(left, 0.0, 1.0)
+            obs[:, layout["bomb_time_left"].start] = min(1.0, max(0.0, left))
 
         masks = np.zeros((n, NUM_ACTIONS), dtype=np.int8)
         masks[:, STOP_ACTION] = 1
@@ -150,20 +143,53 @@ class ObservationEncoder:
         masks[deciding, :STOP_ACTION] = self.graph.out_edges[agents.node[deciding]] >= 0
         return obs.astype(np.float32), masks
 
-    def _slots(
-        self, table: np.ndarray, pos: np.ndarray, alive: np.ndarray, hp: np.ndarray
-    ) -> np.ndarray:
-        """(N, slots * 5) features of the agents a slot table names (zeros: dead or unused)."""
-        idx = np.maximum(table, 0)
-        valid = (table >= 0) & alive[idx]
-        offset = np.clip((pos[idx] - pos[:, None, :]) / (2 * self._half), -1.0, 1.0)
-        features = np.concatenate(
-            [np.ones((*idx.shape, 1)), offset, (hp[idx] / 100.0)[..., None]], axis=2
-        )
-        return (features * valid[..., None]).reshape(len(table), -1)
-
     def _bomb_state(self, bomb: Bomb) -> int:
         """Index into BOMB_STATES."""
         if not self.bomb or (bomb.status == BombStatus.CARRIED and bomb.carrier < 0):
             return 0
         return 1 + int(bomb.status)
+
+
+_PER_AGENT = (
+    "position", "yaw", "hp", "armor", "helmet", "defuse_kit", "has_bomb", "is_ct",
+    "needs_decision", "teammates", "enemies", "bomb_offset",
+)  # fmt: skip
+"""The entries `_agent_features` fills, in the order of its `starts`."""
+
+
+@njit(cache=True)
+def _agent_features(
+    obs, starts, pos, yaw, hp, armor, helmet, kit, is_ct, due, alive, mates, enemies,
+    centre, half, bomb_pos, bomb_known, carrier,
+):  # fmt: skip
+    """Fill each agent's own entries, its teammate and enemy slots and the bomb's offset into
+    the zeroed (N, size) `obs` (the entries of `_PER_AGENT`, at `starts`)."""
+    p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = starts
+    for i in range(obs.shape[0]):
+        for axis in range(3):
+            v = (pos[i, axis] - centre[axis]) / half[axis]
+            obs[i, p0 + axis] = min(1.0, max(-1.0, v))
+        angle = math.radians(yaw[i])
+        obs[i, y0], obs[i, y0 + 1] = math.sin(angle), math.cos(angle)
+        obs[i, h0] = hp[i] / 100.0
+        obs[i, a0] = armor[i] / 100.0
+        obs[i, hel0] = 1.0 if helmet[i] else 0.0
+        obs[i, k0] = 1.0 if kit[i] else 0.0
+        obs[i, b0] = 1.0 if i == carrier else 0.0
+        obs[i, c0] = 1.0 if is_ct[i] else 0.0
+        obs[i, d0] = 1.0 if due[i] else 0.0
+        for start, table in ((m0, mates), (e0, enemies)):
+            for slot in range(table.shape[1]):
+                j = table[i, slot]
+                if j < 0 or not alive[j]:
+                    continue  # zeros: an unused slot or a dead agent
+                at = start + 5 * slot
+                obs[i, at] = 1.0
+                for axis in range(3):
+                    v = (pos[j, axis] - pos[i, axis]) / (2 * half[axis])
+                    obs[i, at + 1 + axis] = min(1.0, max(-1.0, v))
+                obs[i, at + 4] = hp[j] / 100.0
+        if bomb_known:
+            for axis in range(3):
+                v = (bomb_pos[axis] - pos[i, axis]) / (2 * half[axis])
+                obs[i, o0 + axis] = min(1.0, max(-1.0, v))

@@ -1,0 +1,53 @@
+"""Busy simulated rounds for engine tests: five T and five CT on one bomb site, random walkers
+that plant, defuse and shoot (not real data), so that every mechanic fires within a round."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from decoy_cli.sim.combat import CombatBatch, DamageResult
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.state import Agents
+from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+
+
+class Shots:
+    """A damage model that hits a tenth of the visible pairs for 10 HP (drawn from the
+    engine's generator, so both runs must ask it at the same ticks in the same order)."""
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        hit = rng.random(len(batch)) < 0.1
+        groups = np.where(hit, 2, -1).astype(np.int8)
+        return DamageResult(np.where(hit, 10, 0).astype(np.int64), groups, hit)
+
+
+class Wanderers:
+    """Random valid moves; a STOP (a quarter of the decisions) holds a random time and plants
+    (a T) or defuses (a CT), so plants, aborts, pick-ups and defuses all happen."""
+
+    def __init__(self, seed: int) -> None:
+        self.rng = np.random.default_rng(seed)
+
+    def decide(self, sim: Simulator, agent: int) -> Decision:
+        mask = sim.graph.action_mask(int(sim.agents.node[agent]))
+        if self.rng.random() < 0.25:
+            t_side = sim.agents.side[agent] == "T"
+            hold = int(self.rng.integers(1, 400))
+            return Decision(STOP_ACTION, hold_ticks=hold, plant=t_side, defuse=not t_side)
+        moves = np.flatnonzero(mask[:STOP_ACTION])
+        return Decision(int(self.rng.choice(moves)), speed=float(self.rng.uniform(1.0, 6.0)))
+
+
+def site_agents(graph: WaypointGraph, seed: int) -> Agents:
+    """Five T and five CT on one bomb site, close enough to see and shoot each other."""
+    rng = np.random.default_rng(seed)
+    site = graph.region_of("bombsite_a" if seed % 2 else "bombsite_b")
+    nodes = rng.choice(site, 10, replace=False)
+    return Agents.create(
+        names=[f"p{i}" for i in range(10)],
+        sides=["T"] * 5 + ["CT"] * 5,
+        positions=graph.positions[nodes],
+        nodes=nodes,
+        weapons=["AK-47"] * 5 + ["M4A4"] * 5,
+        has_defuser=np.array([False] * 5 + [True] * 5),
+    )
