@@ -66,6 +66,8 @@ def _apply(document: Any, path: tuple[Any, ...], replacement: Any) -> None:
         parent[path[-1]]
     except (KeyError, IndexError, TypeError):
         return
+    if not isinstance(parent, dict | list):  # an earlier mutation put a string (or number) here
+        return
     if isinstance(replacement, str) and replacement == _DELETE:
         del parent[path[-1]]
     else:

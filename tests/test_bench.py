@@ -101,7 +101,7 @@ def test_table1_rows_are_consistent(quick_run) -> None:
         assert math.isclose(row["time_scale"], row["game_s"] / row["wall_s"])
         paper = PAPER_TICKS_PER_S[row["agents"]]
         assert row["paper_ticks_per_s"] == paper
-        assert math.isclose(row["ratio_to_paper"], row["ticks_per_s"] / paper)
+        assert "ratio_to_paper" not in row  # the paper's machine is not this one
 
 
 def test_throughput_sections_count_what_they_measured(quick_run) -> None:

@@ -4,8 +4,10 @@ Speed differs by several times between machines and from one hour to the next on
 so a speed-up is only meaningful as a ratio of runs made side by side. Every run here is a fresh
 Python process that calls the bench sections of one code tree through `DRIVER` (which uses only
 the bench API both trees have: `BenchConfig.create`, `check_damage_model`, `find_data`,
-`run_section`); runs alternate current, baseline, current, baseline, ... and each pair gives one
-ratio of the section's headline figures (`headlines`), reported as median, min and max.
+`run_section`), or, for the sections of `decoy_cli.bench.portable`, that file of the current
+tree on the side's package; runs alternate current, baseline, current, baseline, ... and each
+pair gives one ratio of the section's headline figures (`headlines`), reported as median, min
+and max.
 
 The baseline is a git ref of the checkout this code runs from (exported with `git archive` into
 a folder beside the report, removed afterwards) or the Python interpreter of another environment
@@ -32,6 +34,8 @@ from pathlib import Path
 from typing import Any
 
 import decoy_cli
+from decoy_cli.bench import portable
+from decoy_cli.bench.portable import PORTABLE_SECTIONS
 from decoy_cli.errors import DecoyError
 
 DRIVER = """
@@ -48,7 +52,15 @@ config = BenchConfig.create(**args["config"])
 status = check_damage_model(args["config"]["models"])
 data = find_data(Path(args["data"])) if args["data"] else None
 try:
-    result = run_section(args["section"], config, status, data)
+    if args["portable"]:  # the current tree's file, run on this tree's package
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("decoy_portable_bench", args["portable"])
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        section = module.PORTABLE_SECTIONS[args["section"]]
+        result = section(args["config"])
+    else:
+        result = run_section(args["section"], config, status, data)
 except Exception as error:
     result = {"error": f"{type(error).__name__}: {error}"}
 result["code"] = decoy_cli.__file__
@@ -57,6 +69,9 @@ with open(args["result"] + ".part", "w") as handle:
 os.replace(args["result"] + ".part", args["result"])
 """
 """Runs one section of whichever decoy_cli the interpreter imports; writes its JSON result."""
+
+PORTABLE_FILE = Path(portable.__file__).resolve()
+"""The portable sections' source, loaded by path in either tree's process."""
 
 RUN_TIMEOUT_S = 3600
 """Wall-clock limit of one section run."""
@@ -158,6 +173,7 @@ def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | No
     result = scratch / "result.json"
     args = {"config": config, "data": str(data) if data else None, "section": section}
     args["result"] = str(result)
+    args["portable"] = str(PORTABLE_FILE) if section in PORTABLE_SECTIONS else None
     try:
         done = subprocess.run(
             [tree.python, "-c", DRIVER, json.dumps(args)],
@@ -192,6 +208,10 @@ def headlines(section: str, result: dict[str, Any]) -> dict[str, float]:
         figures = {"MB/s (JSON)": result.get("mb_per_s_decompressed")}
     elif section == "replay" and result.get("rounds"):
         figures = {"rounds/s": result.get("rounds_per_s")}
+    elif section == "kinematic":
+        figures = {f"ticks/s, {result.get('agents')} agents": result.get("ticks_per_s")}
+    elif section == "env":
+        figures = {"agent decisions/s": result.get("decisions_per_s")}
     elif section == "table1":
         rows = result.get("rows", [])
         figures = {f"ticks/s, {row.get('agents')} agents": row.get("ticks_per_s") for row in rows}

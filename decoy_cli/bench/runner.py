@@ -23,6 +23,7 @@ from typing import Any
 from decoy_cli import __version__
 from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
 from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
+from decoy_cli.bench.portable import PORTABLE_SECTIONS
 from decoy_cli.bench.simspeed import (
     AGENT_COUNTS,
     PAPER_DECISIONS,
@@ -36,7 +37,7 @@ from decoy_cli.sim.setup import check_mover
 
 REPORT_FORMAT = 1
 
-SECTIONS = ("table1", "combat_step", "replay", "metrics", "reader")
+SECTIONS = ("table1", "kinematic", "env", "combat_step", "replay", "metrics", "reader")
 """Section keys of the report, in the order they run."""
 
 DATA_SECTIONS = ("replay", "reader")
@@ -163,6 +164,8 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
             "paper": {"source": PAPER, "ticks_per_s": PAPER_TICKS_PER_S},
             "rows": [row.to_dict() for row in rows],
         }
+    elif name in PORTABLE_SECTIONS:
+        result = PORTABLE_SECTIONS[name](portable_config(config))
     elif name == "combat_step":
         costs = step_costs(model or NeverHits(), 5, config.combat_repeats, config.seed)
         result = {"damage_model": status.label, "rows": costs}
@@ -190,6 +193,12 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
         "peak_rss_mb": peak_rss_mb(),
         "ru_maxrss_mb": ru_maxrss_mb(),
     }
+
+
+def portable_config(config: BenchConfig) -> dict[str, Any]:
+    """What a portable section (`decoy_cli.bench.portable`) reads of the config."""
+    keys = ("quick", "models", "combat", "bomb", "seed")
+    return {key: getattr(config, key) for key in keys}
 
 
 def _needed(data: BenchData | None, name: str) -> BenchData:

@@ -104,8 +104,7 @@ class SpeedRow:
     game_s: float
     ticks_per_s: float
     time_scale: float
-    paper_ticks_per_s: float | None
-    ratio_to_paper: float | None
+    paper_ticks_per_s: float | None  # the paper's table, from its machine (not comparable)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -184,7 +183,6 @@ def run_agents(
         ticks_per_s=ticks / wall,
         time_scale=game / wall,
         paper_ticks_per_s=paper,
-        ratio_to_paper=ticks / wall / paper if paper else None,
     )
 
 

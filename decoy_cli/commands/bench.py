@@ -32,6 +32,8 @@ DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
 
 TITLES = {
     "table1": "Table 1: simulator speed",
+    "kinematic": "kinematic core, Table 1 at 10 agents",
+    "env": "PettingZoo environment, 5v5",
     "combat_step": "one 5v5 combat step",
     "replay": "replay throughput",
     "metrics": "metric throughput",
@@ -265,6 +267,8 @@ def _render(name: str, result: dict[str, Any]) -> Table | Text:
         return Text(f"{title}: failed: {result['error']}", style="red")
     return {
         "table1": _table1,
+        "kinematic": _kinematic_table,
+        "env": _env_table,
         "combat_step": _combat_table,
         "replay": _replay_table,
         "metrics": _metrics_table,
@@ -293,8 +297,7 @@ def _table1(result: dict[str, Any]) -> Table:
             "game s",
             "ticks/s",
             "time scale",
-            "paper ticks/s",
-            "ours / paper",
+            "paper's table, ticks/s",
         ],
         caption=(
             f"{result['mover']} mover, bomb rules {'on' if result['bomb'] else 'off'}, "
@@ -303,7 +306,9 @@ def _table1(result: dict[str, Any]) -> Table:
                 if result["combat"]
                 else "no combat step"
             )
-            + f"; peak memory {result['peak_rss_mb']:.0f} MB"
+            + f"; peak memory {result['peak_rss_mb']:.0f} MB. The paper's figures come from "
+            "its machine: they do not compare with this one's (measure a speed-up side by side "
+            "with --baseline)"
         ),
     )
     for row in result["rows"]:
@@ -320,8 +325,43 @@ def _table1(result: dict[str, Any]) -> Table:
             f"{row['ticks_per_s']:,.0f}",
             f"{row['time_scale']:.1f}x",
             f"{paper:,g}" if paper else "–",
-            f"{row['ratio_to_paper']:.2f}x" if row["ratio_to_paper"] else "–",
         )
+    return table
+
+
+def _kinematic_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        f"kinematic core: Table 1's protocol at {result['agents']} agents, event by event",
+        ["decisions", "ticks", "wall s", "ticks/s", "time scale"],
+        caption=f"damage model: {result['damage_model']}; peak memory "
+        f"{result['peak_rss_mb']:.0f} MB",
+    )
+    table.add_row(
+        f"{result['decisions']:,}",
+        f"{result['ticks']:,}",
+        f"{result['wall_s']:.2f}",
+        f"{result['ticks_per_s']:,.0f}",
+        f"{result['time_scale']:.1f}x",
+    )
+    return table
+
+
+def _env_table(result: dict[str, Any]) -> Table:
+    table = _table(
+        "PettingZoo environment: random masked actions, 5v5, combat and bomb on",
+        ["rounds", "agent decisions", "env steps", "game s", "wall s", "decisions/s", "env MB"],
+        caption=f"{result['mover']} mover, damage model: {result['damage_model']}; env MB: "
+        f"resident memory the environment added; peak memory {result['peak_rss_mb']:.0f} MB",
+    )
+    table.add_row(
+        str(result["rounds"]),
+        f"{result['decisions']:,}",
+        f"{result['steps']:,}",
+        f"{result['game_s']:.0f}",
+        f"{result['wall_s']:.2f}",
+        f"{result['decisions_per_s']:,.0f}",
+        f"{result['env_memory_mb']:.0f}",
+    )
     return table
 
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from decoy_cli.csgo import GRAVITY_M_S2, HAMMER_TO_M, JUMP_SPEED_M_S, TICK_RATE
-from decoy_cli.sim.movement.interface import MoveStep
+from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT, MoveStep
 from decoy_cli.sim.movement.kernels import begin_edge
 from decoy_cli.sim.movement.layout import (
     F_CARRY,
@@ -95,6 +95,10 @@ class MoverBase:
         self._fv[:, F_SIDE] = 1.0
         self._iv = np.zeros((n, INT_SLOTS), dtype=np.int64)
         self._iv[:, I_ALIVE] = 1
+        self._flags = flags = np.zeros((FLAG_ROWS, n), dtype=bool)
+        self._out = MoveStep(
+            flags[R_ARRIVED], flags[R_MOVING], flags[R_STUCK], flags[R_TELEPORTED], flags[R_MOVED]
+        )
         self._views = {
             "positions": read_only(self._pos),
             "heading": read_only(self._fv[:, F_HEADING]),
@@ -213,10 +217,12 @@ class MoverBase:
         self._fv[i, F_MAX_SPEED] = float(speed)
 
     def _new_flags(self) -> tuple[np.ndarray, MoveStep]:
-        flags = np.zeros((FLAG_ROWS, self.n), dtype=bool)
-        return flags, MoveStep(
-            flags[R_ARRIVED], flags[R_MOVING], flags[R_STUCK], flags[R_TELEPORTED], flags[R_MOVED]
-        )
+        """The flags and `MoveStep` of the next call, cleared: the mover's own, reused by every
+        `step` and `glide` (so a caller copies what it keeps past the next call)."""
+        flags, out = self._flags, self._out
+        flags.fill(False)
+        out.happened = ARRIVAL | STUCK | TELEPORT
+        return flags, out
 
     def step(self) -> MoveStep:
         """Advance every agent by one tick."""

@@ -59,7 +59,8 @@ class Mover(Protocol):
         ...
 
     def step(self) -> MoveStep:
-        """Advance every agent by one tick."""
+        """Advance every agent by one tick. The `MoveStep` is the mover's own: the next `step`
+        or `glide` overwrites it (copy what you keep)."""
         ...
 
     def glide(self, max_ticks: int) -> tuple[int, MoveStep]:

@@ -1,0 +1,146 @@
+"""Bench sections that run from this file on any version's code: the kinematic core and the
+environment, measured the same way on the current code and on a baseline that predates them.
+
+`decoy bench --baseline REF` runs each section in a fresh process of either code tree. The
+sections here use only what every version of the simulator offers (`speed_table` of
+`decoy_cli.bench.simspeed`, `DecoyParallelEnv`, `load_damage_model`), so the baseline's process
+loads this file by path (`baseline.DRIVER`) and its imports resolve to the baseline's package:
+one measuring code, two simulators.
+
+* `kinematic`: the Table 1 protocol at 10 agents with the kinematic mover, whose engine plays
+  event by event (`Simulator.run`);
+* `env`: agent decisions per second through the PettingZoo environment, 5 T against 5 CT,
+  combat with the chosen damage model, the bomb on, each agent that needs a decision taking a
+  uniformly random allowed action (its action mask); the resident memory the environment adds
+  to the process is reported beside it.
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+KINEMATIC_AGENTS = 10
+"""The agent count of the kinematic row (the issue's and the paper's middle row)."""
+
+ENV_ROUNDS = 5
+"""Timed environment rounds (one more, untimed, warms up the compiled code)."""
+
+
+def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
+    """Table 1's protocol at `KINEMATIC_AGENTS` agents with the kinematic mover."""
+    from decoy_cli.bench.simspeed import speed_table
+
+    decisions = 1_000 if config.get("quick") else 10_000
+    model, label = _model(config)
+    rows = speed_table(
+        (KINEMATIC_AGENTS,),
+        decisions,
+        model,
+        mover="kinematic",
+        combat=bool(config.get("combat", True)),
+        bomb=bool(config.get("bomb", True)),
+        seed=int(config.get("seed", 0)),
+    )
+    row = rows[0].to_dict()
+    return {
+        "agents": KINEMATIC_AGENTS,
+        "decisions": row["decisions"],
+        "ticks": row["ticks"],
+        "wall_s": row["wall_s"],
+        "ticks_per_s": row["ticks_per_s"],
+        "time_scale": row["time_scale"],
+        "damage_model": label,
+    }
+
+
+def env_section(config: dict[str, Any]) -> dict[str, Any]:
+    """Random masked 5v5 rounds through `DecoyParallelEnv` (module docstring)."""
+    from decoy_cli.sim import DecoyParallelEnv
+
+    rounds = 1 if config.get("quick") else ENV_ROUNDS
+    rng = np.random.default_rng(int(config.get("seed", 0)))
+    model, label = _model(config)
+    before = _rss_mb()
+    env = DecoyParallelEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5)
+    try:
+        _play(env, rng, seed=0)  # warm-up: compilation and caches
+        started = time.perf_counter()
+        cpu = time.process_time()
+        totals = [_play(env, rng, seed=k + 1) for k in range(rounds)]
+        wall = time.perf_counter() - started
+        cpu = time.process_time() - cpu
+        grown = _rss_mb() - before
+    finally:
+        env.close()
+    decisions = sum(t["decisions"] for t in totals)
+    return {
+        "rounds": rounds,
+        "mover": "kinematic",
+        "decisions": decisions,
+        "steps": sum(t["steps"] for t in totals),
+        "game_s": sum(t["game_s"] for t in totals),
+        "outcomes": [t["outcome"] for t in totals],
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "decisions_per_s": decisions / wall,
+        "env_memory_mb": grown,
+        "damage_model": label,
+    }
+
+
+def _play(env: Any, rng: np.random.Generator, seed: int) -> dict[str, Any]:
+    """One round of random masked actions; its decisions, steps, game time and outcome."""
+    obs, infos = env.reset(seed=seed)
+    decisions = steps = 0
+    tick = 0
+    outcome = ""
+    while env.agents:
+        actions = {}
+        for name in env.agents:
+            if infos[name]["needs_decision"]:
+                allowed = np.flatnonzero(obs[name]["action_mask"])
+                actions[name] = int(allowed[int(rng.random() * len(allowed))])
+        decisions += len(actions)
+        obs, _, _, _, infos = env.step(actions)
+        steps += 1
+        for info in infos.values():
+            tick = max(tick, int(info["tick"]))
+            outcome = str(info.get("reason", outcome))
+    return {"decisions": decisions, "steps": steps, "game_s": tick / 60.0, "outcome": outcome}
+
+
+def _model(config: dict[str, Any]) -> tuple[Callable | None, str]:
+    """The damage model the config names and how the report names it (None: "none", or a
+    model that did not load, said so; the section then runs without shooting)."""
+    from decoy_cli.damage import load_damage_model
+
+    models = str(config.get("models", "shipped"))
+    if models == "none":
+        return None, "none"
+    try:
+        return load_damage_model(models), models
+    except Exception as error:  # any version's loading error: reported, the section goes on
+        return None, f"none ({models} did not load: {error})"
+
+
+def _rss_mb() -> float:
+    """Resident memory of this process now, MB (Linux; the peak where /proc is missing)."""
+    status = Path("/proc/self/status")
+    if status.is_file():
+        for line in status.read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+PORTABLE_SECTIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
+    "kinematic": kinematic_section,
+    "env": env_section,
+}
+"""The sections this file runs, by name."""
