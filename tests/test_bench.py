@@ -75,7 +75,7 @@ def test_quick_bench_writes_every_section_and_the_machine(quick_run) -> None:
     assert "torch" in machine["packages"]
     assert report["quick"] is True and report["data"]["kind"] == "given"
     assert "machine:" in result.stdout and machine["cpu"] in result.stdout
-    for title in ("Table 1", "combat step", "replay throughput", "metric", "reader"):
+    for title in ("Table 1", "kinematic core", "PettingZoo", "combat step", "replay", "reader"):
         assert title in result.stdout
 
 
@@ -87,6 +87,8 @@ def test_the_model_fallback_is_said_and_labelled(quick_run) -> None:
     assert "line of sight only, no inference" in report["sections"]["table1"]["damage_model"]
     assert "line of sight only, no inference" in report["sections"]["combat_step"]["damage_model"]
     assert report["sections"]["replay"]["options"]["combat"] is False
+    for name in ("kinematic", "env"):  # the portable sections name what they shot with
+        assert "no-such-models did not load" in report["sections"][name]["damage_model"]
 
 
 def test_table1_rows_are_consistent(quick_run) -> None:
@@ -107,6 +109,13 @@ def test_table1_rows_are_consistent(quick_run) -> None:
 def test_throughput_sections_count_what_they_measured(quick_run) -> None:
     _, report = quick_run
     sections = report["sections"]
+    kinematic = sections["kinematic"]
+    assert kinematic["agents"] == 10 and kinematic["decisions"] >= 1000
+    assert kinematic["ticks_per_s"] == pytest.approx(kinematic["ticks"] / kinematic["wall_s"])
+    env = sections["env"]
+    assert env["rounds"] == 1 and len(env["outcomes"]) == 1 and env["outcomes"][0]
+    assert env["decisions"] >= env["steps"] > 0 and env["game_s"] > 0
+    assert env["decisions_per_s"] == pytest.approx(env["decisions"] / env["wall_s"])
     replay = sections["replay"]
     # the fixture has rounds 1 and 2 with frames (one replayed untimed to warm up), 3 without
     assert replay["rounds"] == 1 and replay["failed"] == 1

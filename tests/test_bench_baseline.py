@@ -29,6 +29,9 @@ def test_ratios_pair_the_alternating_runs() -> None:
 
 def test_headlines_are_rates_higher_is_better() -> None:
     assert headlines("metrics", {"pairs_per_s": 10.0}) == {"pairs/s": 10.0}
+    kinematic = {"agents": 10, "ticks_per_s": 3.0}
+    assert headlines("kinematic", kinematic) == {"ticks/s, 10 agents": 3.0}
+    assert headlines("env", {"decisions_per_s": 7.0}) == {"agent decisions/s": 7.0}
     rows = [{"agents": 2, "ticks_per_s": 5.0}, {"agents": 10, "ticks_per_s": 2.0}]
     assert headlines("table1", {"rows": rows}) == {
         "ticks/s, 2 agents": 5.0,
@@ -61,6 +64,19 @@ def test_a_git_ref_side_by_side_with_a_relative_out(
     assert "/baseline-" in runs["baseline"][0]["code"]
     assert runs["current"][0]["code"].startswith(str(CHECKOUT))
     assert [p.name for p in (tmp_path / "side").iterdir()] == ["bench.json"]  # nothing left
+
+
+@needs_git
+def test_a_portable_section_runs_this_trees_file_on_the_baselines_package(tmp_path: Path) -> None:
+    args = ["bench", "--quick", "--sections", "kinematic", "--repeats", "1", "--baseline", "HEAD"]
+    result = runner.invoke(app, [*args, "--models", "none", "--out", str(tmp_path / "b.json")])
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "b.json").read_text())["side_by_side"]
+    (row,) = report["ratios"]
+    assert row["figure"] == "ticks/s, 10 agents" and row["baseline"][0] > 0
+    runs = report["runs"]["kinematic"]
+    assert "/baseline-" in runs["baseline"][0]["code"]
+    assert runs["baseline"][0]["damage_model"] == "none"
 
 
 def test_a_baseline_that_runs_the_current_code_is_an_error(tmp_path: Path) -> None:
