@@ -29,6 +29,7 @@ LAYERS = {
     "synth": 5,
     "evaluate": 6,
     "bench": 6,
+    "rl": 6,
     "commands": 7,
     "cli": 7,
 }

@@ -211,7 +211,7 @@ class DecoyParallelEnv(ParallelEnv):
             )
             for agent in self.possible_agents
         }
-        self._action_spaces = {
+        self._action_spaces: dict[str, spaces.Discrete] = {
             agent: spaces.Discrete(NUM_ACTIONS) for agent in self.possible_agents
         }
 
