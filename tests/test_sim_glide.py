@@ -116,3 +116,24 @@ def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypa
 
     monkeypatch.setattr(Simulator, "run", every_tick)
     assert play() == glided
+
+
+def test_moving_on_after_the_end_event_by_event_is_stepping_after_the_end(physics) -> None:
+    """A replay follows the data past the outcome (`after_end`): the same, tick for tick."""
+
+    def stepped(sim: Simulator) -> None:
+        _every_tick(sim)
+        for _ in range(400):
+            sim.step(after_end=True)
+
+    def glided(sim: Simulator) -> None:
+        sim.run()
+        sim.run(to_tick=sim.tick + 400, after_end=True)
+
+    for seed in range(4):
+        a = _play(physics, "kinematic", seed, stepped)
+        b = _play(physics, "kinematic", seed, glided)
+        assert a.outcome is not None and a.outcome == b.outcome and a.tick == b.tick
+        assert a.events == b.events
+        for name in ("position", "yaw", "hp", "alive"):
+            np.testing.assert_array_equal(getattr(a.recording, name), getattr(b.recording, name))

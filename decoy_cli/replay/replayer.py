@@ -246,6 +246,8 @@ def replay_round(
         # The replay follows the data to its last frame: a round the rules end earlier (the
         # clock, the bomb) goes on moving through the round-end delay, as the real players
         # did, with the outcome as decided (`Simulator.step(after_end=True)`).
+        # It plays event by event (`Simulator.run`) from one stop to the next: a frame's tick,
+        # where the data's bomb, weapon and kit are followed, and the tick before a death.
         while sim.tick < end_tick and not (sim.done and sim.outcome is None):
             # Scripted deaths come before the step of the death frame's tick, which records the
             # frame: the frame that shows the player dead in the data shows it dead here too.
@@ -253,7 +255,11 @@ def replay_round(
                 if tick <= sim.tick + 1 and agents.alive[i]:
                     sim.kill(i, "scripted")
                     scripted[i] = True
-            sim.step(after_end=True)
+            stop = int(frame_ticks[np.searchsorted(frame_ticks, sim.tick, side="right")])
+            for i, tick in deaths.items():
+                if agents.alive[i]:
+                    stop = min(stop, tick - 1)
+            sim.run(to_tick=max(stop, sim.tick + 1), after_end=True)
             f = frame_of_tick.get(sim.tick)
             if f is not None and bomb is not None:
                 follow_data_bomb(sim, bomb, f, round_)
@@ -271,8 +277,7 @@ def replay_round(
         if options.play_out and sim.combat is not None and not sim.done:
             # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later
             limit = max(sim.tick, rules_config.round_ticks) + rules_config.bomb_ticks + 1
-            while not sim.done and sim.tick < limit:
-                sim.step()
+            sim.run(to_tick=limit)
         stuck = np.asarray(sim.mover.stuck_events).copy()
         recoveries = np.asarray(sim.mover.recoveries).copy()
     return ReplayResult(

@@ -162,7 +162,9 @@ class Simulator:
         recorded (a replay following the data through the round-end delay, when real players
         still move), while the rules, combat and the outcome stay as they ended."""
         if after_end and self.outcome is not None:
-            return self._move_after_end()
+            start = len(self.events)
+            self._move_after_end(self.tick + 1)
+            return self.events[start:]
         if self.done:
             return []
         start = len(self.events)
@@ -194,31 +196,48 @@ class Simulator:
             )
         self._record()
 
-    def _move_after_end(self) -> list[SimEvent]:
-        """One tick of movement after the outcome (see `step`); returns its events (stuck,
-        teleport)."""
-        start = len(self.events)
+    def _move_after_end(self, end: int) -> None:
+        """Movement after the outcome (see `step`): the next tick's decisions, then its motion
+        and that of the ticks after it up to `end` on which no decision falls due and nothing
+        is recorded, in one mover call."""
         self.tick += 1
         self._decide()
-        self._move()
+        last = min(end, next_due(self.waiting, self.agents.alive, self.hold_until, self.tick) - 1)
+        if self._next_record < len(self._record_at):
+            last = min(last, int(self._record_at[self._next_record]) - 1)
+        if last > self.tick:
+            ticks, moved = self.mover.glide(last - self.tick + 1)
+            self.tick += ticks - 1
+            self._moved(moved)
+        else:
+            self._moved(self.mover.step())
         self._record()
-        return self.events[start:]
 
     def run(
-        self, until: Callable[[Simulator], bool] | None = None, *, to_tick: int | None = None
+        self,
+        until: Callable[[Simulator], bool] | None = None,
+        *,
+        to_tick: int | None = None,
+        after_end: bool = False,
     ) -> Recording:
         """Play until the round ends (the tick bound), `to_tick` is reached, or `until(sim)`
-        says stop.
+        says stop; with `after_end`, the agents go on moving after the outcome, as
+        `step(after_end=True)` has them, until `to_tick`.
 
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
-        the first arrival; every other tick is played whole, as `step` plays it.
-        The result is tick for tick what stepping every tick gives. `until` is asked after each
-        step and each glide, i.e. whenever anything but motion may have happened (a decision,
-        an arrival, an event, a combat step, a recorded tick): a predicate on decisions,
-        events, deaths or the bomb sees every change. To stop at a tick, give `to_tick`."""
+        the first arrival; every other tick is played whole, as `step` plays it. The result is
+        tick for tick what stepping every tick gives. `until` is asked after each step and each
+        glide, i.e. whenever anything but motion may have happened (a decision, an arrival, an
+        event, a combat step, a recorded tick): a predicate on decisions, events, deaths or the
+        bomb sees every change. To stop at a tick, give `to_tick`."""
         end = self._max_tick if to_tick is None else int(to_tick)
-        while not self.done and self.tick < end and not (until is not None and until(self)):
+        while self.tick < end and not (until is not None and until(self)):
+            if self.done:
+                if not (after_end and self.outcome is not None):
+                    break
+                self._move_after_end(end)
+                continue
             self.tick += 1
             self._decide()
             last = min(self._quiet_until(self.tick - 1), end)
