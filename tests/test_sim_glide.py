@@ -71,19 +71,25 @@ def test_run_is_tick_for_tick_what_stepping_every_tick_gives(physics, mover) -> 
 
 
 def test_until_is_asked_whenever_more_than_motion_may_have_happened(physics) -> None:
-    """A predicate on decisions stops the run exactly where stepping every tick stops."""
+    """Predicates on decisions and on deaths stop the run at the tick stepping stops at."""
 
-    def enough(sim: Simulator) -> bool:
-        return int(sim.decisions.sum()) >= 150
+    def decisions(count: int) -> Callable[[Simulator], bool]:
+        return lambda sim: int(sim.decisions.sum()) >= count
 
-    def step_until(sim: Simulator) -> None:
-        while not sim.done and not enough(sim):
-            sim.step()
+    def deaths(count: int) -> Callable[[Simulator], bool]:
+        return lambda sim: int((~sim.agents.alive).sum()) >= count
 
-    stepped = _play(physics, "kinematic", 3, step_until)
-    glided = _play(physics, "kinematic", 3, lambda sim: sim.run(until=enough))
-    assert glided.tick == stepped.tick and int(glided.decisions.sum()) >= 150
-    assert glided.events == stepped.events
+    cases = [(seed, decisions(5 + 49 * seed)) for seed in range(8)]
+    for seed, until in [*cases, (5, deaths(2)), (6, deaths(1))]:
+
+        def step_until(sim: Simulator, until=until) -> None:
+            while not sim.done and not until(sim):
+                sim.step()
+
+        stepped = _play(physics, "kinematic", seed, step_until)
+        glided = _play(physics, "kinematic", seed, lambda sim, until=until: sim.run(until=until))
+        assert until(stepped) and glided.tick == stepped.tick, seed
+        assert glided.events == stepped.events
 
 
 def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypatch) -> None:
