@@ -125,6 +125,7 @@ class Simulator:
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
         self.decision_count = 0  # decisions.sum(), kept as they are made
+        self._speeds: dict[object, float] = {}
         self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
@@ -322,7 +323,12 @@ class Simulator:
         if alive.tobytes() != self._alive_judged:  # not judged yet, or a kill from outside
             return tick
         rules = self.rules.quiet_until(
-            tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, self.mover.standing
+            tick,
+            self.agents,
+            self.bomb,
+            self.wants_plant,
+            self.wants_defuse,
+            self.mover.is_standing,
         )
         last = min(self._max_tick - 1, rules, due - 1)
         if self.combat is not None:
@@ -402,7 +408,7 @@ class Simulator:
                 continue
             target = int(self.graph.edge_target[edge])
             top = (
-                max_speed_m_s(str(agents.weapon[agent]))
+                self._weapon_speed(agents.weapon[agent])
                 if decision.max_speed is None
                 else float(decision.max_speed)
             )
@@ -411,6 +417,13 @@ class Simulator:
             self.mover.set_goal(
                 agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
             )
+
+    def _weapon_speed(self, weapon: object) -> float:
+        """The weapon's CS:GO top speed, m/s (looked up once per weapon)."""
+        speed = self._speeds.get(weapon)
+        if speed is None:
+            speed = self._speeds[weapon] = max_speed_m_s(str(weapon))
+        return speed
 
     def _record(self) -> None:
         rec = self.recording

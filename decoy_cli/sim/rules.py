@@ -44,6 +44,7 @@ importable from here too.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -269,13 +270,13 @@ class BombRules:
         bomb: Bomb,
         wants_plant: np.ndarray,
         wants_defuse: np.ndarray,
-        standing: np.ndarray,
+        standing: Callable[[int], bool],
     ) -> int:
         """The last tick through which `step` and `outcome` have nothing to do but let a carried
         bomb follow its carrier, as long as no agent dies or changes what it wants and the
-        `standing` agents (no motion under way) stay put; `tick` when the next tick may matter
-        (a plant or a defuse under way or wanted where it can start, a dropped bomb that can be
-        picked up). The engine crosses such ticks in one go (`Simulator.run`)."""
+        agents `standing` says have no motion under way stay put; `tick` when the next tick may
+        matter (a plant or a defuse under way or wanted where it can start, a dropped bomb that
+        can be picked up). The engine crosses such ticks in one go (`Simulator.run`)."""
         last = 1 << 62
         planted = False
         if self.config.bomb_enabled:
@@ -284,7 +285,7 @@ class BombRules:
                 if not agents.alive[carrier] or bomb.planter == carrier:
                     return tick
                 if wants_plant[carrier] and (  # a plant starts once it stands in a zone
-                    not standing[carrier] or self._site_at(agents.position[carrier])
+                    not standing(carrier) or self._site_at(agents.position[carrier])
                 ):
                     return tick
             elif bomb.status == BombStatus.DROPPED:

@@ -126,11 +126,10 @@ class MoverBase:
         """(N,) how often each agent was teleported to its goal (the last-resort recovery)."""
         return self._views["recoveries"]
 
-    @property
-    def standing(self) -> np.ndarray:
-        """(N,) True for agents with no motion under way: they stay where they are until given
-        a goal (nothing pushes a standing agent)."""
-        return self._iv[:, I_PHASE] == IDLE
+    def is_standing(self, agent: int) -> bool:
+        """Whether the agent has no motion under way: it stays where it is until given a goal
+        (nothing pushes a standing agent)."""
+        return bool(self._iv[agent, I_PHASE] == IDLE)
 
     @property
     def alive(self) -> np.ndarray:

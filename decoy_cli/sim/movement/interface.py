@@ -73,9 +73,8 @@ class Mover(Protocol):
     @property
     def positions(self) -> np.ndarray: ...
 
-    @property
-    def standing(self) -> np.ndarray:
-        """(N,) True for agents with no motion under way (they stay put until given a goal)."""
+    def is_standing(self, agent: int) -> bool:
+        """Whether the agent has no motion under way (it stays put until given a goal)."""
         ...
 
     @property
