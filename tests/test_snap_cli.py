@@ -327,3 +327,33 @@ def test_real_match_file() -> None:
     assert totals.unsnappable < 0.02 * totals.frames_with_position
     table = study.metrics.table.set_index(["group", "metric"])  # type: ignore[union-attr]
     assert table.loc[("T", "mean_dist"), "mean"] == pytest.approx(study.rows["mean_dist"].mean())
+
+
+def test_snap_tells_frames_in_the_air_apart_as_the_replay_does(tmp_path: Path) -> None:
+    """With the world, a frame 1 m above the floor (a jump's apex) is in the air: not snapped
+    and not unsnappable. The command opens the world as the replay does and counts it; without
+    the world the library cannot tell (the frame snaps, 1 m off)."""
+    from decoy_cli.sim.setup import RoundSetup
+
+    document = on_graph_match()
+    t1 = next(
+        p
+        for p in document["gameRounds"][0]["frames"][FLOAT_FRAME]["t"]["players"]
+        if p["name"] == "t1"
+    )
+    t1["z"] -= 4.0 / HAMMER_TO_M  # from 5 m above its waypoint to 1 m
+    path = write_match(tmp_path / "jump.json.xz", document)
+    graph = builtin_graph()
+    round_ = read_match(path).round(1)
+    with RoundSetup(graph=graph).open_physics() as physics:
+        one = study_round(round_, graph, physics=physics)
+    snap = one.plan.snaps[[p.name for p in one.plan.players].index("t1")]
+    assert snap.status[FLOAT_FRAME] == SnapStatus.AIRBORNE
+    assert _row(one.rows, "t1")["airborne"] == 1 and one.totals.airborne == 1
+    assert one.rows["unsnappable"].sum() == 0
+    blind = study_round(round_, graph)
+    assert _row(blind.rows, "t1")["airborne"] == 0 and blind.totals.airborne == 0
+    result = _invoke(str(path))
+    assert result.exit_code == 0, result.output
+    line = next(x for x in result.stdout.splitlines() if "frames in the air" in x)
+    assert line.rstrip(" │").endswith(" 1")

@@ -30,6 +30,7 @@ from decoy_cli.replay.study import (
     study_round,
     write_csv,
 )
+from decoy_cli.sim.setup import RoundSetup
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
@@ -104,7 +105,8 @@ def snap(
     round_ = match.round(num)
     chosen = _player_rows(round_, players)
     window = _frame_window(frames, round_.num_frames)
-    study = study_round(round_, graph, metrics=metrics, max_distance=max_snap)
+    with RoundSetup(graph=graph).open_physics() as physics:  # the replay's in-the-air rule
+        study = study_round(round_, graph, metrics=metrics, max_distance=max_snap, physics=physics)
     show_round(console, round_, study, graph, worst)
     if metrics:
         show_round_metrics(console, study.rows)
@@ -150,14 +152,19 @@ def _snap_batch(
         transient=True,
         disable=not stderr.is_terminal,
     )
-    with progress:
+    with progress, RoundSetup(graph=graph).open_physics() as physics:
         task = progress.add_task("snap", total=len(files), rounds=0)
 
         def on_progress(files_done: float, rounds: int) -> None:
             progress.update(task, completed=files_done, rounds=rounds)
 
         study = study_files(
-            files, graph, metrics=metrics, max_distance=max_snap, on_progress=on_progress
+            files,
+            graph,
+            metrics=metrics,
+            max_distance=max_snap,
+            on_progress=on_progress,
+            physics=physics,  # the replay's in-the-air rule
         )
     if path.is_file() and study.failures and study.failures[0].round_num is None:
         raise EstaError(study.failures[0].message)

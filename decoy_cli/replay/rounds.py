@@ -42,6 +42,7 @@ SUMMARY_COLUMNS = (
     "snap_max_m",
     f"within_{WITHIN_M:g}m",
     "unsnappable",
+    "airborne",
     "intervals",
     "infeasible",
     "worst_ratio",
@@ -66,7 +67,8 @@ class RoundPlan:
     """One row per player with `SUMMARY_COLUMNS`: snap quality, plan feasibility, fate.
 
     `within_0.5m` is the share of alive frames with a position that snapped within 0.5 m;
-    `unsnappable` counts alive frames with no waypoint on their floor; `worst_ratio` is the
+    `unsnappable` counts alive frames with no waypoint on their floor, `airborne` those in the
+    air (found only with the world, not snapped and not in `within_0.5m`); `worst_ratio` is the
     largest required / maximum speed ratio; `died_s` is NaN for a survivor.
     """
 
@@ -158,6 +160,7 @@ def _summary_row(player: PlayerInfo, alive: np.ndarray, snap: SnapResult, plan: 
         float(worst),
         float(within),
         snap.num_unsnappable,
+        snap.num_airborne,
         plan.num_intervals,
         plan.num_infeasible,
         plan.worst_ratio,

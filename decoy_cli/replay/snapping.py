@@ -69,6 +69,12 @@ class SnapResult:
         """Alive frames whose position has no waypoint on its floor within the snap distance."""
         return self.count(SnapStatus.NO_WAYPOINT)
 
+    @property
+    def num_airborne(self) -> int:
+        """Alive frames more than `AIRBORNE_M` above the world's floor (jumping, falling): not
+        snapped, a player in the air stands at no waypoint."""
+        return self.count(SnapStatus.AIRBORNE)
+
     def counts(self) -> dict[str, int]:
         """Frame count per status name (for example {'SNAPPED': 120, 'NOT_ALIVE': 13, ...})."""
         return {status.name: self.count(status) for status in SnapStatus}

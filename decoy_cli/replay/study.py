@@ -36,6 +36,7 @@ from decoy_cli.metrics.trajectory import trajectory_metrics_frame
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.replay.snapping import DEFAULT_MAX_SNAP_M, WITHIN_M, SnapStatus
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.physics import PhysicsWorld
 
 KEY_COLUMNS = ("match", "round", "player", "side")
 """Columns that identify a player-round in `rows` and `intervals`."""
@@ -87,9 +88,12 @@ class SnapTotals:
     rounds: int
     player_rounds: int
     frames_with_position: int
-    """Alive frames with a position: snapped plus unsnappable."""
+    """Alive frames with a position, on the ground when the world was given: snapped plus
+    unsnappable."""
     snapped: int
     unsnappable: int
+    airborne: int
+    """Alive frames in the air (not snapped; counted only when the world was given)."""
     snap_median_m: float
     snap_p95_m: float
     within: float
@@ -190,9 +194,12 @@ def study_round(
     *,
     metrics: bool = False,
     max_distance: float = DEFAULT_MAX_SNAP_M,
+    physics: PhysicsWorld | None = None,
 ) -> RoundStudy:
-    """Snap and plan one round (a reader `Round`) and gather its rows, intervals and errors."""
-    plan = snap_round(round_, graph, max_distance=max_distance)
+    """Snap and plan one round (a reader `Round`) and gather its rows, intervals and errors.
+    With `physics` (the graph's world), frames in the air are told apart and not snapped, as
+    the replay does."""
+    plan = snap_round(round_, graph, max_distance=max_distance, physics=physics)
     match_id, round_num = str(round_.match_id), int(round_.round_num)
     rows = plan.summary.copy()
     rows.insert(0, "round", round_num)
@@ -235,8 +242,10 @@ def study_files(
     metrics: bool = False,
     max_distance: float = DEFAULT_MAX_SNAP_M,
     on_progress: Callable[[float, int], None] | None = None,
+    physics: PhysicsWorld | None = None,
 ) -> SnapStudy:
     """Study every round of every match file; failures are recorded, the batch goes on.
+    `physics` as in `study_round`.
 
     `on_progress(files_done, rounds_studied)` is called after each round and after each file;
     `files_done` counts a file's rounds as fractions of it (1.5 = half of the second file).
@@ -248,7 +257,8 @@ def study_files(
         if isinstance(item, RoundFailure):
             failures.append(item)
         else:
-            _study_match(item, graph, metrics, max_distance, studies, failures, i, on_progress)
+            _study_match(item, graph, (metrics, max_distance, physics), studies, failures, i,
+                         on_progress)  # fmt: skip
         if on_progress is not None:
             on_progress(i + 1.0, len(studies))
     return combine(studies, failures, metrics=metrics)
@@ -257,14 +267,15 @@ def study_files(
 def _study_match(
     match: Match,
     graph: WaypointGraph,
-    metrics: bool,
-    max_distance: float,
+    how: tuple[bool, float, PhysicsWorld | None],
     studies: list[RoundStudy],
     failures: list[RoundFailure],
     index: int,
     on_progress: Callable[[float, int], None] | None,
 ) -> None:
-    """Study the rounds of one match into `studies`, recording the ones that fail."""
+    """Study the rounds of one match into `studies`, recording the ones that fail; `how` is
+    (metrics, max_distance, physics) as `study_round` takes them."""
+    metrics, max_distance, physics = how
     count = len(match.rounds)  # progress counts the rounds the reader built
     built = 0
     for item in match_rounds(match):
@@ -273,7 +284,11 @@ def _study_match(
             continue
         built += 1
         try:
-            studies.append(study_round(item, graph, metrics=metrics, max_distance=max_distance))
+            studies.append(
+                study_round(
+                    item, graph, metrics=metrics, max_distance=max_distance, physics=physics
+                )
+            )
         except DecoyError as error:
             failure = failure_from(error, match.path, item.round_num, SNAP_ERROR)
             prefix = f"{match.path}: round {item.round_num}: "
@@ -326,6 +341,7 @@ def pooled_totals(rows: pd.DataFrame, errors: np.ndarray, *, rounds: int) -> Sna
         frames_with_position=with_position,
         snapped=len(errors),
         unsnappable=unsnappable,
+        airborne=int(rows["airborne"].sum()) if len(rows) and "airborne" in rows else 0,
         snap_median_m=median,
         snap_p95_m=p95,
         within=(
