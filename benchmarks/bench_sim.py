@@ -35,14 +35,15 @@ def main() -> None:
     model = load_damage_model(args.models)
     print(f"damage model: {args.models if model else 'none (line of sight only)'}")
     rows = speed_table(tuple(args.agents), args.decisions, model, mover=args.mover, seed=args.seed)
-    print("agents  ticks  decisions  wall s  game s  ticks/s  time scale  paper ticks/s  ratio")
+    print(
+        "agents  ticks  decisions  wall s  game s  ticks/s  time scale  paper's table (its machine)"
+    )
     for row in rows:
         paper = row.paper_ticks_per_s
-        ratio = f"{row.ratio_to_paper:6.1f}x" if row.ratio_to_paper else "     -"
         print(
             f"{row.agents:>6} {row.ticks:>6} {row.decisions:>10} {row.wall_s:>7.2f} "
             f"{row.game_s:>7.1f} {row.ticks_per_s:>8.0f} {row.time_scale:>11.1f} "
-            f"{paper if paper else '-':>14} {ratio}"
+            f"{paper if paper else '-':>14}"
         )
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -143,3 +143,39 @@ def test_moving_on_after_the_end_event_by_event_is_stepping_after_the_end(physic
         assert a.events == b.events
         for name in ("position", "yaw", "hp", "alive"):
             np.testing.assert_array_equal(getattr(a.recording, name), getattr(b.recording, name))
+
+
+def test_a_predicate_true_after_the_decisions_but_not_after_the_tick_does_not_stop() -> None:
+    """The environment's predicate (someone needs a decision): the only agent due next is
+    killed by the combat step of the very tick, so stepping goes on, and so must run."""
+    from decoy_cli.sim.engine import Decision
+    from decoy_cli.sim.state import Agents, SimEvent
+    from decoy_cli.waypoints.graph import STOP_ACTION
+
+    class Stopper:
+        def decide(self, sim: Simulator, agent: int) -> Decision:
+            return Decision(STOP_ACTION, hold_ticks=30 if agent == 0 else 2000)
+
+    class KillsAgentZeroAt30:
+        def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]:
+            if tick == 30 and agents.alive[0]:
+                agents.alive[0], agents.hp[0] = False, 0
+                return [SimEvent(tick, "kill", 0)]
+            return []
+
+    def due(sim: Simulator) -> bool:
+        return sim.tick > 1 and bool(sim.needs_decision.any())
+
+    def stepping(sim: Simulator) -> None:
+        while not sim.done and not due(sim):
+            sim.step()
+
+    ends = []
+    for drive in (stepping, lambda sim: sim.run(until=due)):
+        setup = RoundSetup(graph=GRAPH, bomb=False)
+        agents = site_agents(GRAPH, 0)
+        with open_round(setup, agents, Stopper(), seed=0) as sim:
+            sim.combat = KillsAgentZeroAt30()
+            drive(sim)
+        ends.append((sim.tick, sim.events))
+    assert ends[0] == ends[1] and ends[0][0] > 30

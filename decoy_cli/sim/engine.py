@@ -228,12 +228,12 @@ class Simulator:
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
         the first arrival; every other tick is played whole, as `step` plays it. The result is
-        tick for tick what stepping every tick gives. `until` is asked after each tick's
-        decisions (when it then says stop, that tick is finished first, as `step` would) and
-        after each played tick or glide: wherever anything but motion may have happened, so a
-        predicate on decisions, events, deaths or the bomb stops the run at the tick stepping
-        would. Motion alone (positions, the tick) changes inside a glide unseen: to stop at a
-        tick give `to_tick`; to watch positions, `step`."""
+        tick for tick what stepping every tick gives. `until` is asked after each played tick
+        or glide, and after each tick's decisions (when it then says stop, the tick is played
+        whole without a glide and `until` is asked again): wherever anything but motion may have
+        happened, so a predicate on decisions, events, deaths or the bomb stops the run at the
+        tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
+        to stop at a tick give `to_tick`; to watch positions, `step`."""
         end = self._max_tick if to_tick is None else int(to_tick)
         while self.tick < end and not (until is not None and until(self)):
             if self.done:
@@ -243,9 +243,9 @@ class Simulator:
                 continue
             self.tick += 1
             self._decide()
-            if until is not None and until(self):  # the decisions did it: finish this tick
-                self._finish_tick(self._move())
-                break
+            if until is not None and until(self):  # the decisions may have done it: play
+                self._finish_tick(self._move())  # the tick whole, then ask again
+                continue
             last = min(self._quiet_until(self.tick - 1), end)
             if last >= self.tick:
                 self._glide(last)
