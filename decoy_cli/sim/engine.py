@@ -125,7 +125,6 @@ class Simulator:
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
         self.decision_count = 0  # decisions.sum(), kept as they are made
-        self._speeds: dict[object, float] = {}
         self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
@@ -206,12 +205,9 @@ class Simulator:
         last = min(end, next_due(self.waiting, self.agents.alive, self.hold_until, self.tick) - 1)
         if self._next_record < len(self._record_at):
             last = min(last, int(self._record_at[self._next_record]) - 1)
-        if last > self.tick:
-            ticks, moved = self.mover.glide(last - self.tick + 1)
-            self.tick += ticks - 1
-            self._moved(moved)
-        else:
-            self._moved(self.mover.step())
+        ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
+        self.tick += ticks - 1
+        self._moved(moved)
         self._record()
 
     def run(
@@ -373,14 +369,10 @@ class Simulator:
     @property
     def needs_decision(self) -> np.ndarray:
         """(N,) bool: agents that will ask their policy for an action at the next tick."""
-        if self.done:
-            return np.zeros(self.agents.count, dtype=bool)
-        return self._due_at(self.tick + 1)
-
-    def _due_at(self, tick: int) -> np.ndarray:
-        """Alive agents waiting at a waypoint, or whose STOP ends by `tick`."""
-        expired = (self.hold_until > 0) & (tick >= self.hold_until)
-        return self.agents.alive & (self.waiting | expired)
+        due = np.zeros(self.agents.count, dtype=bool)
+        if not self.done:
+            due[due_agents(self.waiting, self.agents.alive, self.hold_until, self.tick + 1)] = True
+        return due
 
     def _decide(self) -> None:
         agents = self.agents
@@ -408,7 +400,7 @@ class Simulator:
                 continue
             target = int(self.graph.edge_target[edge])
             top = (
-                self._weapon_speed(agents.weapon[agent])
+                max_speed_m_s(str(agents.weapon[agent]))
                 if decision.max_speed is None
                 else float(decision.max_speed)
             )
@@ -417,13 +409,6 @@ class Simulator:
             self.mover.set_goal(
                 agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
             )
-
-    def _weapon_speed(self, weapon: object) -> float:
-        """The weapon's CS:GO top speed, m/s (looked up once per weapon)."""
-        speed = self._speeds.get(weapon)
-        if speed is None:
-            speed = self._speeds[weapon] = max_speed_m_s(str(weapon))
-        return speed
 
     def _record(self) -> None:
         rec = self.recording
