@@ -50,7 +50,8 @@ def test_rllib_sees_only_the_agents_that_decide_and_every_ending() -> None:
             break
         assert not any(rewards.values())
     assert partial  # agents between decisions were left out
-    assert set(obs) == set(env.possible_agents) and env.outcome["reason"] == "TargetSaved"
+    assert set(obs) == set(env.possible_agents)
+    assert {info["reason"] for info in infos.values()} == {"TargetSaved"}
     assert all(rewards[n] == (1.0 if n.startswith("ct") else -1.0) for n in obs)
     env.close()
 

@@ -11,16 +11,14 @@ one measuring code, two simulators.
   event by event (`Simulator.run`);
 * `env`: agent decisions per second through the PettingZoo environment, 5 T against 5 CT,
   combat with the chosen damage model, the bomb on, each agent that needs a decision taking a
-  uniformly random allowed action (its action mask); the resident memory the environment adds
-  to the process is reported beside it.
+  uniformly random allowed action (its action mask); how far the environment raises the
+  process's peak resident memory is reported beside it.
 """
 
 from __future__ import annotations
 
-import resource
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -61,12 +59,13 @@ def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
 
 def env_section(config: dict[str, Any]) -> dict[str, Any]:
     """Random masked 5v5 rounds through `DecoyParallelEnv` (module docstring)."""
+    from decoy_cli.bench.machine import peak_rss_mb
     from decoy_cli.sim import DecoyParallelEnv
 
     rounds = 1 if config.get("quick") else ENV_ROUNDS
     rng = np.random.default_rng(int(config.get("seed", 0)))
     model, label = _model(config)
-    before = _rss_mb()
+    before = peak_rss_mb()
     env = DecoyParallelEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5)
     try:
         _play(env, rng, seed=0)  # warm-up: compilation and caches
@@ -75,7 +74,7 @@ def env_section(config: dict[str, Any]) -> dict[str, Any]:
         totals = [_play(env, rng, seed=k + 1) for k in range(rounds)]
         wall = time.perf_counter() - started
         cpu = time.process_time() - cpu
-        grown = _rss_mb() - before
+        grown = peak_rss_mb() - before
     finally:
         env.close()
     decisions = sum(t["decisions"] for t in totals)
@@ -127,16 +126,6 @@ def _model(config: dict[str, Any]) -> tuple[Callable | None, str]:
         return load_damage_model(models), models
     except Exception as error:  # any version's loading error: reported, the section goes on
         return None, f"none ({models} did not load: {error})"
-
-
-def _rss_mb() -> float:
-    """Resident memory of this process now, MB (Linux; the peak where /proc is missing)."""
-    status = Path("/proc/self/status")
-    if status.is_file():
-        for line in status.read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024.0
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 PORTABLE_SECTIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {

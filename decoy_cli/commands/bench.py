@@ -351,7 +351,7 @@ def _env_table(result: dict[str, Any]) -> Table:
         "PettingZoo environment: random masked actions, 5v5, combat and bomb on",
         ["rounds", "agent decisions", "env steps", "game s", "wall s", "decisions/s", "env MB"],
         caption=f"{result['mover']} mover, damage model: {result['damage_model']}; env MB: "
-        f"resident memory the environment added; peak memory {result['peak_rss_mb']:.0f} MB",
+        f"peak resident memory the environment added; peak memory {result['peak_rss_mb']:.0f} MB",
     )
     table.add_row(
         str(result["rounds"]),

@@ -45,13 +45,10 @@ class DecoyRLlibEnv(MultiAgentEnv):
             for name in names
         }
         self.action_spaces = {name: self.env.action_space(name) for name in names}
-        self.outcome: dict[str, str] = {}
-        """The winner and reason of the last round that ended (empty while it goes on)."""
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         observations, infos = self.env.reset(seed=seed, options=options)
         self.agents = list(self.env.agents)
-        self.outcome = {}
         acting = [name for name in self.env.agents if infos[name]["needs_decision"]]
         return self._observe(observations, acting), {name: infos[name] for name in acting}
 
@@ -60,9 +57,6 @@ class DecoyRLlibEnv(MultiAgentEnv):
         acting = [name for name in observations if infos[name]["needs_decision"] or ends[name]]
         self.agents = list(self.env.agents)
         over = not self.agents
-        if over:
-            last = next(iter(infos.values()))
-            self.outcome = {"winner": last["winner"], "reason": last["reason"]}
         return (
             self._observe(observations, acting),
             {name: rewards[name] for name in acting},
