@@ -1,0 +1,76 @@
+"""Fingerprints of replays, to show two code trees replay real rounds identically.
+
+    python benchmarks/replay_fingerprints.py OUT.json [FILES] [EVERY]
+    PYTHONPATH=/path/to/other/tree python benchmarks/replay_fingerprints.py OTHER.json
+    python benchmarks/replay_fingerprints.py --compare OUT.json OTHER.json
+
+Replays every EVERY-th round (default 4) of the first FILES match files (default 15) of
+../shared/data/esta_dust2_tside under four settings (movement only; the bomb; the bomb with the
+physics mover; shooting with the shipped models and the bomb) and writes, per replay, a SHA-256
+of its recording (ticks, positions, yaw, HP, alive), its events and its outcome, with the time
+taken. `--compare` counts the replays whose fingerprints differ.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "esta_dust2_tside"
+
+
+def fingerprints(files: int, every: int) -> dict[str, str]:
+    from decoy_cli.damage import load_damage_model
+    from decoy_cli.esta import read_match
+    from decoy_cli.replay import ReplayOptions, replay_round
+    from decoy_cli.waypoints.build import builtin_graph
+    from decoy_cli.world.navmesh import nav_world
+    from decoy_cli.world.physics import PhysicsWorld
+
+    graph = builtin_graph()
+    settings = {
+        "move": ReplayOptions(combat=False, bomb=False),
+        "bomb": ReplayOptions(combat=False, bomb=True),
+        "physics": ReplayOptions(combat=False, bomb=True, mover="physics"),
+        "combat": ReplayOptions(combat=True, bomb=True, damage_model=load_damage_model("shipped")),
+    }
+    out = {}
+    with PhysicsWorld(nav_world()) as physics:
+        for name, options in settings.items():
+            for path in sorted(DATA.glob("*.json.xz"))[:files]:
+                for round_ in read_match(path).rounds[::every]:
+                    key = f"{name}:{path.name}:{round_.round_num}"
+                    result = replay_round(round_, graph, options, physics=physics)
+                    digest = hashlib.sha256()
+                    rec = result.recording
+                    for array in (rec.ticks, rec.position, rec.yaw, rec.hp, rec.alive):
+                        digest.update(np.ascontiguousarray(array).tobytes())
+                    events = [(e.tick, e.kind, e.agent, e.other, sorted(e.data.items()))
+                              for e in result.events]  # fmt: skip
+                    digest.update(repr((events, result.outcome)).encode())
+                    out[key] = digest.hexdigest()
+    return out
+
+
+def main() -> None:
+    if sys.argv[1:2] == ["--compare"]:
+        a, b = (json.loads(Path(p).read_text())["replays"] for p in sys.argv[2:4])
+        differ = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
+        print(f"{len(a)} and {len(b)} replays; {len(differ)} differ {differ[:10]}")
+        return
+    files = int(sys.argv[2]) if len(sys.argv) > 2 else 15
+    every = int(sys.argv[3]) if len(sys.argv) > 3 else 4
+    began = time.perf_counter()
+    replays = fingerprints(files, every)
+    seconds = time.perf_counter() - began
+    Path(sys.argv[1]).write_text(json.dumps({"seconds": seconds, "replays": replays}, indent=1))
+    print(f"{len(replays)} replays in {seconds:.1f} s -> {sys.argv[1]}")
+
+
+if __name__ == "__main__":
+    main()
