@@ -12,8 +12,20 @@ from __future__ import annotations
 
 import math
 
+MAP_NAMES = (
+    "de_ancient",
+    "de_dust2",
+    "de_inferno",
+    "de_mirage",
+    "de_nuke",
+    "de_overpass",
+    "de_train",
+    "de_vertigo",
+)
+"""The eight competitive maps ESTA covers; each ships its world and waypoint graph."""
+
 BUILTIN_MAP = "de_dust2"
-"""The map whose world, waypoint graph and bomb sites ship with the project."""
+"""The default map of every command (the one the real data in ../shared/data is on)."""
 
 HAMMER_TO_M = 0.01905
 """One Hammer unit in metres."""

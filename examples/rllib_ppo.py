@@ -34,6 +34,7 @@ def main() -> None:
     )  # fmt: skip
     parser.add_argument("--address", default=None, help="a running Ray cluster ('auto', host:port)")
     parser.add_argument("--batch", type=int, default=4000, help="env steps per iteration")
+    parser.add_argument("--map", default="dust2", help="a built-in map: dust2, mirage, ...")
     parser.add_argument("--mover", choices=("kinematic", "physics"), default="kinematic")
     parser.add_argument("--models", default="shipped", help="damage models: shipped, rules, none")
     parser.add_argument("--seed", type=int, default=0)
@@ -61,7 +62,9 @@ def main() -> None:
     )
     config = (
         PPOConfig()
-        .environment(DecoyRLlibEnv, env_config={"mover": args.mover, "models": args.models})
+        .environment(
+            DecoyRLlibEnv, env_config={"map": args.map, "mover": args.mover, "models": args.models}
+        )
         .multi_agent(policies={"shared"}, policy_mapping_fn=lambda agent, episode, **kw: "shared")
         .rl_module(rl_module_spec=MultiRLModuleSpec(rl_module_specs={"shared": module}))
         .env_runners(num_env_runners=args.env_runners)

@@ -243,7 +243,7 @@ def test_missing_or_corrupt_mesh(tmp_path: Path, name: str, content, fragment: s
         (["--seed", "1,2,nan"], "--seed wants three numbers"),
         (["--seed", "40,40,0"], "seed 0 at [40.0, 40.0, 0.0] m is not above a floor"),
         (["--offset", "a,b,c"], "--offset wants three numbers"),
-        (["--map", "nuke"], "unknown map 'nuke'"),
+        (["--map", "cache"], "unknown map 'cache'"),
     ],
 )
 def test_bad_options(tmp_path: Path, small_obj: Path, args: list[str], fragment: str) -> None:

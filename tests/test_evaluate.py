@@ -402,7 +402,7 @@ def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path
     for args, expected in (
         ([str(tmp_path / "nowhere")], "no such file or folder"),
         ([str(tmp_path), "--combat"], "no .json.xz or .json match files"),
-        ([str(clean), "--map", "nuke"], "unknown map 'nuke'"),
+        ([str(clean), "--map", "cache"], "unknown map 'cache'"),
         ([str(clean), "--no-combat", "--no-bomb", "--mover", "teleport"], "unknown mover"),
         ([str(clean), "--combat", "--models", str(tmp_path / "no-models")], "no such model"),
     ):

@@ -33,12 +33,12 @@ from worlds import (
     walls_around,
 )
 
-from decoy_cli.csgo import JUMP_HEIGHT_M
+from decoy_cli.csgo import JUMP_HEIGHT_M, MAP_NAMES
 from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.build import build_graph, builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, build_lattice
-from decoy_cli.world.navmesh import REGION_PLACES
+from decoy_cli.world.navmesh import load_navmesh
 from decoy_cli.world.physics import PhysicsWorld
 
 WORLDS = {
@@ -387,17 +387,18 @@ def test_builds_are_deterministic(tmp_path) -> None:
     np.testing.assert_array_equal(order, np.arange(first.num_nodes))
 
 
-# ---- the shipped de_dust2 graph ----------------------------------------------------------------
+# ---- the shipped graphs ------------------------------------------------------------------------
 
 
-def test_shipped_graph_invariants() -> None:
-    """The same invariants on the shipped graph (rebuilding it is the CLI test's job). Nudged
+@pytest.mark.parametrize("map_name", MAP_NAMES)
+def test_shipped_graph_invariants(map_name: str) -> None:
+    """The same invariants on every shipped graph (rebuilding them is the CLI test's job). Nudged
     nodes bend some edges: a few dozen lie up to ~31 degrees off their compass direction, none
-    by half a sector or more."""
-    graph = builtin_graph()
+    by half a sector or more. Each region holds waypoints of its nav places only."""
+    graph = builtin_graph(map_name)
     count, _ = connected_components(graph.adjacency, directed=True, connection="strong")
     assert count == 1
-    assert graph.num_nodes > 6000 and graph.num_edges > 40_000
+    assert graph.num_nodes > 4000 and graph.num_edges > 25_000
     slots = Counter(zip(graph.edge_source.tolist(), graph.edge_direction.tolist(), strict=True))
     assert max(slots.values()) == 1
     delta = graph.positions[graph.edge_target] - graph.positions[graph.edge_source]
@@ -409,5 +410,5 @@ def test_shipped_graph_invariants() -> None:
         nodes = graph.region_of(region)
         assert len(nodes) >= 20
         places = {graph.place_names[p] for p in graph.node_place[nodes]}
-        assert places == {REGION_PLACES[region]}
-    assert np.mean(graph.node_place >= 0) > 0.95
+        assert places <= set(load_navmesh(map_name).regions[region])
+    assert np.mean(graph.node_place >= 0) > 0.85  # some nav areas have no place name

@@ -11,7 +11,7 @@ from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M, PLAYER_HEIGHT_M, PLAYER_RA
 from decoy_cli.errors import WorldError
 from decoy_cli.waypoints.build import builtin_graph, default_seeds
 from decoy_cli.world import nav_geometry, navmesh
-from decoy_cli.world.navmesh import REGION_PLACES, NavMesh, load_navmesh, nav_world
+from decoy_cli.world.navmesh import REGIONS, NavMesh, load_navmesh, nav_world
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
@@ -64,14 +64,14 @@ def test_load_navmesh(nav: NavMesh) -> None:
     assert len(np.unique(nav.area_id)) == nav.num_areas
     assert nav.connections.min() >= 0 and nav.connections.max() < nav.num_areas
     assert {"TSpawn", "CTSpawn", "BombsiteA", "BombsiteB"} <= set(nav.places)
-    assert set(REGION_PLACES.values()) <= set(nav.places)
+    assert {p for r in REGIONS for p in nav.regions[r]} <= set(nav.places)
     assert np.all(nav.x_min < nav.x_max) and np.all(nav.y_min < nav.y_max)
     assert nav.radar == {"pos_x": -2476.0, "pos_y": 3239.0, "scale": 4.4}
 
 
 def test_unknown_builtin_map() -> None:
-    with pytest.raises(WorldError, match="no built-in map 'de_nuke'"):
-        load_navmesh("de_nuke")
+    with pytest.raises(WorldError, match="no built-in map 'de_cache'"):
+        load_navmesh("de_cache")
 
 
 def seam_mismatch(nav: NavMesh, contacts, zx: np.ndarray, zy: np.ndarray) -> np.ndarray:

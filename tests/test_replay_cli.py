@@ -164,14 +164,30 @@ def test_bad_input_is_one_error_line(
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.output
 
 
-def test_a_round_of_another_map_is_refused(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("file_map", "extra", "message"),
+    [
+        ("de_cache", [], "a de_cache round, a map decoy has no world for"),
+        ("de_inferno", ["--map", "dust2"], "a de_inferno round, not de_dust2 (--map)"),
+    ],
+)
+def test_a_round_of_a_map_without_a_world_or_not_the_asked_one_is_refused(
+    tmp_path: Path, file_map: str, extra: list[str], message: str
+) -> None:
     document = on_graph_match()
-    document["mapName"] = "de_inferno"
-    path = write_match(tmp_path / "inferno.json", document)
-    result = _invoke(f"{path}:1", "--out", str(tmp_path / "out"))
+    document["mapName"] = file_map
+    path = write_match(tmp_path / "other.json", document)
+    result = _invoke(f"{path}:1", *extra, "--out", str(tmp_path / "out"))
     assert result.exit_code == 1
-    assert result.stderr == f"error: {path}:1: a de_inferno round; decoy replays de_dust2\n"
+    assert result.stderr == f"error: {path}:1: {message}\n"
     assert not (tmp_path / "out").exists()
+
+
+def test_an_unknown_map_option_names_the_known_maps(tmp_path: Path) -> None:
+    path = write_match(tmp_path / "m.json", on_graph_match())
+    result = _invoke(f"{path}:1", "--map", "cache", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1
+    assert result.stderr.startswith("error: unknown map 'cache'; this decoy knows: ancient, dust2")
 
 
 def test_a_real_round(tmp_path: Path) -> None:

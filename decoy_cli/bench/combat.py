@@ -66,7 +66,7 @@ def time_steps(
         t0 = time.perf_counter()
         pairs = los.visible_pairs(agents)
         t1 = time.perf_counter()
-        batch = make_batch(agents, pairs, BUILTIN_MAP)
+        batch = make_batch(agents, pairs, str(graph.meta.get("map", BUILTIN_MAP)))
         t2 = time.perf_counter()
         result = model(batch, rng)
         t3 = time.perf_counter()
@@ -90,13 +90,18 @@ def summarize_ms(times: list[float]) -> dict[str, float]:
 
 
 def step_costs(
-    model: DamageModel, per_side: int = 5, repeats: int = 300, seed: int = 0
+    model: DamageModel,
+    per_side: int = 5,
+    repeats: int = 300,
+    seed: int = 0,
+    map_name: str = BUILTIN_MAP,
 ) -> list[dict]:
-    """One row per layout: the step's parts (milliseconds) and the visible pairs per step."""
+    """One row per layout: the step's parts (milliseconds) and the visible pairs per step, on a
+    built-in map."""
     rng = np.random.default_rng(seed)
-    graph = builtin_graph()
+    graph = builtin_graph(map_name)
     rows = []
-    with PhysicsWorld(nav_world()) as physics:
+    with PhysicsWorld(nav_world(map_name)) as physics:
         los = LineOfSight(physics, 2 * per_side)
         try:
             for layout in LAYOUTS:

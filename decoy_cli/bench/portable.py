@@ -44,6 +44,7 @@ def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
         combat=bool(config.get("combat", True)),
         bomb=bool(config.get("bomb", True)),
         seed=int(config.get("seed", 0)),
+        **({"map_name": config["map"]} if "map" in config else {}),
     )
     row = rows[0].to_dict()
     return {
@@ -66,7 +67,8 @@ def env_section(config: dict[str, Any]) -> dict[str, Any]:
     rng = np.random.default_rng(int(config.get("seed", 0)))
     model, label = _model(config)
     before = peak_rss_mb()
-    env = DecoyParallelEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5)
+    on_map = {"map": config["map"]} if "map" in config else {}
+    env = DecoyParallelEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5, **on_map)
     try:
         _play(env, rng, seed=0)  # warm-up: compilation and caches
         started = time.perf_counter()

@@ -32,8 +32,10 @@ from decoy_cli.bench.simspeed import (
     Switches,
     speed_table,
 )
+from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.setup import check_mover
+from decoy_cli.waypoints.build import canonical_map
 
 REPORT_FORMAT = 1
 
@@ -63,6 +65,7 @@ class BenchConfig:
     combat: bool = True
     bomb: bool = True
     seed: int = 0
+    map_name: str = BUILTIN_MAP
     agent_counts: tuple[int, ...] = AGENT_COUNTS
     decisions: int = PAPER_DECISIONS
     combat_repeats: int = 300
@@ -80,16 +83,19 @@ class BenchConfig:
         combat: bool = True,
         bomb: bool = True,
         seed: int = 0,
+        map_name: str = BUILTIN_MAP,
     ) -> BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
         round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
         check_mover(mover)
         switches = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
+        map_id = canonical_map(map_name)
         if not quick:
-            return cls(quick=False, models=models, **switches)
+            return cls(quick=False, models=models, map_name=map_id, **switches)
         return cls(
             quick=True,
             models=models,
+            map_name=map_id,
             **switches,
             agent_counts=(2, 10),
             decisions=1_000,
@@ -154,8 +160,10 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
             combat=config.combat,
             bomb=config.bomb,
             seed=config.seed,
+            map_name=config.map_name,
         )
         result = {
+            "map": config.map_name,
             "mover": config.mover,
             "combat": config.combat,
             "bomb": config.bomb,
@@ -167,8 +175,10 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
     elif name in PORTABLE_SECTIONS:
         result = PORTABLE_SECTIONS[name](portable_config(config))
     elif name == "combat_step":
-        costs = step_costs(model or NeverHits(), 5, config.combat_repeats, config.seed)
-        result = {"damage_model": status.label, "rows": costs}
+        costs = step_costs(
+            model or NeverHits(), 5, config.combat_repeats, config.seed, config.map_name
+        )
+        result = {"map": config.map_name, "damage_model": status.label, "rows": costs}
     elif name == "replay":
         data = _needed(data, name)
         result = replay_throughput(
@@ -198,7 +208,10 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
 def portable_config(config: BenchConfig) -> dict[str, Any]:
     """What a portable section (`decoy_cli.bench.portable`) reads of the config."""
     keys = ("quick", "models", "combat", "bomb", "seed")
-    return {key: getattr(config, key) for key in keys}
+    settings = {key: getattr(config, key) for key in keys}
+    if config.map_name != BUILTIN_MAP:  # only then: earlier versions' sections know no map
+        settings["map"] = config.map_name
+    return settings
 
 
 def _needed(data: BenchData | None, name: str) -> BenchData:

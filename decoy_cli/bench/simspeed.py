@@ -19,7 +19,7 @@ from typing import TypedDict
 
 import numpy as np
 
-from decoy_cli.csgo import TICK_RATE
+from decoy_cli.csgo import BUILTIN_MAP, TICK_RATE
 from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.setup import RoundSetup, open_round
@@ -196,16 +196,17 @@ def speed_table(
     bomb: bool = True,
     seed: int = 0,
     warmup_decisions: int = 200,
+    map_name: str = BUILTIN_MAP,
 ) -> list[SpeedRow]:
     """Table 1 rows for each agent count, after an untimed warm-up (compilation, caches).
 
     `model` None runs the combat step with `NeverHits` (line of sight, no inference); `combat`
-    False runs no combat step at all.
+    False runs no combat step at all. `map_name` is the built-in map played on.
     """
-    graph = builtin_graph()
+    graph = builtin_graph(map_name)
     model = NeverHits() if model is None else model
     options = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
-    with PhysicsWorld(nav_world()) as physics:
+    with PhysicsWorld(nav_world(map_name)) as physics:
         if warmup_decisions:
             run_agents(physics, graph, 2, warmup_decisions, model, **options)
         return [run_agents(physics, graph, n, decisions, model, **options) for n in counts]

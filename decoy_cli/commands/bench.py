@@ -24,6 +24,7 @@ from decoy_cli.bench import (
 )
 from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
 from decoy_cli.commands._console import make_console
+from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage import CHOICES_HELP, SHIPPED_CHOICES
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
@@ -76,6 +77,12 @@ def bench(
     ),
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="The JSON report."),
     seed: int = typer.Option(0, "--seed", help="Seed of agent placements and actions."),
+    map_name: str = typer.Option(
+        "dust2",
+        "--map",
+        help="Built-in map of Table 1, the kinematic, env and combat-step sections (replay and "
+        "reader use the data's files).",
+    ),
     sections: str = typer.Option(
         ",".join(SECTIONS), "--sections", help="Comma-separated sections to run."
     ),
@@ -102,7 +109,13 @@ def bench(
     check_writable(out)  # before minutes of measuring
     chosen = _chosen_sections(sections)
     config = BenchConfig.create(
-        quick=quick, models=models, mover=mover, combat=combat, bomb=bomb, seed=seed
+        quick=quick,
+        models=models,
+        mover=mover,
+        combat=combat,
+        bomb=bomb,
+        seed=seed,
+        map_name=map_name,
     )
     bench_data = find_data(data)
     machine = machine_info()
@@ -110,6 +123,8 @@ def bench(
     if baseline is not None:
         switches = {"quick": quick, "models": models, "mover": mover, "combat": combat}
         switches |= {"bomb": bomb, "seed": seed}
+        if config.map_name != BUILTIN_MAP:  # only then: earlier versions know no --map
+            switches["map_name"] = config.map_name
         _side_by_side(console, chosen, switches, bench_data, baseline, repeats, out)
         return
     status = check_damage_model(models)

@@ -16,6 +16,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 from decoy_cli.synth import PlayedRound, write_sample
 from decoy_cli.synth.sample import MAX_ROUNDS
+from decoy_cli.waypoints.build import canonical_map
 
 DEFAULT_OUT = Path("examples") / "sample"
 
@@ -27,18 +28,21 @@ def make_sample(
     models: str = typer.Option(
         "shipped", "--models", help=f"Damage models for combat: {CHOICES_HELP}."
     ),
+    map_name: str = typer.Option("dust2", "--map", help="The map to play on."),
 ) -> None:
-    """Write a synthetic ESTA match: scripted 5v5 de_dust2 rounds played in the simulator.
+    """Write a synthetic ESTA match: scripted 5v5 rounds played in the simulator.
 
-    Both teams follow plausible routes (T strategies such as A long, B tunnels or a mid-to-A
-    split; CT setups such as 2-1-2), the bomb rules are on, and combat runs through the damage
-    models (none: rounds end by the bomb or time). The file is labelled synthetic in its
-    metadata. The same seed and models give the same bytes.
+    Both teams follow plausible routes (on de_dust2 hand-written T strategies such as A long, B
+    tunnels or a mid-to-A split; on other maps executes and splits along shortest paths from the
+    spawns to the sites; CT setups such as 2-1-2), the bomb rules are on, and combat runs
+    through the damage models (none: rounds end by the bomb or time). The file is labelled
+    synthetic in its metadata. The same seed and models give the same bytes.
     """
     if not 1 <= rounds <= MAX_ROUNDS:
         raise DecoyError(f"--rounds must be between 1 and {MAX_ROUNDS}, not {rounds}")
     if seed < 0:
         raise DecoyError(f"--seed must be >= 0, not {seed}")
+    map_id = canonical_map(map_name)
     console = make_console()
     damage_model = load_damage_model(models)
     if damage_model is None:
@@ -60,7 +64,13 @@ def make_sample(
     with progress:
         task = progress.add_task("rounds", total=rounds)
         path, sample = write_sample(
-            out, rounds, seed, damage_model, models, on_round=lambda _: progress.advance(task)
+            out,
+            rounds,
+            seed,
+            damage_model,
+            models,
+            on_round=lambda _: progress.advance(task),
+            map_name=map_id,
         )
     seconds = time.perf_counter() - started
 

@@ -30,8 +30,13 @@ def replay(
         "--mover",
         help="kinematic (default: measured the more faithful) or physics (capsules that collide).",
     ),
+    map_name: str | None = typer.Option(
+        None, "--map", help="The round's map (default: the one the file names); a check."
+    ),
     graph_file: Path | None = typer.Option(
-        None, "--graph", help="Waypoint graph (.npz from build-waypoints; default: built-in)."
+        None,
+        "--graph",
+        help="Waypoint graph (.npz from build-waypoints; default: the built-in one of the map).",
     ),
     out: Path | None = typer.Option(
         None,
@@ -72,7 +77,15 @@ def replay(
         seed=seed,
         implausible=policy,
     )
-    run = replay_address(address, options, models=models, graph_file=graph_file, out=out, gif=gif)
+    run = replay_address(
+        address,
+        options,
+        models=models,
+        map_name=map_name,
+        graph_file=graph_file,
+        out=out,
+        gif=gif,
+    )
     round_, result, players = run.round_, run.result, run.players
     real = (round_.winning_side, round_.end_reason)
     simulated = (result.outcome.winner, result.outcome.reason) if result.outcome else (None, None)

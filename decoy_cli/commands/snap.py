@@ -18,6 +18,7 @@ from decoy_cli.commands._snap_output import (
     show_worst,
     totals_table,
 )
+from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import Round, iter_match_files, parse_round_address, read_match
 from decoy_cli.replay import DEFAULT_MAX_SNAP_M
@@ -31,9 +32,9 @@ from decoy_cli.replay.study import (
     write_csv,
 )
 from decoy_cli.sim.setup import RoundSetup
-from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
+from decoy_cli.world.navmesh import load_navmesh
 
 _WITHIN = f"within_{WITHIN_M:g}m"
 
@@ -44,8 +45,11 @@ def snap(
         metavar="FILE:ROUND | FILE | FOLDER",
         help="One round (match.json.xz:3), every round of a match file, or of a folder of them.",
     ),
+    map_name: str = typer.Option(
+        "dust2", "--map", help="The map whose built-in graph to snap to (other maps' files fail)."
+    ),
     graph_file: Path | None = typer.Option(
-        None, "--graph", help="Waypoint graph (.npz from build-waypoints; default: built-in)."
+        None, "--graph", help="Waypoint graph (.npz from build-waypoints; overrides --map)."
     ),
     max_snap: float = typer.Option(
         DEFAULT_MAX_SNAP_M,
@@ -83,7 +87,8 @@ def snap(
     With --metrics, the metrics of the snapped trajectory against the original (the bound a
     replay can reach). Exits non-zero when a file or round failed."""
     console = make_console()
-    graph = WaypointGraph.load(graph_file) if graph_file is not None else builtin_graph()
+    map_id = canonical_map(map_name)
+    graph = WaypointGraph.load(graph_file) if graph_file is not None else builtin_graph(map_id)
     path = Path(target)
     if path.exists():
         for option, given in (
@@ -113,7 +118,8 @@ def snap(
     if actions:
         show_actions(console, round_, study, chosen, actions)
     if plot is not None:
-        nav = load_navmesh(BUILTIN_MAP) if graph.meta.get("map") == BUILTIN_MAP else None
+        graph_map = str(graph.meta.get("map", ""))
+        nav = load_navmesh(graph_map) if graph_map in MAP_NAMES else None
         plot_round_plan(
             study.plan,
             round_.position,

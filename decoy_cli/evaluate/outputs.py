@@ -149,7 +149,8 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
     written.append(
         write_json(out / "summary.json", summary(evaluation, tables, info), sort_keys=False)
     )
-    figures = draw_figures(out / "figures", evaluation.accumulator, tables, load_navmesh())
+    nav = load_navmesh(evaluation.settings.map_name)
+    figures = draw_figures(out / "figures", evaluation.accumulator, tables, nav)
     written += list(figures.values())
     text = report_markdown(
         evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}

@@ -22,7 +22,7 @@ from decoy_cli.esta.reader import MATCH_SUFFIXES
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
-from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
 
@@ -47,18 +47,25 @@ def replay_address(
     options: ReplayOptions,
     *,
     models: str | None,
+    map_name: str | None = None,
     graph_file: Path | None = None,
     out: Path | None = None,
     gif: bool = False,
 ) -> SingleReplay:
     """Replay the round at "FILE:ROUND" and write its files (see the module docstring).
 
-    `models` names the damage models in the summary (None: no shooting).
+    `models` names the damage models in the summary (None: no shooting). The round is replayed
+    on its own map (the file's `mapName`); `map_name`, when given, must agree with it, and so
+    must the map a `graph_file` was built for.
     """
+    if map_name is not None:
+        map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
     round_ = load_round(address, implausible=options.implausible)
-    if round_.map_name and round_.map_name != BUILTIN_MAP:
-        raise DecoyError(f"{address}: a {round_.map_name} round; decoy replays {BUILTIN_MAP}")
-    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph()
+    map_id = round_map(address, round_.map_name, map_name)
+    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id)
+    graph_map = str(graph.meta.get("map", ""))
+    if graph_map and graph_map != map_id:
+        raise DecoyError(f"{address}: a {map_id} round, but the graph {graph_file} is {graph_map}")
     started = time.perf_counter()
     result = replay_round(round_, graph, options)
     seconds = time.perf_counter() - started
@@ -66,13 +73,30 @@ def replay_address(
     summary = replay_summary(address, round_, options, models, result, players, seconds)
     folder = out or DEFAULT_REPLAY_OUT / replay_folder_name(round_.path, round_.round_num)
     write_replay(folder, round_, result, players, summary)
-    nav = load_navmesh()
+    nav = load_navmesh(map_id)
     shown = "".join(c if c.isprintable() else "?" for c in round_.match_id[:8])
     title = f"{shown} round {round_.round_num}: original (dashed) vs replay"
     plot_paths(folder / "paths.png", round_, result, nav, title=title)
     if gif:
         animate(folder / "round.gif", round_, result, nav)
     return SingleReplay(round_, options, result, players, summary, folder, seconds)
+
+
+def round_map(address: str, file_map: str, asked: str | None) -> str:
+    """The map a round is replayed on: the file's (a built-in map; BUILTIN_MAP when the file
+    names none), which must be `asked` when that is given."""
+    if not file_map:
+        map_id = asked or BUILTIN_MAP
+    else:
+        try:
+            map_id = canonical_map(file_map)
+        except DecoyError:
+            raise DecoyError(
+                f"{address}: a {file_map} round, a map decoy has no world for"
+            ) from None
+    if asked is not None and asked != map_id:
+        raise DecoyError(f"{address}: a {map_id} round, not {asked} (--map)")
+    return map_id
 
 
 def replay_folder_name(file: Path, round_num: int) -> str:

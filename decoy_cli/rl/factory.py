@@ -13,7 +13,7 @@ from typing import Any
 
 from decoy_cli.sim.env import DecoyParallelEnv
 
-ENV_SETTINGS = ("n_t", "n_ct", "mover", "models", "combat", "bomb", "stop_seconds")
+ENV_SETTINGS = ("map", "n_t", "n_ct", "mover", "models", "combat", "bomb", "stop_seconds")
 """The settings `env_from_config` reads; "models" names the damage models as `--models` does."""
 
 

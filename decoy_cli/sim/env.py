@@ -21,7 +21,8 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from decoy_cli.csgo import seconds_to_ticks
+from decoy_cli.csgo import BUILTIN_MAP, seconds_to_ticks
+from decoy_cli.errors import GraphError
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.observation import (
@@ -32,7 +33,7 @@ from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.sim.view import TopDownView
-from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import is_known
 from decoy_cli.world.physics import PhysicsWorld
@@ -59,8 +60,27 @@ class _ChosenActions:
             ) from None
 
 
+def _map_graph(map_name: str | None, graph: WaypointGraph | None) -> WaypointGraph:
+    """The graph of an environment: the given one (which must be of `map_name` when both are
+    given) or the built-in graph of `map_name` (default de_dust2)."""
+    try:
+        map_id = canonical_map(map_name or BUILTIN_MAP)
+    except GraphError as error:
+        raise ValueError(str(error)) from None
+    if graph is None:
+        return builtin_graph(map_id)
+    graph_map = str(graph.meta.get("map", ""))
+    if map_name is not None and graph_map and graph_map != map_id:
+        raise ValueError(f"map {map_name!r} given with a graph of {graph_map}")
+    return graph
+
+
 class DecoyParallelEnv(ParallelEnv):
     """One CS:GO round on the waypoint graph as a PettingZoo parallel environment.
+
+    Map: `map` names a built-in map ("mirage" or "de_mirage"; default de_dust2), whose shipped
+    graph and world are used; a `graph` given instead is used as it is (`map`, if also given,
+    must be the graph's map).
 
     Agents: `t_0 .. t_{n_t-1}` then `ct_0 .. ct_{n_ct-1}`, spawned at distinct random waypoints
     of the graph regions `t_spawn` and `ct_spawn`, 100 HP, no armor, the side's pistol (or
@@ -144,6 +164,7 @@ class DecoyParallelEnv(ParallelEnv):
         self,
         n_t: int = 5,
         n_ct: int = 5,
+        map: str | None = None,
         graph: WaypointGraph | None = None,
         world: World | None = None,
         mover: str = "kinematic",
@@ -163,7 +184,7 @@ class DecoyParallelEnv(ParallelEnv):
             raise ValueError(f"stop_seconds must be > 0, got {stop_seconds!r}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r} (rgb_array or None)")
-        self.graph = builtin_graph() if graph is None else graph
+        self.graph = _map_graph(map, graph)
         self.world = world
         self.mover_kind = mover
         self.damage_model: DamageModel | None

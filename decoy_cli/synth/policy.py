@@ -44,7 +44,8 @@ class ScriptedPolicy:
         self.hold_until = np.full(n, -1, dtype=np.int64)  # -1: not yet arrived at the leg
         self.routed_to_plant = {plan.carrier}
         self.rotated: set[int] = set()
-        self._site_place = places.graph.place_names.index(SITE_PLACES[plan.site])
+        self._on_site = np.zeros(graph.num_nodes, dtype=bool)
+        self._on_site[places.nodes(SITE_PLACES[plan.site])] = True
         self._paths: dict[int, tuple[int, list[int]]] = {}
         self._bomb_node: tuple[tuple[float, ...], int] | None = None
 
@@ -146,7 +147,7 @@ class ScriptedPolicy:
         """True once an alive T stands on the attacked bomb site (its nav place)."""
         agents = sim.agents
         ts = agents.alive & (agents.side == "T")
-        return bool(np.any(self.graph.node_place[agents.node[ts]] == self._site_place))
+        return bool(np.any(self._on_site[agents.node[ts]]))
 
     def _fetcher(self, sim: Simulator) -> int:
         """The alive T nearest (horizontally) the dropped bomb; -1 if none is alive."""

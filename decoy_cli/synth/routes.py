@@ -1,4 +1,4 @@
-"""Plausible de_dust2 strategies as routes on the waypoint graph, built from its nav places.
+"""Plausible strategies as routes on the waypoint graph, built from its nav places.
 
 A route is a list of legs: a waypoint to reach, and how long to hold there (a minimum, and an
 absolute tick before which the agent does not go on: a team waits at its staging spot until the
@@ -6,20 +6,23 @@ execute) with the place to face while holding. Waypoints are drawn at random (se
 waypoints of a nav place that lie nearest a reference (the place's own centre, or another
 place's: "the part of LongA nearest ARamp" is the top of long), so every round differs.
 
-T strategies (`T_STRATEGIES`): A long, A short (catwalk), B tunnels, mid to B (through mid
-doors and B doors), and a mid-to-A split (long, short and one player through CT spawn). Every T
-walks its group's places, waits at the group's staging place until the execute tick, then runs
-to a waypoint of the bomb site; the bomb carrier's last leg is a plant waypoint inside the site's
-bomb-target zone. CT setups (`CT_SETUPS`): the usual 2-1-2 (long, A site, mid, two B) and stacks
-on A or B; each CT walks from spawn to its role's spot and holds there facing where the T come
-from, and the CTs that defend elsewhere (mid, the other site) have a rotation leg to the edge of
-the attacked site on its retake side, taken when the first T reaches the site (a call). What
-happens after (plant, retake, defuse, picking up a dropped bomb) is decided during the round by
-the policy (decoy_cli/synth/player.py).
+A map's strategies are a `MapPlan`. On de_dust2 they are written by hand from its places
+(`DUST2_PLAN`); every other map gets the plan of `decoy_cli.synth.corridors`, built from shortest
+paths on its graph. The de_dust2 plan: T strategies (`T_STRATEGIES`): A long, A short (catwalk), B
+tunnels, mid to B (through mid doors and B doors), and a mid-to-A split (long, short and one player
+through CT spawn). Every T walks its group's places, waits at the group's staging place until the
+execute tick, then runs to a waypoint of the bomb site; the bomb carrier's last leg is a plant
+waypoint inside the site's bomb-target zone. CT setups (`CT_SETUPS`): the usual 2-1-2 (long, A site,
+mid, two B) and stacks on A or B; each CT walks from spawn to its role's spot and holds there facing
+where the T come from, and the CTs that defend elsewhere (mid, the other site) have a rotation leg
+to the edge of the attacked site on its retake side, taken when the first T reaches the site (a
+call). What happens after (plant, retake, defuse, picking up a dropped bomb) is decided during the
+round by the policy (decoy_cli/synth/player.py).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +32,10 @@ from decoy_cli.errors import GraphError
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.waypoints.graph import WaypointGraph
 
-SITE_PLACES = {"A": "BombsiteA", "B": "BombsiteB"}
+SITE_PLACES = {"A": "bombsite_a", "B": "bombsite_b"}
+"""Bomb site -> the graph region (a place of `Places`) holding its waypoints."""
+SPAWNS = {"T": "t_spawn", "CT": "ct_spawn"}
+"""Side -> the graph region (a place of `Places`) where it spawns."""
 RETAKE_FROM = {"A": "ExtendedA", "B": "BDoors"}
 """Where the CT retake of a site comes from: the place the T on the site watch."""
 
@@ -133,15 +139,37 @@ CT_SETUP_WEIGHTS = {"2-1-2": 0.6, "A stack": 0.2, "B stack": 0.2}
 TEAM_SIZE = 5
 
 
+@dataclass(frozen=True)
+class MapPlan:
+    """The strategies of one map: T strategies, CT roles and setups (with their weights), and
+    the place each site's retake comes from."""
+
+    t_strategies: tuple[TStrategy, ...]
+    ct_roles: Mapping[str, CtRole]
+    ct_setups: Mapping[str, tuple[str, ...]]
+    ct_setup_weights: Mapping[str, float]
+    retake_from: Mapping[str, str]
+
+
+DUST2_PLAN = MapPlan(T_STRATEGIES, CT_ROLES, CT_SETUPS, CT_SETUP_WEIGHTS, RETAKE_FROM)
+
+
 class Places:
-    """The graph's nav places: their waypoints, centres, and random spots near a reference."""
+    """The graph's nav places and regions (`t_spawn`, `bombsite_a`, ...; plus any named sets of
+    waypoints added with `add`): their waypoints, centres, and random spots near a reference."""
 
     def __init__(self, graph: WaypointGraph) -> None:
         self.graph = graph
         self._nodes = {
             name: np.flatnonzero(graph.node_place == k) for k, name in enumerate(graph.place_names)
         }
+        self._nodes.update({name: np.asarray(nodes) for name, nodes in graph.regions.items()})
         self._centre: dict[str, np.ndarray] = {}
+
+    def add(self, name: str, nodes: np.ndarray) -> None:
+        """Name a set of waypoints, so routes can use it like a place."""
+        self._nodes[name] = np.asarray(nodes, dtype=np.int64)
+        self._centre.pop(name, None)
 
     def nodes(self, place: str) -> np.ndarray:
         """Waypoint indices of a place; a GraphError when the graph has none."""
@@ -150,12 +178,17 @@ class Places:
             raise GraphError(f"the waypoint graph has no waypoints in the nav place {place!r}")
         return nodes
 
+    def centre_node(self, place: str) -> int:
+        """The place's waypoint nearest the mean of its waypoints."""
+        nodes = self.nodes(place)
+        positions = self.graph.positions[nodes]
+        mean = positions.mean(axis=0)
+        return int(nodes[np.argmin(np.linalg.norm(positions - mean, axis=1))])
+
     def centre(self, place: str) -> np.ndarray:
-        """(3,) position of the place's waypoint nearest the mean of its waypoints."""
+        """(3,) position of the place's centre waypoint (`centre_node`)."""
         if place not in self._centre:
-            positions = self.graph.positions[self.nodes(place)]
-            mean = positions.mean(axis=0)
-            self._centre[place] = positions[np.argmin(np.linalg.norm(positions - mean, axis=1))]
+            self._centre[place] = self.graph.positions[self.centre_node(place)]
         return self._centre[place]
 
     def spots(
@@ -210,11 +243,13 @@ def plant_nodes(places: Places, zones: SiteZones, site: str) -> np.ndarray:
     return inside
 
 
-def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> RoutePlan:
+def plan_round(
+    places: Places, zones: SiteZones, rng: np.random.Generator, map_plan: MapPlan = DUST2_PLAN
+) -> RoutePlan:
     """Draw a T strategy, a CT setup and every player's route (5 against 5)."""
-    strategy = T_STRATEGIES[int(rng.integers(len(T_STRATEGIES)))]
-    names = list(CT_SETUPS)
-    ct_setup = str(rng.choice(names, p=[CT_SETUP_WEIGHTS[n] for n in names]))
+    strategy = map_plan.t_strategies[int(rng.integers(len(map_plan.t_strategies)))]
+    names = list(map_plan.ct_setups)
+    ct_setup = str(rng.choice(names, p=[map_plan.ct_setup_weights[n] for n in names]))
     execute = tick_at(rng.uniform(*EXECUTE_S))
     site_place = SITE_PLACES[strategy.site]
 
@@ -222,7 +257,7 @@ def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> Ro
     order = rng.permutation(TEAM_SIZE)
     carrier = int(rng.integers(TEAM_SIZE))
     plant_node = int(rng.choice(plant_nodes(places, zones, strategy.site)))
-    t_spawns = places.spots("TSpawn", rng, TEAM_SIZE, share=SPAWN_SHARE)
+    t_spawns = places.spots(SPAWNS["T"], rng, TEAM_SIZE, share=SPAWN_SHARE)
     routes: list[list[Leg]] = []
     for agent in range(TEAM_SIZE):
         group = groups[int(order[agent])]
@@ -235,16 +270,16 @@ def plan_round(places: Places, zones: SiteZones, rng: np.random.Generator) -> Ro
             else:
                 legs.append(Leg(places.spot(place, rng)))
         final = plant_node if agent == carrier else places.spot(site_place, rng)
-        legs.append(Leg(final, watch=RETAKE_FROM[strategy.site]))
+        legs.append(Leg(final, watch=map_plan.retake_from[strategy.site]))
         routes.append(legs)
 
-    ct_spawns = places.spots("CTSpawn", rng, TEAM_SIZE, share=SPAWN_SHARE)
+    ct_spawns = places.spots(SPAWNS["CT"], rng, TEAM_SIZE, share=SPAWN_SHARE)
     rotations = {}
-    for k, role_name in enumerate(CT_SETUPS[ct_setup]):
-        role = CT_ROLES[role_name]
+    for k, role_name in enumerate(map_plan.ct_setups[ct_setup]):
+        role = map_plan.ct_roles[role_name]
         hold = Leg(places.spot(role.place, rng, role.near), watch=role.watch)
         routes.append([Leg(int(ct_spawns[k]), tick_at(rng.uniform(*START_HOLD_S))), hold])
         if role.site != strategy.site:
-            entry = places.spot(site_place, rng, RETAKE_FROM[strategy.site])
+            entry = places.spot(site_place, rng, map_plan.retake_from[strategy.site])
             rotations[TEAM_SIZE + k] = Leg(entry, watch=site_place)
     return RoutePlan(strategy, ct_setup, routes, carrier, plant_node, rotations)

@@ -1,10 +1,11 @@
 """The synthetic ESTA sample: scripted rounds played in the simulator, written as one match file.
 
 No real ESTA file may ship with the project, so `decoy evaluate` has a built-in sample made here:
-`play_match` plays `rounds` scripted 5-on-5 rounds on the built-in de_dust2 graph (strategies
-and loadouts drawn from `numpy.random.default_rng([seed, round])`, combat through the given
-damage model, bomb rules on) and `write_sample` writes them as `synthetic-dust2-seed<N>.json.xz`.
-The file says what it is: matchID `synthetic-dust2-seed<N>`, clientName `decoy make-sample`,
+`play_match` plays `rounds` scripted 5-on-5 rounds on a built-in map's graph (de_dust2 by
+default; strategies and loadouts drawn from `numpy.random.default_rng([seed, round])`, combat
+through the given damage model, bomb rules on) and `write_sample` writes them as
+`synthetic-<map>-seed<N>.json.xz` (map without its `de_` prefix). The file says what it is:
+matchID `synthetic-<map>-seed<N>`, clientName `decoy make-sample`,
 and a top-level `provenance` key (as the real T-side files have) with `"synthetic": true`, the
 command that made it and what it does and does not record. Same seed and damage model, same
 bytes.
@@ -24,6 +25,7 @@ from decoy_cli.esta.records import MatchRecord
 from decoy_cli.esta.writer import write_match
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.rules import SiteZones
+from decoy_cli.synth.corridors import corridor_plan
 from decoy_cli.synth.loadouts import buy_kind, side_loadouts
 from decoy_cli.synth.player import (
     DEMO_TICK_RATE,
@@ -33,8 +35,8 @@ from decoy_cli.synth.player import (
     play_round,
     scripted_setup,
 )
-from decoy_cli.synth.routes import TEAM_SIZE, Places, plan_round
-from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.synth.routes import DUST2_PLAN, TEAM_SIZE, Places, plan_round
+from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP
 
@@ -59,12 +61,12 @@ above 7.6e16), so nothing can be mistaken for a real player."""
 TEAM_NAMES = {"T": "Synthetic T", "CT": "Synthetic CT"}
 
 
-def sample_match_id(seed: int) -> str:
-    return f"synthetic-dust2-seed{seed}"
+def sample_match_id(seed: int, map_name: str = BUILTIN_MAP) -> str:
+    return f"synthetic-{map_name.removeprefix('de_')}-seed{seed}"
 
 
-def sample_file_name(seed: int) -> str:
-    return f"{sample_match_id(seed)}.json.xz"
+def sample_file_name(seed: int, map_name: str = BUILTIN_MAP) -> str:
+    return f"{sample_match_id(seed, map_name)}.json.xz"
 
 
 @dataclass
@@ -90,7 +92,9 @@ def play_match(
     if seed < 0:
         raise ValueError(f"the seed must be >= 0, not {seed}")
     graph = builtin_graph() if graph is None else graph
+    map_name = canonical_map(str(graph.meta.get("map", BUILTIN_MAP)))
     places = Places(graph)
+    map_plan = DUST2_PLAN if map_name == "de_dust2" else corridor_plan(places)
     zones = SiteZones.from_graph(graph)
     setup = scripted_setup(graph, damage_model)
     physics = setup.open_physics() if setup.needs_physics else None
@@ -100,7 +104,7 @@ def play_match(
     try:
         for k in range(rounds):
             rng = np.random.default_rng([seed, k + 1])
-            plan = plan_round(places, zones, rng)
+            plan = plan_round(places, zones, rng, map_plan)
             buys = {
                 side: buy_kind(k, side, previous_winner, HALF_ROUNDS, rng) for side in ("T", "CT")
             }
@@ -125,29 +129,36 @@ def play_match(
         if physics is not None:
             physics.close()
     match = MatchRecord(
-        match_id=sample_match_id(seed),
-        map_name=BUILTIN_MAP,
+        match_id=sample_match_id(seed, map_name),
+        map_name=map_name,
         tick_rate=DEMO_TICK_RATE,
         rounds=[r.record for r in played],
         team_names=TEAM_NAMES,
-        provenance=provenance(rounds, seed, models_label, combat=damage_model is not None),
+        provenance=provenance(
+            rounds, seed, models_label, combat=damage_model is not None, map_name=map_name
+        ),
         client_name=CLIENT_NAME,
     )
     return SampleMatch(match, played)
 
 
-def provenance(rounds: int, seed: int, models_label: str, combat: bool) -> dict[str, Any]:
+def provenance(
+    rounds: int, seed: int, models_label: str, combat: bool, map_name: str = BUILTIN_MAP
+) -> dict[str, Any]:
     """The `provenance` key of a sample file: synthetic, how it was made, what it holds."""
+    command = f"decoy make-sample --rounds {rounds} --seed {seed} --models {models_label}"
+    if map_name != BUILTIN_MAP:
+        command += f" --map {map_name.removeprefix('de_')}"
     return {
         "synthetic": True,
         "generator": CLIENT_NAME,
-        "command": f"decoy make-sample --rounds {rounds} --seed {seed} --models {models_label}",
+        "command": command,
         "decoy_version": __version__,
         "seed": seed,
         "damage_models": models_label,
         "combat": combat,
         "note": (
-            "Not real CS:GO data: scripted rounds played in decoy's simulator on the de_dust2 "
+            f"Not real CS:GO data: scripted rounds played in decoy's simulator on the {map_name} "
             "waypoint graph (both teams on plausible routes, bomb rules on, combat "
             f"{'on' if combat else 'off'}), written in the ESTA (awpy 1.x) format."
         ),
@@ -166,8 +177,11 @@ def write_sample(
     damage_model: DamageModel | None,
     models_label: str,
     on_round: Callable[[PlayedRound], None] | None = None,
+    map_name: str = BUILTIN_MAP,
 ) -> tuple[Path, SampleMatch]:
-    """Play the sample and write it to `out_dir/synthetic-dust2-seed<seed>.json.xz`."""
-    sample = play_match(rounds, seed, damage_model, models_label, on_round=on_round)
-    path = write_match(sample.match, Path(out_dir) / sample_file_name(seed))
+    """Play the sample on a built-in map and write it to
+    `out_dir/synthetic-<map>-seed<seed>.json.xz`."""
+    graph = builtin_graph(map_name)
+    sample = play_match(rounds, seed, damage_model, models_label, graph, on_round=on_round)
+    path = write_match(sample.match, Path(out_dir) / sample_file_name(seed, sample.match.map_name))
     return path, sample

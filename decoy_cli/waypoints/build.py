@@ -14,33 +14,33 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES
 from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
-from decoy_cli.world.navmesh import BUILTIN_MAP, REGION_PLACES, NavMesh, asset_dir, load_navmesh
+from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
 GRAPH_FILE = "waypoints.npz"
-MAP_ALIASES = {"dust2": BUILTIN_MAP, BUILTIN_MAP: BUILTIN_MAP}
 
 
 def canonical_map(name: str) -> str:
-    """'dust2' or 'de_dust2' -> 'de_dust2'; a GraphError for maps the project has no data for."""
-    try:
-        return MAP_ALIASES[name.lower()]
-    except KeyError:
-        known = ", ".join(sorted(MAP_ALIASES))
-        raise GraphError(f"unknown map {name!r}; this decoy knows: {known}") from None
+    """'mirage' or 'de_mirage' -> 'de_mirage'; a GraphError for maps the project has no data for."""
+    key = name.lower()
+    for candidate in (key, f"de_{key}"):
+        if candidate in MAP_NAMES:
+            return candidate
+    short = ", ".join(m.removeprefix("de_") for m in MAP_NAMES)
+    raise GraphError(f"unknown map {name!r}; this decoy knows: {short}")
 
 
 def default_seeds(nav: NavMesh) -> np.ndarray:
     """The centres of the largest T-spawn and CT-spawn nav areas, metres: every playable spot
     is reachable from a spawn."""
     seeds = []
-    for place in ("TSpawn", "CTSpawn"):
-        idx = np.nonzero(nav.place == place)[0]
+    for region in ("t_spawn", "ct_spawn"):
+        idx = np.nonzero(np.isin(nav.place, nav.regions[region]))[0]
         area = idx[np.argmax((nav.x_max - nav.x_min)[idx] * (nav.y_max - nav.y_min)[idx])]
         seeds.append(
             [
@@ -96,8 +96,8 @@ def build_graph(
         [place_index.get(str(nav.place[a]), -1) if a >= 0 else -1 for a in area], dtype=np.int16
     )
     regions = {
-        region: np.nonzero(node_place == place_index[place])[0]
-        for region, place in REGION_PLACES.items()
+        region: np.nonzero(np.isin(node_place, [place_index[p] for p in region_places]))[0]
+        for region, region_places in nav.regions.items()
     }
     stats = result.stats.as_dict()
     stats.pop("seconds")  # timings vary run to run; the file must not

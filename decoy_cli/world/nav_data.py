@@ -16,13 +16,9 @@ from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.package_data import packaged_dir
 
-REGION_PLACES = {
-    "t_spawn": "TSpawn",
-    "ct_spawn": "CTSpawn",
-    "bombsite_a": "BombsiteA",
-    "bombsite_b": "BombsiteB",
-}
-"""Regions the simulator and the replay use, and the nav place that defines each."""
+REGIONS = ("t_spawn", "ct_spawn", "bombsite_a", "bombsite_b")
+"""Regions the simulator and the replay use; each map's `map.json` names the nav places of each
+(usually TSpawn, CTSpawn, BombsiteA and BombsiteB)."""
 
 
 @dataclass(frozen=True)
@@ -39,6 +35,7 @@ class NavMesh:
     z_at_max: np.ndarray  # height at (x_max, y_max)
     connections: np.ndarray  # (C, 2) area indices (not ids), directed
     radar: dict[str, float]
+    regions: dict[str, tuple[str, ...]]  # region -> the nav places that make it
 
     @property
     def num_areas(self) -> int:
@@ -104,6 +101,7 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
     with open(folder / "nav_connections.csv", newline="") as f:
         pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in csv.DictReader(f)]
     meta = json.loads((folder / "map.json").read_text())
+    regions = {region: tuple(meta["regions"][region]) for region in REGIONS}
     return NavMesh(
         area_id=area_id,
         place=np.array([r["place"] for r in rows]),
@@ -115,6 +113,7 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
         z_at_max=col["z_at_max"],
         connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
         radar=meta["radar"],
+        regions=regions,
     )
 
 

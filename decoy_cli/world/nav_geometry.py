@@ -161,6 +161,12 @@ def _subtract(interval: tuple[float, float], covers: list[tuple[float, float]]):
     return [(a, b) for a, b in pieces if b - a > TOUCH_TOL_U]
 
 
+def floor_corner_heights(nav: NavMesh) -> tuple[np.ndarray, np.ndarray]:
+    """The fitted heights of every area's (x_max, y_min) and (x_min, y_max) corners, Hammer units:
+    with the two known corners they give the bilinear floor the world is built from."""
+    return fit_corner_heights(nav, _find_contacts(nav))
+
+
 def build_nav_triangles(nav: NavMesh) -> np.ndarray:
     """Floors, step faces, bridges and walls of the nav world, (T, 3, 3) in Hammer units."""
     contacts = _find_contacts(nav)
@@ -351,7 +357,28 @@ class _Side:
             return tris
         push = min(WALL_PUSH_U, part.gap / 2)
         tris = self._strip(part, push, z0, z1)
-        return tris + self._vertical(part, push, (z0, z1), (o0, o1))
+        # Where the lower floor goes on under the upper one across the face's line (a walkway
+        # over a passage, not a box), there is no face.
+        out = self.coord + self.sign * push
+        lower = min((z0 + z1) / 2, (o0 + o1) / 2)
+        for p_lo, p_hi in self._outside_areas(part.lo, part.hi, out, lower):
+            piece = _OpenPart(p_lo, p_hi, part.other, part.gap)
+            za = tuple(height(self.area, *self.point(v, self.coord)) for v in (p_lo, p_hi))
+            zb = tuple(
+                height(part.other, *self.point(v, self.coord + self.sign * part.gap))
+                for v in (p_lo, p_hi)
+            )
+            tris += self._vertical(piece, push, za, zb)
+        return tris
+
+    def _outside_areas(self, lo: float, hi: float, out: float, level_z: float) -> list:
+        """The parts of [lo, hi] on the line at `out` that stand inside no other area whose
+        floor is within a jump of `level_z`."""
+        across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
+        along = (self.t_hi > lo) & (self.t_lo < hi)
+        inside = across & along & (np.abs(self.centre_z - level_z) <= JUMP_U)
+        inside[self.area] = False
+        return _subtract((lo, hi), list(zip(self.t_lo[inside], self.t_hi[inside], strict=True)))
 
     def _strip(self, part: _OpenPart, width: float, z0: float, z1: float) -> list:
         """The area's floor extended outward by `width`."""
@@ -395,11 +422,9 @@ class _Side:
         out = self.coord + self.sign * push
         a0 = part.lo - (push if self._open_corner(part.lo, high_end=False) else 0.0)
         a1 = part.hi + (push if self._open_corner(part.hi, high_end=True) else 0.0)
+        pieces = self._outside_areas(a0, a1, out, (z0 + z1) / 2)
         across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
         along = (self.t_hi > a0) & (self.t_lo < a1)
-        inside = across & along & (np.abs(self.centre_z - (z0 + z1) / 2) <= JUMP_U)
-        inside[self.area] = False
-        pieces = _subtract((a0, a1), list(zip(self.t_lo[inside], self.t_hi[inside], strict=True)))
         clearance = np.minimum(nav.z_at_min, nav.z_at_max) - max(z0, z1)
         overhead = across & along & (clearance > 72)
         top = WALL_HEIGHT_U

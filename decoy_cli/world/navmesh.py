@@ -36,7 +36,7 @@ import numpy as np
 
 from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
 from decoy_cli.world.nav_data import (
-    REGION_PLACES,
+    REGIONS,
     NavMesh,
     asset_dir,
     load_navmesh,
@@ -47,7 +47,7 @@ from decoy_cli.world.world import World
 
 __all__ = [
     "BUILTIN_MAP",
-    "REGION_PLACES",
+    "REGIONS",
     "NavMesh",
     "asset_dir",
     "load_navmesh",
