@@ -14,10 +14,11 @@ from typer.testing import CliRunner, Result
 from worlds import fixture_room, room, seeds_of
 
 from decoy_cli.cli import app
+from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.waypoints.build import GRAPH_FILE, build_graph
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.meshfile import read_mesh, write_obj, write_tri
-from decoy_cli.world.navmesh import asset_dir
+from decoy_cli.world.navmesh import REGIONS, asset_dir
 from decoy_cli.world.world import World
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -101,6 +102,8 @@ def test_builtin_build(tmp_path: Path, subtests: pytest.Subtests) -> None:
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 50_000
         assert sorted(p.name for p in tmp_path.iterdir()) == ["dust2.npz", "dust2.png"]
         assert result.stderr == ""
+        found = re.search(r"nav coverage: ([\d.]+)% of", result.stdout)
+        assert found and float(found.group(1)) / 100 >= COVERAGE_TARGET
 
     with subtests.test("--check-esta on the real T-side positions"):
         if not TSIDE.is_dir():
@@ -112,6 +115,33 @@ def test_builtin_build(tmp_path: Path, subtests: pytest.Subtests) -> None:
         median, p95, within = (float(v) for v in row.groups())
         assert median < 0.35 and p95 < 0.8 and within >= 90.0
         assert "no waypoint on their floor" in result.stdout
+
+
+# ---- the other built-in maps ---------------------------------------------------------------------
+
+COVERAGE_TARGET = 0.98
+"""Share of a map's nav-mesh floor (by area) within 0.5 m of a waypoint (issue 16's target)."""
+
+COVERAGE_BELOW_TARGET = {"de_inferno": 0.95, "de_nuke": 0.88}
+"""Maps that miss the target today, with the floor they must not fall below: nuke's roofs,
+silo and heaven are reached by ladders, which awpy's nav data lacks; inferno's library, deck
+and balcony are cut off by wall faces the nav world puts across their doorways."""
+
+
+@pytest.mark.parametrize("map_name", [m for m in MAP_NAMES if m != "de_dust2"])
+def test_every_other_shipped_graph_is_current(tmp_path: Path, map_name: str) -> None:
+    """Rebuilding a map's graph gives the shipped bytes; both spawns and both bomb sites have
+    waypoints; the build reports the nav mesh's coverage."""
+    out = tmp_path / "graph.npz"
+    result = build("--map", map_name.removeprefix("de_"), "--no-plot", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    shipped = asset_dir(map_name) / GRAPH_FILE
+    assert out.read_bytes() == shipped.read_bytes(), npz_difference(out, shipped)
+    graph = WaypointGraph.load(out)
+    assert all(len(graph.region_of(r)) >= 20 for r in REGIONS)
+    found = re.search(r"nav coverage: ([\d.]+)% of", result.stdout)
+    assert found, result.stdout
+    assert float(found.group(1)) / 100 >= COVERAGE_BELOW_TARGET.get(map_name, COVERAGE_TARGET)
 
 
 # ---- user meshes -------------------------------------------------------------------------------

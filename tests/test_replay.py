@@ -47,8 +47,8 @@ RUN_START = (5.458, -19.007, 0.008)
 """A T-spawn waypoint with a straight run of 40 walk edges north (into Outside Long)."""
 STILL_SPOT = (-33.742, -20.407, 2.458)
 """A T-spawn waypoint far from the run, where players stand."""
-DETOUR = ((-30.242, -3.607, 2.439), (-28.784, -3.045, 2.439))
-"""Two T-spawn waypoints 1.56 m apart with 4.8 m of path between them (around an obstacle)."""
+DETOUR = ((-19.927, -9.13, 2.444), (-19.286, -7.701, 2.483))
+"""Two T-spawn waypoints 1.57 m apart with 4.57 m of path between them (around an obstacle)."""
 ABSENT_PARKING_NODE = 0
 """Where the replay puts an agent that is never on the graph (it has no waypoint of its own)."""
 
@@ -194,7 +194,7 @@ STILL, WALKER, DETOURER = range(3)
 
 def timing_round() -> SimpleNamespace:
     """One player stands 10 s; one walks the straight run, two edges per frame (2.8 m/s, below
-    the AK-47's 4.1 m/s); one runs the detour there and back in one frame each (4.8 m in 0.5 s:
+    the AK-47's 4.1 m/s); one runs the detour there and back in one frame each (4.57 m in 0.5 s:
     over twice the AK-47's speed), then stands still."""
     run = straight_run(node_at(RUN_START), direction=0, count=2 * TIMING_FRAMES - 1)
     a, b = node_at(DETOUR[0]), node_at(DETOUR[1])

@@ -16,6 +16,7 @@ from decoy_cli.errors import GraphError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.files import check_writable
 from decoy_cli.waypoints.build import build_graph, canonical_map, read_manual_waypoints
+from decoy_cli.waypoints.coverage import NavCoverage, nav_coverage
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.waypoints.plot import plot_graph
 from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_aligned
@@ -162,6 +163,10 @@ def build_waypoints(
         f"{elapsed:.1f}",
     )
     console.print(table)
+    regions = ", ".join(f"{name} {len(nodes):,}" for name, nodes in graph.regions.items())
+    console.print(f"region waypoints: {regions}", highlight=False)
+    if mesh is None:
+        _show_coverage(console, nav_coverage(graph, load_navmesh(map_id)))
     console.print(f"graph written to {out}")
     if plot:
         png = out.with_suffix(".png")
@@ -178,6 +183,17 @@ def build_waypoints(
         quality = alignment_quality(graph, result.pruned_positions, world, check_esta)
         _show_alignment(console, quality, check_esta)
         check_aligned(quality, min_aligned)
+
+
+def _show_coverage(console: Console, coverage: NavCoverage) -> None:
+    worst = ", ".join(
+        f"{place or '(unnamed)'} {share:.0%}" for place, share in coverage.worst_places()
+    )
+    console.print(
+        f"nav coverage: {coverage.covered:.2%} of the nav mesh's {coverage.area_m2:,.0f} m² "
+        f"within 0.5 m of a waypoint; least covered places: {worst}",
+        highlight=False,
+    )
 
 
 def _show_alignment(console: Console, quality: SnapQuality, path: Path) -> None:

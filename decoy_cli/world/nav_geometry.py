@@ -371,14 +371,17 @@ class _Side:
             tris += self._vertical(piece, push, za, zb)
         return tris
 
-    def _outside_areas(self, lo: float, hi: float, out: float, level_z: float) -> list:
+    def _outside_areas(
+        self, lo: float, hi: float, out: float, level_z: float, clearance: float = 0.0
+    ) -> list:
         """The parts of [lo, hi] on the line at `out` that stand inside no other area whose
-        floor is within a jump of `level_z`."""
+        floor is within a jump of `level_z`, nor within `clearance` of its ends along the line."""
         across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
-        along = (self.t_hi > lo) & (self.t_lo < hi)
+        along = (self.t_hi + clearance > lo) & (self.t_lo - clearance < hi)
         inside = across & along & (np.abs(self.centre_z - level_z) <= JUMP_U)
         inside[self.area] = False
-        return _subtract((lo, hi), list(zip(self.t_lo[inside], self.t_hi[inside], strict=True)))
+        spans = zip(self.t_lo[inside] - clearance, self.t_hi[inside] + clearance, strict=True)
+        return _subtract((lo, hi), list(spans))
 
     def _strip(self, part: _OpenPart, width: float, z0: float, z1: float) -> list:
         """The area's floor extended outward by `width`."""
@@ -422,7 +425,9 @@ class _Side:
         out = self.coord + self.sign * push
         a0 = part.lo - (push if self._open_corner(part.lo, high_end=False) else 0.0)
         a1 = part.hi + (push if self._open_corner(part.hi, high_end=True) else 0.0)
-        pieces = self._outside_areas(a0, a1, out, (z0 + z1) / 2)
+        # A wall stands as far from another floor's end as from its own area (`push`): the nav
+        # stops that far short of the real walls on every side, doorways included.
+        pieces = self._outside_areas(a0, a1, out, (z0 + z1) / 2, clearance=push)
         across = (self.near_lo + TOUCH_TOL_U < out) & (out < self.near_hi - TOUCH_TOL_U)
         along = (self.t_hi > a0) & (self.t_lo < a1)
         clearance = np.minimum(nav.z_at_min, nav.z_at_max) - max(z0, z1)
