@@ -197,6 +197,16 @@ def test_each_failure_is_one_line_and_the_others_go_on(site: Site, tmp_path: Pat
     assert "Traceback" not in result.output
 
 
+def test_another_map_is_kept_when_asked_for(site: Site, tmp_path: Path) -> None:
+    dest = tmp_path / "esta"
+    result = _download(site, dest, "mirage", LAN_ID, "--map", "mirage")
+    assert result.exit_code == 1
+    assert "de_dust2 match, not de_mirage: not kept" in result.stderr
+    assert sorted(p.name for p in dest.iterdir()) == ["mirage.json.xz"]
+    unknown = _download(site, dest, "mirage", "--map", "cache")
+    assert unknown.exit_code == 1 and unknown.stderr.startswith("error: unknown map 'cache'")
+
+
 def test_refused_connection_and_timeout(site: Site, tmp_path: Path) -> None:
     with socket.socket() as probe:  # a port nobody listens on
         probe.bind(("127.0.0.1", 0))

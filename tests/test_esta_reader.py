@@ -356,10 +356,10 @@ def test_nan_literal_position_names_round_frame_player(tmp_path: Path) -> None:
 def test_off_map_position(tmp_path: Path) -> None:
     document = make_match()
     player = document["gameRounds"][0]["frames"][2]["ct"]["players"][0]
-    player["x"] = 12_000.0
+    player["x"] = 17_000.0  # beyond the engine's world (de_vertigo's z of 11,500 u is not)
     message = _round_error(tmp_path, document, 1)
     assert (
-        f"frame 2 (tick {ROUND1_TICKS[2]}): player {player['steamID']} position (12000.0" in message
+        f"frame 2 (tick {ROUND1_TICKS[2]}): player {player['steamID']} position (17000.0" in message
     )
 
 

@@ -1,4 +1,4 @@
-"""`decoy download ID...`: fetch ESTA de_dust2 match files by id, verified, into a folder."""
+"""`decoy download ID...`: fetch ESTA match files of one map by id, verified, into a folder."""
 
 from __future__ import annotations
 
@@ -26,6 +26,7 @@ from decoy_cli.esta.download import (
     parse_sha256,
 )
 from decoy_cli.files import check_folder_writable
+from decoy_cli.waypoints.build import canonical_map
 
 
 def download(
@@ -56,15 +57,19 @@ def download(
     timeout: float = typer.Option(
         60.0, "--timeout", min=0.1, help="Seconds to wait for a connection or for more data."
     ),
+    map_name: str = typer.Option(
+        "dust2", "--map", help="The map the matches must be on (a match of another is not kept)."
+    ),
 ) -> None:
-    """Download ESTA de_dust2 match files by id, verified, into a folder.
+    """Download ESTA match files of one map by id, verified, into a folder.
 
-    Each file is verified (complete, xz, readable as ESTA, on de_dust2) before it is renamed
+    Each file is verified (complete, xz, readable as ESTA, on the map) before it is renamed
     into the folder; a verified file already there is kept. A failure is one line per id, the
     other ids go on, and the exit code is 1 if any failed."""
     console = make_console()
     errors = make_console(stderr=True)
     expected = _parse_checksums(sha256, ids)
+    map_id = canonical_map(map_name)
     check_folder_writable(dest)  # one error line, not one per id
     failed = 0
     with Progress(
@@ -90,6 +95,7 @@ def download(
                     sha256=expected.get(match_id),
                     timeout=timeout,
                     on_progress=advance,
+                    map_name=map_id,
                 )
             except DecoyError as error:
                 failed += 1

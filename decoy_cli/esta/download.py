@@ -12,10 +12,10 @@ checksums: the sha256 of every verified file is reported so that a user can pin 
 expected sha256 can be given.
 
 A download is streamed to a hidden temporary file beside the target and verified before it is
-renamed into place: the body is complete (as long as its Content-Length), its sha256 matches
-when one is expected, it is xz data that decompresses, the reader parses it as an ESTA match
-with at least one readable round, and the match is on de_dust2. Anything else is one
-DownloadError line and the temporary file is removed, so the folder only ever holds verified
+renamed into place: the body is complete (as long as its Content-Length), its sha256 matches when
+one is expected, it is xz data that decompresses, the reader parses it as an ESTA match with at
+least one readable round, and the match is on the asked map (de_dust2 by default). Anything else is
+one DownloadError line and the temporary file is removed, so the folder only ever holds verified
 matches. A target that is already present and verifies is not downloaded again.
 """
 
@@ -116,7 +116,9 @@ def match_urls(ref: MatchRef, base_url: str = ESTA_BASE_URL) -> list[str]:
     return [f"{base}/{subset}/{ref.file_name}" for subset in subsets]
 
 
-def verify_file(path: str | Path, sha256: str | None = None) -> tuple[str, int]:
+def verify_file(
+    path: str | Path, sha256: str | None = None, map_name: str = MAP_NAME
+) -> tuple[str, int]:
     """Check a match file on disk (module doc); returns its sha256 and readable rounds."""
     path = Path(path)
     try:
@@ -126,10 +128,12 @@ def verify_file(path: str | Path, sha256: str | None = None) -> tuple[str, int]:
             digest = hashlib.file_digest(source, "sha256").hexdigest()
     except OSError as error:
         raise DownloadError(f"cannot read {path}: {error.strerror or error}") from None
-    return _verify(path, digest, head, sha256)
+    return _verify(path, digest, head, sha256, map_name)
 
 
-def _verify(path: Path, digest: str, head: bytes, expected: str | None) -> tuple[str, int]:
+def _verify(
+    path: Path, digest: str, head: bytes, expected: str | None, map_name: str
+) -> tuple[str, int]:
     """The checks after the body is complete: checksum, xz, ESTA, map."""
     if expected is not None and digest != expected:
         raise DownloadError(f"sha256 mismatch: expected {expected}, got {digest}")
@@ -143,8 +147,8 @@ def _verify(path: Path, digest: str, head: bytes, expected: str | None) -> tuple
         match = read_match(path)
     except EstaError as error:
         raise DownloadError(f"not a readable ESTA match: {_without_path(error, path)}") from None
-    if match.map_name != MAP_NAME:
-        raise DownloadError(f"a {match.map_name or 'map-less'} match, not {MAP_NAME}: not kept")
+    if match.map_name != map_name:
+        raise DownloadError(f"a {match.map_name or 'map-less'} match, not {map_name}: not kept")
     if not match.rounds:
         raise DownloadError(f"no readable round in the match ({len(match.round_errors)} broken)")
     return digest, len(match.rounds)
@@ -162,6 +166,7 @@ def download_match(
     sha256: str | None = None,
     timeout: float = 60.0,
     on_progress: ProgressCallback | None = None,
+    map_name: str = MAP_NAME,
 ) -> Downloaded:
     """Fetch, verify and place one match as `dest/<uuid>.json.xz` (module doc).
 
@@ -178,7 +183,7 @@ def download_match(
     note = ""
     if target.is_file():
         try:
-            digest, rounds = verify_file(target, expected)
+            digest, rounds = verify_file(target, expected, map_name)
         except DownloadError as error:
             note = f"the file there failed verification ({error})"
         else:
@@ -197,7 +202,7 @@ def download_match(
         with os.fdopen(fd, "wb") as out:
             url, digest, head = _fetch_first(ref, match_id, base_url, out, timeout, on_progress)
         try:
-            digest, rounds = _verify(tmp, digest, head, expected)
+            digest, rounds = _verify(tmp, digest, head, expected, map_name)
         except DownloadError as error:
             raise DownloadError(f"{match_id}: {url}: {error}") from None
         os.chmod(tmp, 0o644)

@@ -4,8 +4,8 @@ Players are keyed by `steamID` (as a string), falling back to `name` when the st
 0 (awpy writes 0 for bots); their order inside a frame is not trusted. Rows are ordered T first,
 then CT, each by key. A player entry whose x, y or z is null cannot be placed: it counts as absent
 from that frame, like a player missing from the list. Absent cells hold NaN (position, yaw),
-`MISSING` (hp, armor), "" (weapon) and False (flags, `alive`, `present`). A NaN, infinite or
-off-map coordinate (beyond ±10,000 Hammer units) is an error, and so is an unknown weapon.
+`MISSING` (hp, armor), "" (weapon) and False (flags, `alive`, `present`). A NaN, infinite or off-map
+coordinate (beyond the engine's ±16,384 Hammer units) is an error, and so is an unknown weapon.
 
 The round's clock is the game's: seconds since freeze-time end counted in ticks at the file's
 `tickRate` (`round_clock_zero`). A file's own `seconds` only place the zero: some awpy 1.x
@@ -27,8 +27,9 @@ from decoy_cli.weapons import is_known
 
 Side = Literal["T", "CT"]
 
-MAX_COORD_U = 10_000.0
-"""Largest plausible |coordinate| in Hammer units; de_dust2 spans about ±3,500."""
+MAX_COORD_U = 16_384.0
+"""Largest possible |coordinate| in Hammer units: the Source engine's world bound
+(MAX_COORD_INTEGER). de_dust2 spans about ±3,500 u; de_vertigo's floors lie near z = 11,500 u."""
 
 MISSING = -1
 """hp and armor where the player is absent or the value is null."""

@@ -91,20 +91,48 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
     folder = asset_dir(map_name)
     if not (folder / "nav_areas.csv").is_file():
         raise WorldError(f"no built-in map {map_name!r} (looked in {folder})")
-    with open(folder / "nav_areas.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    area_id = np.array([int(r["area_id"]) for r in rows], dtype=np.int64)
-    col = {
-        k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k not in ("area_id", "place")
-    }
+    return read_navmesh(folder)
+
+
+NAV_COLUMNS = ("x_min", "y_min", "z_at_min", "x_max", "y_max", "z_at_max")
+
+
+def read_navmesh(folder: Path) -> NavMesh:
+    """A map's nav mesh from its folder (`nav_areas.csv`, `nav_connections.csv`, `map.json`);
+    a WorldError naming the file and line for a missing or bad value."""
+    areas = folder / "nav_areas.csv"
+    try:
+        with open(areas, newline="") as f:
+            rows = list(csv.DictReader(f))
+        with open(folder / "nav_connections.csv", newline="") as f:
+            links = list(csv.DictReader(f))
+        meta = json.loads((folder / "map.json").read_text())
+        regions = {region: tuple(meta["regions"][region]) for region in REGIONS}
+        radar = {key: float(meta["radar"][key]) for key in ("pos_x", "pos_y", "scale")}
+    except (OSError, UnicodeDecodeError, csv.Error, ValueError, KeyError, TypeError) as error:
+        raise WorldError(f"{folder}: not a readable map folder ({error})") from None
+    values = np.full((len(rows), len(NAV_COLUMNS)), np.nan)
+    area_id = np.zeros(len(rows), dtype=np.int64)
+    for line, row in enumerate(rows, start=2):
+        try:
+            area_id[line - 2] = int(row["area_id"])
+            values[line - 2] = [float(row[key]) for key in NAV_COLUMNS]
+        except (KeyError, TypeError, ValueError):
+            values[line - 2] = np.nan
+        if not np.all(np.isfinite(values[line - 2])):
+            raise WorldError(
+                f"{areas}, line {line}: an area needs an id and numbers in "
+                f"{', '.join(NAV_COLUMNS)} (corner heights included)"
+            )
     index = {int(a): i for i, a in enumerate(area_id)}
-    with open(folder / "nav_connections.csv", newline="") as f:
-        pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in csv.DictReader(f)]
-    meta = json.loads((folder / "map.json").read_text())
-    regions = {region: tuple(meta["regions"][region]) for region in REGIONS}
+    try:
+        pairs = [(index[int(r["from_area"])], index[int(r["to_area"])]) for r in links]
+    except (KeyError, TypeError, ValueError):
+        raise WorldError(f"{folder / 'nav_connections.csv'}: a link names no known area") from None
+    col = dict(zip(NAV_COLUMNS, values.T, strict=True))
     return NavMesh(
         area_id=area_id,
-        place=np.array([r["place"] for r in rows]),
+        place=np.array([r.get("place") or "" for r in rows]),
         x_min=col["x_min"],
         y_min=col["y_min"],
         x_max=col["x_max"],
@@ -112,7 +140,7 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
         z_at_min=col["z_at_min"],
         z_at_max=col["z_at_max"],
         connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
-        radar=meta["radar"],
+        radar=radar,
         regions=regions,
     )
 
