@@ -61,8 +61,23 @@ approximate)."""
 JUMP_HEIGHT_M = 64 * HAMMER_TO_M
 """Highest ledge a player reaches with a crouch-jump (a plain jump clears about 55.8 u)."""
 
-MAX_DROP_M = 210 * HAMMER_TO_M
-"""Deepest drop the waypoint builder links: the safe fall (580 u/s at 800 u/s² gravity, ~210 u)."""
+SAFE_FALL_SPEED_U_S = 580.0
+"""Landing speed up to which a fall does no damage (CS_PLAYER_MAX_SAFE_FALL_SPEED in CS:GO's
+cs_gamerules.cpp): a fall of 580² / (2 × 800) = 210 u."""
+
+FATAL_FALL_SPEED_U_S = 1000.0
+"""Landing speed at which a fall does 100 damage (CS_PLAYER_FATAL_FALL_SPEED in CS:GO's
+cs_gamerules.cpp; the Source SDK's 1024 and Counter-Strike: Source's 1100 x 1.25 are other
+games'). The damage is linear in between. On the real T-side rounds, health lost at falls of
+200-310 u follows it (`python benchmarks/fall_damage_check.py`)."""
+
+SAFE_DROP_M = SAFE_FALL_SPEED_U_S**2 / (2 * 800) * HAMMER_TO_M
+"""The deepest fall that does no damage (210 u)."""
+
+MAX_DROP_M = 620 * HAMMER_TO_M
+"""Project choice: the deepest drop the waypoint builder links, a fall a player at full health
+survives (99 damage; 625 u is fatal). Drops deeper than `SAFE_DROP_M` cost health
+(`fall_damage`)."""
 
 MAX_VELOCITY_M_S = 3500 * HAMMER_TO_M
 """The engine's velocity cap (sv_maxvelocity 3500 u/s): no player moves faster, falling included."""
@@ -88,3 +103,13 @@ def tick_at(seconds: float, tick_rate: int = TICK_RATE) -> int:
     """The tick nearest a moment in time (seconds on the round's clock): where data frames,
     deadlines and recorded events fall."""
     return round(float(seconds) * tick_rate)
+
+
+def fall_damage(height_m: float) -> int:
+    """Damage of a fall from rest through `height_m` metres: the landing speed at sv_gravity 800
+    above the safe speed, times 100 / (fatal − safe), rounded to whole health points."""
+    speed_u_s = math.sqrt(2 * 800 * max(height_m, 0.0) / HAMMER_TO_M)
+    if speed_u_s <= SAFE_FALL_SPEED_U_S:
+        return 0
+    per_speed = 100 / (FATAL_FALL_SPEED_U_S - SAFE_FALL_SPEED_U_S)
+    return round((speed_u_s - SAFE_FALL_SPEED_U_S) * per_speed)

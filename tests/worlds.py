@@ -159,6 +159,28 @@ def overpass_world() -> World:
     )
 
 
+CLIFF_Z = 6.0
+"""Height of the cliff world's plateau: a 315 u fall, deeper than the safe 210 u."""
+
+CLIFF = (8.0, 2.0, 14.0, 6.0)
+"""The plateau's x0, y0, x1, y1 (metres)."""
+
+
+def cliff_world() -> World:
+    """A ground floor (x -14..20, y 0..10) and a plateau `CLIFF_Z` above it (see CLIFF), reached
+    by a ramp (slope 1:2) from the west; its other sides are cliffs down to the ground."""
+    x0, y0, x1, y1 = CLIFF
+    return make_world(
+        [
+            floor(-14.0, 0.0, 20.0, 10.0),
+            floor(x0, y0, x1, y1, CLIFF_Z),
+            ramp_x(x0 - 2 * CLIFF_Z, x0, y0, y1, 0.0, CLIFF_Z),
+        ],
+        "cliff",
+        (0.0, 8.0, 0.0),
+    )
+
+
 def gap_wall_world(gap: float) -> World:
     """An 8 x 6 m room split at x = 4 by a wall with a gap `gap` m wide centred on y = 3."""
     lo, hi = 3.0 - gap / 2, 3.0 + gap / 2

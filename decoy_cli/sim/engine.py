@@ -25,7 +25,7 @@ from typing import Protocol
 
 import numpy as np
 
-from decoy_cli.csgo import TICK_RATE
+from decoy_cli.csgo import TICK_RATE, fall_damage
 from decoy_cli.sim.movement import Mover, MoveStep
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.rules import BombRules
@@ -121,6 +121,7 @@ class Simulator:
         self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
         self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
         self.goal_node = np.full(n, -1, dtype=np.int64)
+        self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
@@ -185,6 +186,13 @@ class Simulator:
             self.events += self.combat.run(agents, self.tick, self.rng)
             for agent in np.nonzero(alive_before & ~agents.alive)[0]:
                 self._kill(int(agent))
+        self._judge_and_announce()
+        self._record()
+
+    def _judge_and_announce(self) -> None:
+        """Judge the outcome (`_judge`); a "round_end" event the moment there is one."""
+        if self.outcome is not None:
+            return
         self._judge()
         if self.outcome is not None:
             self.events.append(
@@ -194,7 +202,6 @@ class Simulator:
                     data={"winner": self.outcome.winner, "reason": self.outcome.reason},
                 )
             )
-        self._record()
 
     def _move_after_end(self, end: int) -> None:
         """Movement after the outcome (see `step`): the next tick's decisions, then its motion
@@ -258,6 +265,7 @@ class Simulator:
         self.agents.position[agent] = self.graph.positions[node]
         self.agents.node[agent] = node
         self.goal_node[agent] = -1
+        self.fall_m[agent] = 0.0
         if agent != self._deciding:
             self.mover.clear_goal(agent)
             self.hold_until[agent] = 0
@@ -283,6 +291,7 @@ class Simulator:
             self.agents.hp[agent] = 0
             self.events.append(SimEvent(self.tick, "death", agent, data={"reason": reason}))
             self._kill(agent)
+        self.fall_m[agent] = 0.0
 
     # ---- internals ----------------------------------------------------------------------------
 
@@ -298,6 +307,8 @@ class Simulator:
         np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
         if moved.happened & ARRIVAL:
             note_arrivals(moved.arrived, agents.alive, agents.node, self.goal_node, self.waiting)
+            if self.fall_m.any():
+                self._land(moved.arrived)
         if moved.happened & STUCK:
             for agent in np.flatnonzero(moved.stuck).tolist():
                 self.events.append(SimEvent(self.tick, "stuck", agent))
@@ -341,10 +352,30 @@ class Simulator:
         at the last tick, is the same as stepping them at every tick."""
         ticks, moved = self.mover.glide(last - self.tick + 1)
         self.tick += ticks - 1
+        alive = self.agents.alive.sum()
         moving = self._moved(moved)
         self.events += self.rules.step(
             self.tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, moving
         )
+        if self.agents.alive.sum() != alive:  # a fall killed at the glide's last tick
+            self._judge_and_announce()
+
+    def _land(self, arrived: np.ndarray) -> None:
+        """Fall damage for the agents that arrived at the end of a drop deeper than the safe
+        fall (`csgo.fall_damage`); a fall that takes the last health kills. Before the round's
+        end only: afterwards nothing changes health."""
+        for agent in np.flatnonzero(arrived & (self.fall_m > 0)).tolist():
+            height = float(self.fall_m[agent])
+            self.fall_m[agent] = 0.0
+            damage = fall_damage(height)
+            if self.outcome is not None or not damage or not self.agents.alive[agent]:
+                continue
+            left = max(0, int(self.agents.hp[agent]) - damage)
+            self.agents.hp[agent] = left
+            data = {"damage": damage, "height_m": round(height, 3)}
+            self.events.append(SimEvent(self.tick, "fall_damage", agent, data=data))
+            if left == 0:
+                self.kill(agent, "fall")
 
     def _judge(self) -> None:
         """The outcome at this tick. It depends only on who is alive, the bomb's status and
@@ -386,6 +417,7 @@ class Simulator:
             self.decision_count += 1
             self.wants_plant[agent] = decision.plant
             self.wants_defuse[agent] = decision.defuse
+            self.fall_m[agent] = 0.0
             if decision.action == STOP_ACTION:
                 self.mover.clear_goal(agent)
                 self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
@@ -406,6 +438,7 @@ class Simulator:
             )
             speed = top if decision.speed is None else min(float(decision.speed), top)
             self.goal_node[agent] = target
+            self.fall_m[agent] = self.graph.fall_m[edge]
             self.mover.set_goal(
                 agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
             )

@@ -29,6 +29,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
+from decoy_cli.csgo import SAFE_DROP_M
 from decoy_cli.errors import GraphError
 from decoy_cli.files import write_atomic
 
@@ -96,6 +97,14 @@ class WaypointGraph:
         """3-D length of every edge in metres."""
         delta = self.positions[self.edge_target] - self.positions[self.edge_source]
         return np.linalg.norm(delta, axis=1)
+
+    @cached_property
+    def fall_m(self) -> np.ndarray:
+        """(E,) depth of each drop edge deeper than the safe fall, metres; 0 for every other
+        edge. An agent that takes such an edge lands with fall damage (the simulator's rule)."""
+        depth = self.positions[self.edge_source, 2] - self.positions[self.edge_target, 2]
+        damaging = (self.edge_kind == EdgeKind.DROP) & (depth > SAFE_DROP_M)
+        return np.where(damaging, depth, 0.0)
 
     @cached_property
     def adjacency(self) -> csr_matrix:

@@ -7,8 +7,9 @@
    a ray up checks headroom; nine rays at the capsule's centre line and edges, at knee, waist and
    head height, check the body's way. Moves become walk, step (ledge up to 18 u) or jump (up to a
    crouch-jump) edges, in both directions where both pass.
-2. **Drop pass.** Moves whose profile falls by more than the step height (down to the safe-fall
-   depth) become one-way drop edges; lower floors first found this way are flooded too.
+2. **Drop pass.** Moves whose profile falls by more than the step height (down to `max_drop`, the
+   deepest fall a player at full health survives; below the safe fall it costs health in the
+   simulator) become one-way drop edges; lower floors first found this way are flooded too.
    **Wall nodes** (the project's addition, `wall_nodes`): where a node has no level move in a
    cardinal direction (a wall, a railing, a cliff edge, the face of a box it jumps onto), a node
    is added toward it, as close as the capsule allows, if the floor continues on the same level
@@ -17,16 +18,16 @@
    wall node. Players hug walls and wait at box faces: on the pure lattice such a position can
    be up to 0.7 m from every node (`decoy build-waypoints --check-esta` measures how many real
    positions each graph covers). Each node still has at most one edge per direction.
-3. **Verification.** A capsule is moved along every edge in pybullet, in steps of at most
-   0.1 m, floating the step height above the floor (as the simulator moves agents); an edge
-   along which it would penetrate the world is removed. First (before wall nodes are placed,
-   so that they stand against the final positions), a node where the capsule does not fit (a
-   lattice point that happens to lie too close to a wall) is moved up to 0.3 m to where it
-   fits, instead of being lost: without that, a quarter of the lattice's edges near walls die.
-   The capsule is 20% thinner than the CS:GO hull (radius 12.8 u, not 16 u): the nav world's
-   walls stand up to 16 u beyond the nav edge, often less where areas face each other across
-   narrow gaps, and the thinner capsule tolerates that approximation (with the full radius,
-   measurably fewer nodes end up in the largest strongly connected component).
+3. **Verification.** A capsule is moved along every edge in pybullet (a drop's fall included), in
+   steps of at most 0.1 m, floating the step height above the floor (as the simulator moves agents);
+   an edge along which it would penetrate the world is removed. First (before wall nodes are placed,
+   so that they stand against the final positions), a node where the capsule does not fit (a lattice
+   point that happens to lie too close to a wall) is moved up to 0.3 m to where it fits, instead of
+   being lost: without that, a quarter of the lattice's edges near walls die. The capsule is 20%
+   thinner than the CS:GO hull (radius 12.8 u, not 16 u): the nav world's walls stand up to 16 u
+   beyond the nav edge, often less where areas face each other across narrow gaps, and the thinner
+   capsule tolerates that approximation (with the full radius, measurably fewer nodes end up in the
+   largest strongly connected component).
 
 Then the graph is pruned to its largest strongly connected component (so an agent can always get
 back), manual waypoints are merged in, each node gets its nav place, and nodes are numbered in a

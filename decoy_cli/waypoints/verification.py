@@ -70,7 +70,8 @@ def verify_edges(
             base = np.full_like(t, max(src[e, 2], dst[e, 2]))
         elif kind[e] == EdgeKind.DROP:
             base = np.full_like(t, src[e, 2])
-            fall = np.linspace(src[e, 2], dst[e, 2], 4)[1:]
+            falls = max(1, int(np.ceil((src[e, 2] - dst[e, 2]) / params.verify_step)))
+            fall = np.linspace(src[e, 2], dst[e, 2], falls + 1)[1:]  # the fall, in as fine steps
             xy = np.vstack([xy, np.repeat(dst[e : e + 1, :2], len(fall), axis=0)])
             base = np.concatenate([base, fall])
         else:
