@@ -28,18 +28,10 @@ import sys
 import tarfile
 from pathlib import Path
 
+from decoy_cli.csgo import MAP_NAMES
+
 AWPY_VERSION = "1.3.1"
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
-ESTA_MAPS = (
-    "de_ancient",
-    "de_dust2",
-    "de_inferno",
-    "de_mirage",
-    "de_nuke",
-    "de_overpass",
-    "de_train",
-    "de_vertigo",
-)
 STANDARD_REGIONS = {
     "t_spawn": ["TSpawn"],
     "ct_spawn": ["CTSpawn"],
@@ -112,8 +104,8 @@ def main(sdist: Path) -> None:
     with tarfile.open(sdist) as archive:
         nav_rows = list(csv.DictReader(io.StringIO(_member(archive, "awpy/data/nav/nav_info.csv"))))
         map_data = json.loads(_member(archive, "awpy/data/map/map_data.json"))
-        links = {m: _member(archive, f"awpy/data/nav/{m}.txt") for m in ESTA_MAPS}
-    for map_name in ESTA_MAPS:
+        links = {m: _member(archive, f"awpy/data/nav/{m}.txt") for m in MAP_NAMES}
+    for map_name in MAP_NAMES:
         extract(map_name, nav_rows, links[map_name], map_data[map_name])
 
 
