@@ -122,6 +122,7 @@ class Simulator:
         self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
         self.goal_node = np.full(n, -1, dtype=np.int64)
         self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
+        self._fall_killed = False  # a landing killed since the outcome was last judged
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
         self.decisions = np.zeros(n, dtype=np.int64)
@@ -191,6 +192,7 @@ class Simulator:
 
     def _judge_and_announce(self) -> None:
         """Judge the outcome (`_judge`); a "round_end" event the moment there is one."""
+        self._fall_killed = False
         if self.outcome is not None:
             return
         self._judge()
@@ -352,12 +354,11 @@ class Simulator:
         at the last tick, is the same as stepping them at every tick."""
         ticks, moved = self.mover.glide(last - self.tick + 1)
         self.tick += ticks - 1
-        alive = self.agents.alive.sum()
         moving = self._moved(moved)
         self.events += self.rules.step(
             self.tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, moving
         )
-        if self.agents.alive.sum() != alive:  # a fall killed at the glide's last tick
+        if self._fall_killed:  # at the glide's last tick
             self._judge_and_announce()
 
     def _land(self, arrived: np.ndarray) -> None:
@@ -376,6 +377,7 @@ class Simulator:
             self.events.append(SimEvent(self.tick, "fall_damage", agent, data=data))
             if left == 0:
                 self.kill(agent, "fall")
+                self._fall_killed = True
 
     def _judge(self) -> None:
         """The outcome at this tick. It depends only on who is alive, the bomb's status and
