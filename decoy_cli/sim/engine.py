@@ -121,7 +121,9 @@ class Simulator:
         self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
         self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
         self.goal_node = np.full(n, -1, dtype=np.int64)
-        self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
+        self.fall_m = [0.0] * n  # depth of the damaging drop each agent is on (0: none)
+        self._falling = 0  # how many agents are on such a drop
+        self._edge_fall = graph.fall_m
         self._fall_killed = False  # a landing killed since the outcome was last judged
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
@@ -267,7 +269,7 @@ class Simulator:
         self.agents.position[agent] = self.graph.positions[node]
         self.agents.node[agent] = node
         self.goal_node[agent] = -1
-        self.fall_m[agent] = 0.0
+        self._set_fall(agent, 0.0)
         if agent != self._deciding:
             self.mover.clear_goal(agent)
             self.hold_until[agent] = 0
@@ -293,7 +295,7 @@ class Simulator:
             self.agents.hp[agent] = 0
             self.events.append(SimEvent(self.tick, "death", agent, data={"reason": reason}))
             self._kill(agent)
-        self.fall_m[agent] = 0.0
+        self._set_fall(agent, 0.0)
 
     # ---- internals ----------------------------------------------------------------------------
 
@@ -309,7 +311,7 @@ class Simulator:
         np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
         if moved.happened & ARRIVAL:
             note_arrivals(moved.arrived, agents.alive, agents.node, self.goal_node, self.waiting)
-            if self.fall_m.any():
+            if self._falling:
                 self._land(moved.arrived)
         if moved.happened & STUCK:
             for agent in np.flatnonzero(moved.stuck).tolist():
@@ -361,13 +363,20 @@ class Simulator:
         if self._fall_killed:  # at the glide's last tick
             self._judge_and_announce()
 
+    def _set_fall(self, agent: int, depth: float) -> None:
+        """Note the depth of the damaging drop an agent is on (0: none), keeping the count."""
+        self._falling += (depth > 0) - (self.fall_m[agent] > 0)
+        self.fall_m[agent] = depth
+
     def _land(self, arrived: np.ndarray) -> None:
         """Fall damage for the agents that arrived at the end of a drop deeper than the safe
         fall (`csgo.fall_damage`); a fall that takes the last health kills. Before the round's
         end only: afterwards nothing changes health."""
-        for agent in np.flatnonzero(arrived & (self.fall_m > 0)).tolist():
-            height = float(self.fall_m[agent])
-            self.fall_m[agent] = 0.0
+        for agent in np.flatnonzero(arrived).tolist():
+            height = self.fall_m[agent]
+            if not height:
+                continue
+            self._set_fall(agent, 0.0)
             damage = fall_damage(height)
             if self.outcome is not None or not damage or not self.agents.alive[agent]:
                 continue
@@ -419,7 +428,8 @@ class Simulator:
             self.decision_count += 1
             self.wants_plant[agent] = decision.plant
             self.wants_defuse[agent] = decision.defuse
-            self.fall_m[agent] = 0.0
+            if self.fall_m[agent]:
+                self._set_fall(agent, 0.0)
             if decision.action == STOP_ACTION:
                 self.mover.clear_goal(agent)
                 self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
@@ -440,7 +450,9 @@ class Simulator:
             )
             speed = top if decision.speed is None else min(float(decision.speed), top)
             self.goal_node[agent] = target
-            self.fall_m[agent] = self.graph.fall_m[edge]
+            depth = float(self._edge_fall[edge])
+            if depth:
+                self._set_fall(agent, depth)
             self.mover.set_goal(
                 agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
             )
