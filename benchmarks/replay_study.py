@@ -85,9 +85,11 @@ def main() -> None:
     print(f"unevaluated: {summary.unevaluated.to_dict('records')}")
     late = players["late_share"].to_numpy(dtype=float)
     p95 = players["late_p95_s"].to_numpy(dtype=float)
+    over = players["late_over_frame"].sum() / max(int(players["targets"].sum()), 1)
     print(
         f"\nlateness: share of targets late, mean over player-rounds {np.nanmean(late):.1%}; "
-        f"p95 lateness median {np.nanmedian(p95):.2f} s, p90 {np.nanpercentile(p95, 90):.2f} s"
+        f"p95 lateness median {np.nanmedian(p95):.2f} s, p90 {np.nanpercentile(p95, 90):.2f} s; "
+        f"targets reached more than 0.5 s late: {over:.2%} of {int(players['targets'].sum()):,}"
     )
     print(
         f"stuck episodes per round: mean {rounds['stuck'].mean():.2f}, "

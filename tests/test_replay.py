@@ -58,7 +58,9 @@ PLAYER_COLUMNS = (
     "died_original",
     "died_replay",
     "death",
+    "targets",
     "late_share",
+    "late_over_frame",
     "late_p95_s",
     "stuck",
     "recoveries",
@@ -249,6 +251,7 @@ def test_a_plan_twice_too_fast_runs_late_then_catches_up(timed: Timed) -> None:
     assert stand.max() <= 0.05
     row = result.lateness_table().iloc[DETOURER]
     assert row["late_max_s"] == pytest.approx(late.max())
+    assert row["late_over_frame"] == int(np.sum(late > 0.5 + 1e-9))
     assert row["late_share"] == pytest.approx(3 / TIMING_FRAMES)
 
 
@@ -530,6 +533,7 @@ def test_a_perfect_replay_of_a_standing_player_measures_the_snap_error(
         assert table.loc[1, name] == pytest.approx(0.0, abs=1e-9), name
     assert table.loc[0, "paper_rmse"] == pytest.approx(SNAP_OFFSET_M / math.sqrt(3), abs=1e-9)
     assert table[["late_share", "late_p95_s"]].to_numpy().tolist() == [[0.0, 0.0]] * 2
+    assert table["late_over_frame"].tolist() == [0, 0] and (table["targets"] == frames).all()
     assert table[["stuck", "recoveries", "relocations"]].to_numpy().sum() == 0
     assert table["reason"].isna().all()
 

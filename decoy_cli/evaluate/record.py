@@ -75,7 +75,15 @@ class RoundRecord(msgspec.Struct, frozen=True):
     hp: HpStats
 
 
-_REPLAY_COLUMNS = ("late_share", "late_p95_s", "stuck", "recoveries", "relocations")
+_REPLAY_COLUMNS = (
+    "targets",
+    "late_share",
+    "late_over_frame",
+    "late_p95_s",
+    "stuck",
+    "recoveries",
+    "relocations",
+)
 """Player columns taken as they are from `metrics.player_metrics`: timing and the mover's
 troubles."""
 

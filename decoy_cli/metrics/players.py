@@ -24,7 +24,9 @@ PLAYER_METRIC_COLUMNS = (
     "died_original",
     "died_replay",
     "death",
+    "targets",
     "late_share",
+    "late_over_frame",
     "late_p95_s",
     "stuck",
     "recoveries",
@@ -40,8 +42,9 @@ class ReplayTrace:
     `position` (F, P, 3) and `alive` (F, P) at the data's frame times; per player: whether the
     data shows a death (`died_original`), whether the replay removed the player at its data
     death time rather than by combat (`scripted_death`), the share of plan targets reached late
-    and the 95th percentile lateness in seconds (NaN when none was reached), stuck episodes,
-    recoveries (teleports) and relocations.
+    and the 95th percentile lateness in seconds (NaN when none was reached), the targets reached
+    and how many of them more than one data frame late, stuck episodes, recoveries (teleports)
+    and relocations.
     """
 
     position: np.ndarray
@@ -50,6 +53,8 @@ class ReplayTrace:
     scripted_death: np.ndarray
     late_share: np.ndarray
     late_p95_s: np.ndarray
+    targets: np.ndarray
+    late_over_frame: np.ndarray
     stuck: np.ndarray
     recoveries: np.ndarray
     relocations: np.ndarray
@@ -81,7 +86,9 @@ def player_metrics(round_: Round, trace: ReplayTrace, *, fastdtw: bool = False) 
                 "died_original": bool(trace.died_original[p]),
                 "died_replay": died_replay,
                 "death": death,
+                "targets": int(trace.targets[p]),
                 "late_share": float(trace.late_share[p]),
+                "late_over_frame": int(trace.late_over_frame[p]),
                 "late_p95_s": float(trace.late_p95_s[p]),
                 "stuck": int(trace.stuck[p]),
                 "recoveries": int(trace.recoveries[p]),

@@ -45,6 +45,10 @@ from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 from decoy_cli.world.physics import PhysicsWorld
 
+DATA_FRAME_S = 0.5
+"""One data frame of ESTA (2 frames per second): a target reached later than this is off by a
+whole frame of the data."""
+
 
 @dataclass
 class ReplayResult:
@@ -77,6 +81,8 @@ class ReplayResult:
             died_original=np.array([plan.death_frame >= 0 for plan in self.plan.plans], bool),
             scripted_death=self.scripted_death,
             late_share=lateness["late_share"].to_numpy(dtype=float),
+            targets=lateness["reached"].to_numpy(dtype=np.int64),
+            late_over_frame=lateness["late_over_frame"].to_numpy(dtype=np.int64),
             late_p95_s=lateness["late_p95_s"].to_numpy(dtype=float),
             stuck=self.stuck if self.stuck is not None else np.zeros(count, np.int64),
             recoveries=self.recoveries
@@ -86,7 +92,9 @@ class ReplayResult:
         )
 
     def lateness_table(self) -> pd.DataFrame:
-        """Per player: share of targets reached late, p95 and max lateness (s), relocations."""
+        """Per player: targets, those reached, the share reached late (after their tick), how
+        many more than one data frame late (`DATA_FRAME_S`), p95 and max lateness (s),
+        relocations."""
         rows = []
         for p, log in enumerate(self.logs):
             late = log.lateness_s
@@ -99,6 +107,7 @@ class ReplayResult:
                     "late_share": float(np.mean(reached > 1 / TICK_RATE + 1e-9))
                     if len(reached)
                     else np.nan,
+                    "late_over_frame": int(np.sum(reached > DATA_FRAME_S + 1e-9)),
                     "late_p95_s": float(np.percentile(reached, 95)) if len(reached) else np.nan,
                     "late_max_s": float(reached.max()) if len(reached) else np.nan,
                     "relocations": log.relocations,
