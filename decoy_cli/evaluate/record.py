@@ -17,6 +17,7 @@ import numpy as np
 from decoy_cli.esta import Round
 from decoy_cli.evaluate.settings import HeatGrid
 from decoy_cli.metrics import metric_names, player_metrics
+from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
 
 if TYPE_CHECKING:
@@ -75,18 +76,6 @@ class RoundRecord(msgspec.Struct, frozen=True):
     hp: HpStats
 
 
-_REPLAY_COLUMNS = (
-    "targets",
-    "late_share",
-    "late_over_frame",
-    "late_p95_s",
-    "stuck",
-    "recoveries",
-    "relocations",
-)
-"""Player columns taken as they are from `metrics.player_metrics`: timing and the mover's
-troubles."""
-
 PLAYER_COLUMNS = (
     "match",
     "round",
@@ -103,7 +92,7 @@ PLAYER_COLUMNS = (
     "hp_rmse",
     "hp_final_original",
     "hp_final_replay",
-    *_REPLAY_COLUMNS,
+    *REPLAY_COLUMNS,
 )
 """Columns of a player row before the trajectory metrics and `reason` (players.csv)."""
 
@@ -176,7 +165,7 @@ def build_record(
                 "hp_rmse": float(np.sqrt(np.mean(diff**2))) if len(known) else np.nan,
                 "hp_final_original": int(hp_o[p, known[-1]]) if len(known) else -1,
                 "hp_final_replay": int(hp_r[p, known[-1]]) if len(known) else -1,
-                **{name: row[name] for name in _REPLAY_COLUMNS},
+                **{name: row[name] for name in REPLAY_COLUMNS},
                 **{name: float(row[name]) for name in metric_names(settings.fastdtw)},
                 "reason": row["reason"],
             }

@@ -18,12 +18,7 @@ import pandas as pd
 from decoy_cli.esta import Round
 from decoy_cli.metrics.trajectory import trajectory_metrics
 
-PLAYER_METRIC_COLUMNS = (
-    "player",
-    "side",
-    "died_original",
-    "died_replay",
-    "death",
+REPLAY_COLUMNS = (
     "targets",
     "late_share",
     "late_over_frame",
@@ -32,6 +27,9 @@ PLAYER_METRIC_COLUMNS = (
     "recoveries",
     "relocations",
 )
+"""Timing and the mover's troubles, per player (from `ReplayTrace`)."""
+
+PLAYER_METRIC_COLUMNS = ("player", "side", "died_original", "died_replay", "death", *REPLAY_COLUMNS)
 """The columns of `player_metrics` before the ten trajectory metrics and `reason`."""
 
 
