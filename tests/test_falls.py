@@ -68,13 +68,14 @@ def cliff_edge(graph) -> int:
 
 
 def _round(graph, mover, hp: list[int], edge: int):
-    """Two agents on the source of `edge` walking it, and a CT far away; returns the sim."""
+    """Two agents on the source of `edge` walking it (health `hp`), and a CT far away (100);
+    returns the sim."""
     start = int(graph.edge_source[edge])
     direction = int(graph.edge_direction[edge])
     far = int(np.argmin(graph.positions[:, 0]))
     nodes = np.array([start, start, far])
     agents = Agents.create(
-        ["a", "b", "ct"], ["T", "T", "CT"], graph.positions[nodes], nodes, hp=np.array(hp)
+        ["a", "b", "ct"], ["T", "T", "CT"], graph.positions[nodes], nodes, hp=np.array([*hp, 100])
     )
     zones = SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]})  # nobody can plant
     plans = {0: [Decision(direction)], 1: [Decision(direction)]}
@@ -115,3 +116,20 @@ def test_a_fall_that_kills_the_last_t_ends_the_round_on_the_landing_tick(cliff) 
     assert sim.outcome is not None and sim.outcome.winner == "CT"
     end = next(e for e in sim.events if e.kind == "round_end")
     assert end.tick == land
+
+
+def test_stepping_and_running_land_alike(cliff) -> None:
+    """The event-by-event run crosses the fall in a glide; stepping every tick gives the same
+    landing, damage, death and end."""
+    _, graph = cliff
+    edge = cliff_edge(graph)
+    stepped = _round(graph, KinematicMover(), [40, 20], edge)
+    while not stepped.done:
+        stepped.step()
+    ran = _round(graph, KinematicMover(), [40, 20], edge)
+    ran.run()
+    assert [(e.tick, e.kind, e.agent) for e in ran.events] == [
+        (e.tick, e.kind, e.agent) for e in stepped.events
+    ]
+    assert ran.tick == stepped.tick and ran.outcome == stepped.outcome
+    np.testing.assert_array_equal(ran.agents.hp, stepped.agents.hp)

@@ -422,3 +422,10 @@ def test_a_relocation_from_outside_a_decision_asks_the_agent_again() -> None:
     assert policy.ticks_of(0) == [1, 6]
     sim.run(to_tick=6 + WALK_3)
     assert sim.agents.node[0] == 2  # walked west from node 3
+
+
+def test_agent_arrays_of_another_length_are_refused() -> None:
+    with pytest.raises(ValueError, match="2 hp for 3 agents"):
+        make_agents(["T", "T", "CT"], [0, 1, 5], hp=np.array([100, 100]))
+    with pytest.raises(ValueError, match="2 nodes for 3 agents"):
+        Agents.create(["a", "b", "c"], ["T", "T", "CT"], LINE.positions[[0, 1, 2]], [0, 1])

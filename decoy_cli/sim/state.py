@@ -50,6 +50,11 @@ class Agents:
         n = len(names)
         if len(sides) != n or any(s not in SIDES for s in sides):
             raise ValueError("every agent needs a side, 'T' or 'CT'")
+        given = {"nodes": nodes, "weapons": weapons, "hp": hp, "armor": armor}
+        given |= {"helmet": helmet, "has_defuser": has_defuser, "yaw": yaw}
+        for name, values in given.items():
+            if values is not None and len(values) != n:
+                raise ValueError(f"{len(values)} {name} for {n} agents")
         return cls(
             names=list(names),
             side=np.asarray(sides, dtype="<U2"),
