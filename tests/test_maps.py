@@ -19,8 +19,8 @@ from decoy_cli.errors import GraphError, WorldError
 from decoy_cli.esta import read_match
 from decoy_cli.sim import DecoyParallelEnv
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
-from decoy_cli.world.nav_data import read_navmesh
-from decoy_cli.world.navmesh import asset_dir
+from decoy_cli.world.nav_data import read_navmesh, read_patches
+from decoy_cli.world.navmesh import asset_dir, load_navmesh
 
 runner = CliRunner()
 WIDE = {"COLUMNS": "220"}
@@ -133,3 +133,22 @@ def test_a_nav_file_with_missing_corner_heights_is_one_error(
     (folder / "map.json").write_text("{}")
     with pytest.raises(WorldError, match="not a readable map folder"):
         read_navmesh(folder)
+
+
+@pytest.mark.parametrize(
+    ("row", "fragment"),
+    [
+        ("-364,1350,-259,,-69,-142,x", "line 3: a patch needs numbers"),
+        ("-364,1350,-259,1400,-142,-69,x", "line 3: an empty or upside-down box"),
+        ("90000,1350,90100,1400,-69,-142,x", "line 3: the box lies off the map's nav mesh"),
+    ],
+)
+def test_a_bad_patch_row_is_one_error_naming_file_and_line(
+    tmp_path: Path, row: str, fragment: str
+) -> None:
+    path = tmp_path / "world_patches.csv"
+    shipped = (asset_dir("de_dust2") / "world_patches.csv").read_text()
+    path.write_text(shipped.rstrip("\n") + "\n" + row + "\n")
+    with pytest.raises(WorldError, match=fragment):
+        read_patches(path, load_navmesh("de_dust2"))
+    assert len(read_patches(asset_dir("de_dust2") / "world_patches.csv", load_navmesh())) == 1

@@ -151,7 +151,39 @@ def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
     path = asset_dir(map_name) / "world_patches.csv"
     if not path.is_file():
         return np.zeros((0, 6))
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    keys = ("x_min", "y_min", "x_max", "y_max", "z_top", "z_bottom")
-    return np.array([[float(r[k]) for k in keys] for r in rows]).reshape(-1, 6)
+    return read_patches(path, load_navmesh(map_name))
+
+
+PATCH_COLUMNS = ("x_min", "y_min", "x_max", "y_max", "z_top", "z_bottom")
+
+PATCH_REACH_U = 512.0
+"""How far beyond the nav mesh's bounding box a patch may reach (Hammer units)."""
+
+
+def read_patches(path: Path, nav: NavMesh) -> np.ndarray:
+    """The boxes of a patches file (`PATCH_COLUMNS`, Hammer units); a WorldError naming the file
+    and line for a malformed row, an empty or upside-down box, or one off the map's nav mesh."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise WorldError(f"{path}: not a readable patches file ({error})") from None
+    low = np.array([nav.x_min.min(), nav.y_min.min(), nav.z_at_min.min()]) - PATCH_REACH_U
+    high = np.array([nav.x_max.max(), nav.y_max.max(), nav.z_at_max.max()]) + PATCH_REACH_U
+    boxes = np.zeros((len(rows), len(PATCH_COLUMNS)))
+    for line, row in enumerate(rows, start=2):
+        try:
+            box = np.array([float(row[key]) for key in PATCH_COLUMNS])
+        except (KeyError, TypeError, ValueError):
+            box = np.full(len(PATCH_COLUMNS), np.nan)
+        where = f"{path}, line {line}"
+        if not np.all(np.isfinite(box)):
+            raise WorldError(f"{where}: a patch needs numbers in {', '.join(PATCH_COLUMNS)}")
+        x0, y0, x1, y1, top, bottom = box
+        if not (x0 < x1 and y0 < y1 and bottom < top):
+            raise WorldError(f"{where}: an empty or upside-down box")
+        corners = np.array([[x0, y0, bottom], [x1, y1, top]])
+        if np.any(corners < low) or np.any(corners > high):
+            raise WorldError(f"{where}: the box lies off the map's nav mesh")
+        boxes[line - 2] = box
+    return boxes
