@@ -123,7 +123,6 @@ class Simulator:
         self.goal_node = np.full(n, -1, dtype=np.int64)
         self.fall_m = [0.0] * n  # depth of the damaging drop each agent is on (0: none)
         self._falling = 0  # how many agents are on such a drop
-        self._edge_fall = graph.fall_m
         self._fall_killed = False  # a landing killed since the outcome was last judged
         self.wants_plant = np.zeros(n, dtype=bool)
         self.wants_defuse = np.zeros(n, dtype=bool)
@@ -450,7 +449,7 @@ class Simulator:
             )
             speed = top if decision.speed is None else min(float(decision.speed), top)
             self.goal_node[agent] = target
-            depth = float(self._edge_fall[edge])
+            depth = float(self.graph.fall_m[edge])
             if depth:
                 self._set_fall(agent, depth)
             self.mover.set_goal(
