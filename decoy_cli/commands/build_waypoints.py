@@ -20,8 +20,11 @@ from decoy_cli.waypoints.coverage import NavCoverage, nav_coverage
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.waypoints.plot import plot_graph
 from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_aligned
+from decoy_cli.world import patch_learning
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
+from decoy_cli.world.physics import PhysicsWorld
+from decoy_cli.world.world import World
 
 DEFAULT_OUT = Path("decoy-out") / "waypoints"
 
@@ -74,10 +77,27 @@ def build_waypoints(
         "--min-aligned",
         help="With --check-esta: fail when fewer positions than this share snap within 0.5 m.",
     ),
+    learn_patches: Path | None = typer.Option(
+        None,
+        "--learn-patches",
+        help="ESTA file or folder: learn floor patches from where its players stand, write them "
+        "(--patches-out) and build on the nav world with them instead of the shipped ones.",
+    ),
+    patches_out: Path | None = typer.Option(
+        None, "--patches-out", help="Learned patches file (default: beside the graph)."
+    ),
+    min_matches: int = typer.Option(
+        patch_learning.MIN_MATCHES,
+        "--min-matches",
+        min=1,
+        help="Fewest matches a learned patch needs.",
+    ),
 ) -> None:
     """Build a waypoint graph: BFS lattice, drop pass, verification, pruning, manual points."""
     console = make_console()
     map_id = canonical_map(map_name)
+    if learn_patches is not None and mesh is not None:
+        raise GraphError("--learn-patches learns on the built-in nav world; leave out --mesh")
     if mesh is None:
         world = nav_world(map_id)
         name = map_id
@@ -93,6 +113,10 @@ def build_waypoints(
     check_writable(out)  # before the build's minutes
     if check_esta is not None:
         collect_match_files([check_esta])  # a missing or empty input fails now, not after
+    if learn_patches is not None:
+        patches_out = patches_out or out.with_suffix(".patches.csv")
+        check_writable(patches_out)
+        world = _learned_world(console, map_id, learn_patches, patches_out, min_matches)
     params = LatticeParams(spacing=spacing, wall_nodes=wall_nodes)
 
     started = time.perf_counter()
@@ -183,6 +207,28 @@ def build_waypoints(
         quality = alignment_quality(graph, result.pruned_positions, world, check_esta)
         _show_alignment(console, quality, check_esta)
         check_aligned(quality, min_aligned)
+
+
+def _learned_world(
+    console: Console, map_id: str, data: Path, patches_out: Path, min_matches: int
+) -> World:
+    """Learn patches from `data` on the bare nav world, write them, and return the nav world
+    with them (which the graph records, so replays use the same world)."""
+    files, _ = collect_match_files([data])
+    nav = load_navmesh(map_id)
+    standing = patch_learning.standing_positions(files, map_id, nav)
+    with PhysicsWorld(nav_world(map_id, ())) as physics:
+        boxes = patch_learning.learn_patches(standing, physics, nav, min_matches=min_matches)
+    patch_learning.write_patches(patches_out, boxes)
+    console.print(
+        f"learned {len({b.patch for b in boxes})} patches ({len(boxes)} boxes) from "
+        f"{len(standing.position):,} standing positions in {len(files)} matches; "
+        f"written to {patches_out}",
+        highlight=False,
+    )
+    return nav_world(
+        map_id, tuple((b.x_min, b.y_min, b.x_max, b.y_max, b.z_top, b.z_bottom) for b in boxes)
+    )
 
 
 def _show_coverage(console: Console, coverage: NavCoverage) -> None:

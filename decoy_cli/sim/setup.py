@@ -53,7 +53,7 @@ def check_mover(mover: str) -> str:
 class RoundSetup:
     """How rounds are simulated (see the module docstring).
 
-    `world` is the geometry for pybullet (None: the nav world of the graph's map); it is used
+    `world` is the geometry for pybullet (None: the nav world the graph was built on); it is used
     only when a client is opened here, not when the caller lends one. `rules` overrides the
     rules' durations and ranges (its `bomb_enabled` is replaced by `bomb`); `zones` the bomb
     sites (None: `SiteZones.from_graph`, the map's measured bomb-target boxes where known).
@@ -102,12 +102,10 @@ class RoundSetup:
 
     def open_physics(self) -> PhysicsWorld:
         """A new pybullet client holding this setup's world (the caller closes it)."""
-        from decoy_cli.world.navmesh import nav_world
+        from decoy_cli.waypoints.build import graph_world
         from decoy_cli.world.physics import PhysicsWorld
 
-        if self.world is not None:
-            return PhysicsWorld(self.world)
-        return PhysicsWorld(nav_world(self.map_name) if self.map_name else nav_world())
+        return PhysicsWorld(self.world if self.world is not None else graph_world(self.graph))
 
 
 OpenRound = Callable[..., AbstractContextManager[Simulator]]

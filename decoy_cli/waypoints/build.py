@@ -18,7 +18,7 @@ from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES
 from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
-from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh
+from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh, nav_world
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
@@ -122,6 +122,7 @@ def build_graph(
             "params": asdict(params),
             "seeds_m": np.round(seed_points, 6).tolist(),
             "manual_waypoints": 0 if manual is None else len(manual),
+            **({"patches": world.meta["patch_boxes"]} if "patch_boxes" in world.meta else {}),
             "stats": stats,
         },
     )
@@ -132,3 +133,13 @@ def build_graph(
 def builtin_graph(map_name: str = BUILTIN_MAP) -> WaypointGraph:
     """The waypoint graph shipped with the package for a built-in map (cached per process)."""
     return WaypointGraph.load(asset_dir(canonical_map(map_name)) / GRAPH_FILE)
+
+
+def graph_world(graph: WaypointGraph) -> World:
+    """The nav world a graph of a built-in map was built on: the map's shipped patches, or the
+    patches recorded in the graph (built with learned ones)."""
+    map_name = str(graph.meta.get("map", "")) or BUILTIN_MAP
+    boxes = graph.meta.get("patches")
+    if boxes is None:
+        return nav_world(map_name)
+    return nav_world(map_name, tuple(tuple(float(v) for v in box) for box in boxes))

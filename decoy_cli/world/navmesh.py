@@ -56,15 +56,28 @@ __all__ = [
 ]
 
 
+PatchBoxes = tuple[tuple[float, ...], ...]
+"""Patch boxes as `PATCH_COLUMNS` rows in Hammer units, hashable (a cache key)."""
+
+
 @cache
-def nav_world(map_name: str = BUILTIN_MAP) -> World:
-    """The built-in triangle world of a map, in metres (cached per process)."""
+def nav_world(map_name: str = BUILTIN_MAP, patches: PatchBoxes | None = None) -> World:
+    """The built-in triangle world of a map, in metres (cached per process), with the map's
+    shipped patches, or with `patches` instead (`()`: the bare nav world, as patches are
+    learned on)."""
     nav = load_navmesh(map_name)
-    boxes = [box_triangles(*b) for b in load_patches(map_name)]
+    shipped = load_patches(map_name) if patches is None else np.array(patches).reshape(-1, 6)
+    boxes = [box_triangles(*b) for b in shipped]
     tris = np.concatenate([build_nav_triangles(nav), *boxes]) * HAMMER_TO_M
     return World(
         triangles=tris,
         name=map_name,
         source=f"built-in {map_name} nav mesh (awpy 1.3.1)",
-        meta={"kind": "navmesh", "areas": nav.num_areas, "patches": len(boxes)},
+        meta={
+            "kind": "navmesh",
+            "areas": nav.num_areas,
+            "patches": len(boxes),
+            # given patches travel with a graph built on this world (graph_world reads them)
+            **({} if patches is None else {"patch_boxes": [list(b) for b in patches]}),
+        },
     )
