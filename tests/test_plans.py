@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from decoy_cli.csgo import GRAVITY_M_S2
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.replay import (
     RELOCATE_ACTION,
@@ -22,7 +23,13 @@ from decoy_cli.replay import (
     snap_positions,
     snap_round,
 )
-from decoy_cli.waypoints.graph import DIRECTION_VECTORS, STOP_ACTION, EdgeKind, WaypointGraph
+from decoy_cli.waypoints.graph import (
+    DIRECTION_VECTORS,
+    RUN_SPEED_M_S,
+    STOP_ACTION,
+    EdgeKind,
+    WaypointGraph,
+)
 
 SPACING = 0.7
 KNIFE_M_S = 250 * 0.01905  # 4.7625
@@ -268,7 +275,24 @@ def test_unreachable_target_is_recorded_and_relocated() -> None:
     assert plan.action_deadline_s.tolist() == [1.0, 2.0, 3.0]
     check_action_chain(graph, plan)
     assert plan.total_length_m == pytest.approx(graph.edge_length[plan.action_edge[0]] + 0.7)
-    assert plan.worst_ratio == pytest.approx(math.hypot(0.7, 2.0) / KNIFE_M_S)  # the drop
+    # the drop: 2 m of fall take sqrt(2 h / g) without headway, so the 0.7 m run has the rest
+    fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
+    assert plan.worst_ratio == pytest.approx(math.hypot(0.7, 2.0) / (1.0 - fall_s) / KNIFE_M_S)
+    assert plan.action_duration_s[0] == pytest.approx(1.0)
+
+
+def test_an_interval_is_shared_by_air_time_first_then_by_length() -> None:
+    graph = with_drop()
+    plan = plan_for(graph, at(10, 7, 8, graph=graph), seconds=[0.0, 2.0, 3.0])
+    fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
+    assert plan.action_duration_s[0] == pytest.approx(2.0)
+    assert plan.interval_required_speed_m_s[0] == pytest.approx(
+        graph.edge_length[plan.action_edge[0]] / (2.0 - fall_s)
+    )
+    assert graph.edge_air_s[plan.action_edge[0]] == pytest.approx(fall_s)
+    assert graph.edge_cost[plan.action_edge[0]] == pytest.approx(
+        graph.edge_length[plan.action_edge[0]] + RUN_SPEED_M_S * fall_s
+    )
 
 
 def test_standing_still_ten_seconds_is_ten_seconds_of_stop() -> None:

@@ -23,6 +23,7 @@ from decoy_cli.cli import app
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.esta import read_match
 from decoy_cli.metrics import METRIC_NAMES
+from decoy_cli.replay.plans import MIN_RUN_S, PathCache
 from decoy_cli.replay.snapping import SnapStatus
 from decoy_cli.replay.study import (
     INTERVAL_COLUMNS,
@@ -60,7 +61,7 @@ def _walks(count: int, frames: int) -> list[np.ndarray]:
 
 
 def _far_node(node: int) -> int:
-    """A waypoint about `JUMP_M` metres of path away from `node`."""
+    """A waypoint about `JUMP_M` metres of path cost (`edge_cost`) away from `node`."""
     dist, _ = builtin_graph().path_lengths(node)
     return int(np.argmin(np.abs(np.where(np.isfinite(dist), dist, np.inf) - JUMP_M)))
 
@@ -123,8 +124,13 @@ def test_study_round_finds_the_planted_defects(match_file: Path) -> None:
     jump = two.intervals.iloc[0]
     assert list(two.intervals.columns) == list(INTERVAL_COLUMNS)
     assert (jump["player"], jump["start_frame"], jump["end_frame"]) == ("t2", 3, 4)
-    assert jump["length_m"] == pytest.approx(JUMP_M, abs=0.8)
-    assert jump["ratio"] == pytest.approx(jump["length_m"] / 0.5 / jump["max_m_s"])
+    graph = builtin_graph()
+    edges = PathCache(graph).edges(int(jump["from_node"]), int(jump["to_node"]))
+    assert edges is not None
+    assert jump["length_m"] == pytest.approx(graph.edge_length[edges].sum())
+    assert graph.edge_cost[edges].sum() == pytest.approx(JUMP_M, abs=0.8)
+    running_s = max(0.5 - graph.edge_air_s[edges].sum(), MIN_RUN_S)  # no headway in the air
+    assert jump["ratio"] == pytest.approx(jump["length_m"] / running_s / jump["max_m_s"])
     assert jump["original_m_s"] > jump["max_m_s"]  # the data itself teleports
     assert _row(two.rows, "t4")["path_length_m"] == 0.0
 

@@ -45,6 +45,10 @@ ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
 RATIO_TOLERANCE = 1e-9
 """An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
 
+MIN_RUN_S = 1.0 / 64
+"""Shortest running time an interval is given (one tick) when its jumps and falls alone take
+all of it: the required speed is then very large, not infinite."""
+
 
 class PathCache:
     """Shortest paths between waypoint pairs on one graph, each pair computed once.
@@ -57,7 +61,7 @@ class PathCache:
         self.graph = graph
         # Edge lookup by (source, target): keys sorted, the shortest edge first among duplicates.
         keys = graph.edge_source.astype(np.int64) * graph.num_nodes + graph.edge_target
-        order = np.lexsort((graph.edge_length, keys))
+        order = np.lexsort((graph.edge_cost, keys))
         self._keys = keys[order]
         self._edge_ids = order
         self._paths: dict[tuple[int, int], np.ndarray | None] = {}
@@ -256,6 +260,7 @@ def build_plan(
     max_speed = _max_speeds(weapons[target_frame[:-1]])
 
     length = np.zeros(count)
+    air = np.zeros(count)  # seconds rising or falling, without headway (graph.edge_air_s)
     unreachable = np.zeros(count, dtype=bool)
     path_parts = [target_node[:1]]
     path_interval_parts = [np.full(len(target_node[:1]), -1, dtype=np.int64)]
@@ -277,18 +282,21 @@ def build_plan(
             duration_parts.append(np.array([dt]))
         else:
             edge_length = graph.edge_length[edges]
+            edge_air = graph.edge_air_s[edges]
             length[k] = edge_length.sum()
+            air[k] = edge_air.sum()
             step_nodes = graph.edge_target[edges].astype(np.int64)
             act_parts.append(graph.edge_direction[edges].astype(np.int8))
             edge_parts.append(edges.astype(np.int64))
-            duration_parts.append(dt * edge_length / length[k])
+            duration_parts.append(_edge_durations(dt, edge_length, edge_air))
         path_parts.append(step_nodes)
         path_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
         act_node_parts.append(step_nodes)
         act_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
 
     with np.errstate(divide="ignore", invalid="ignore"):
-        required = np.where(length == 0, 0.0, length / interval_seconds)
+        running = np.maximum(interval_seconds - air, MIN_RUN_S)
+        required = np.where(length == 0, 0.0, length / running)
     ratio = required / max_speed
     path_interval = np.concatenate(path_interval_parts)
     action_interval = _concat(act_interval_parts, np.int64)
@@ -343,3 +351,12 @@ def _fate(alive: np.ndarray, present: np.ndarray) -> tuple[int, int]:
 def _concat(parts: list[np.ndarray], dtype: type) -> np.ndarray:
     """Concatenate per-interval arrays (none for a plan without intervals)."""
     return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
+
+
+def _edge_durations(seconds: float, length: np.ndarray, air: np.ndarray) -> np.ndarray:
+    """An interval's seconds shared among its edges: each edge's time in the air, and the rest
+    by length, run at one speed (all of it by air time when the air time alone exceeds it)."""
+    total_air = float(air.sum())
+    if total_air > 0 and seconds <= total_air:
+        return seconds * air / total_air
+    return air + (seconds - total_air) * length / float(length.sum())

@@ -19,7 +19,7 @@ from decoy_cli.replay.bomb import FOREVER, DataPlant
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.state import BombStatus
-from decoy_cli.waypoints.graph import STOP_ACTION
+from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 
 
 @dataclass
@@ -48,7 +48,7 @@ class PlanPolicy:
         self,
         plans: list[PlayerPlan],
         tick_of: Callable[[float], int],
-        graph_edge_length: np.ndarray,
+        graph: WaypointGraph,
         plant: DataPlant | None = None,
         defuse_window: dict[int, tuple[int, int]] | None = None,
         interval_caps: list[np.ndarray] | None = None,
@@ -63,6 +63,7 @@ class PlanPolicy:
         # per plan and action: path length of this and the later moves of its interval, and
         # whether it is the last move of its interval
         self._remaining = []
+        self._remaining_air = []  # seconds of those moves spent rising or falling
         self._last_move = []
         for plan in plans:
             n_targets = len(plan.target_node)
@@ -72,23 +73,28 @@ class PlanPolicy:
             self.logs.append(
                 AgentLog(arrival, np.array([tick_of(s) for s in plan.target_seconds], np.int64))
             )
-            lengths = np.where(
-                plan.action_edge >= 0, graph_edge_length[np.maximum(plan.action_edge, 0)], 0.0
-            )
+            moves = plan.action_edge >= 0
+            edge = np.maximum(plan.action_edge, 0)
+            lengths = np.where(moves, graph.edge_length[edge], 0.0)
+            airs = np.where(moves, graph.edge_air_s[edge], 0.0)
             remaining = np.zeros(len(plan.action))
+            remaining_air = np.zeros(len(plan.action))
             last_move = np.zeros(len(plan.action), dtype=bool)
-            running = 0.0
+            running = running_air = 0.0
             seen: set[int] = set()
             for a in range(len(plan.action) - 1, -1, -1):
                 interval = int(plan.action_interval[a])
                 if a == len(plan.action) - 1 or plan.action_interval[a + 1] != interval:
-                    running = 0.0
+                    running = running_air = 0.0
                 running += lengths[a]
+                running_air += airs[a]
                 remaining[a] = running
+                remaining_air[a] = running_air
                 if plan.action_edge[a] >= 0 and interval not in seen:
                     last_move[a] = True
                     seen.add(interval)
             self._remaining.append(remaining)
+            self._remaining_air.append(remaining_air)
             self._last_move.append(last_move)
 
     def decide(self, sim: Simulator, agent: int) -> Decision:
@@ -170,7 +176,7 @@ class PlanPolicy:
             if self._plants_here(sim, agent, interval):
                 self.next_action[agent] = a - 1  # the move waits until the plant completes
                 return Decision(STOP_ACTION, hold_ticks=1, plant=True)
-            seconds_left = (deadline - now) / TICK_RATE
+            seconds_left = (deadline - now) / TICK_RATE - self._remaining_air[agent][a - 1]
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)

@@ -229,7 +229,7 @@ def replay_round(
     defuse = defuse_windows(bomb) if bomb is not None else {}
 
     caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
-    policy = PlanPolicy(plan.plans, tick_at, graph.edge_length, plant, defuse, caps)
+    policy = PlanPolicy(plan.plans, tick_at, graph, plant, defuse, caps)
     start_tick = int(frame_ticks[0])
     scripted = np.zeros(n, dtype=bool)
     weapon_frames = np.asarray(round_.weapon)

@@ -7,7 +7,8 @@ simulator directly. Queries:
 * `nearest(points)`: floor-aware nearest waypoint, vectorised. The search runs in a space whose
   z axis is stretched, and a candidate must lie within a vertical band around the query, so a
   player on the upper floor of a two-floor spot never snaps to the floor below (or above).
-* `shortest_path(a, b)` / `path_lengths(a)`: Dijkstra on edge lengths over the directed graph.
+* `shortest_path(a, b)` / `path_lengths(a)`: Dijkstra on edge costs (`edge_cost`: length plus
+  time in the air) over the directed graph.
 
 Compass directions are numbered clockwise from north (N = +y, E = +x): 0 N, 1 NE, 2 E, 3 SE,
 4 S, 5 SW, 6 W, 7 NW. These are also the paper's 8 move actions; action 8 is STOP.
@@ -29,9 +30,10 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from decoy_cli.csgo import SAFE_DROP_M
+from decoy_cli.csgo import GRAVITY_M_S2, HAMMER_TO_M, JUMP_SPEED_M_S, SAFE_DROP_M
 from decoy_cli.errors import GraphError
 from decoy_cli.files import write_atomic
+from decoy_cli.weapons import KNIFE_SPEED
 
 FORMAT_VERSION = 1
 """Version of the graph file; bump when the arrays or their meaning change."""
@@ -64,6 +66,9 @@ SNAP_MAX_BELOW_M = 1.25
 AIRBORNE_M = 0.4
 """Height above the world's floor from which a position counts as in the air (a jump or a
 fall; a crouch-jump rises 1.2 m, players on the nav world's floors stand within centimetres)."""
+RUN_SPEED_M_S = KNIFE_SPEED * HAMMER_TO_M
+"""The speed that turns seconds in the air into metres of path cost: running with the knife."""
+
 _Z_STRETCH = 4.0
 _CANDIDATES = 12
 
@@ -107,10 +112,32 @@ class WaypointGraph:
         return np.where(damaging, depth, 0.0)
 
     @cached_property
+    def edge_air_s(self) -> np.ndarray:
+        """(E,) seconds of each edge spent rising or falling, when an agent makes no headway:
+        the movers rise straight up onto a jump edge's height (at least the jump's take-off
+        speed) and fall straight down at a drop's end, under sv_gravity."""
+        dz = self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
+        up = (self.edge_kind == EdgeKind.JUMP) & (dz > 0)
+        down = np.isin(self.edge_kind, (EdgeKind.JUMP, EdgeKind.DROP)) & (dz < 0)
+        rise = np.maximum(dz, 0.0)
+        take_off = np.maximum(JUMP_SPEED_M_S, np.sqrt(2 * GRAVITY_M_S2 * rise))
+        rise_s = (take_off - np.sqrt(np.maximum(take_off**2 - 2 * GRAVITY_M_S2 * rise, 0.0))) / (
+            GRAVITY_M_S2
+        )
+        fall_s = np.sqrt(2 * np.maximum(-dz, 0.0) / GRAVITY_M_S2)
+        return np.where(up, rise_s, np.where(down, fall_s, 0.0))
+
+    @cached_property
+    def edge_cost(self) -> np.ndarray:
+        """(E,) what an edge costs a running agent, in metres: its length plus the distance it
+        would have run (at knife speed) in the time it spends rising or falling."""
+        return self.edge_length + RUN_SPEED_M_S * self.edge_air_s
+
+    @cached_property
     def adjacency(self) -> csr_matrix:
-        """Sparse (N, N) matrix of edge lengths, for scipy's graph routines."""
+        """Sparse (N, N) matrix of edge costs (`edge_cost`), for scipy's graph routines."""
         return csr_matrix(
-            (self.edge_length, (self.edge_source, self.edge_target)),
+            (self.edge_cost, (self.edge_source, self.edge_target)),
             shape=(self.num_nodes, self.num_nodes),
         )
 
@@ -174,7 +201,8 @@ class WaypointGraph:
     # ---- shortest paths ---------------------------------------------------------------------
 
     def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
-        """Dijkstra from one node: (distance to every node, predecessor of every node)."""
+        """Dijkstra from one node: (path cost, `edge_cost`, to every node; predecessor of every
+        node)."""
         dist, pred = dijkstra(
             self.adjacency, directed=True, indices=source, return_predecessors=True
         )
