@@ -661,3 +661,31 @@ def test_the_round_clock_is_the_games_whatever_rate_the_file_wrote_seconds_at(
     assert played.clock is not None and played.clock.zero_tick == pytest.approx(ROUND2_FREEZE_END)
     events = played.bomb_events
     assert np.allclose(events["seconds"], (events["tick"].astype(float) - ROUND2_FREEZE_END) / 128)
+
+
+def test_vertical_speed_in_metres_per_second_nan_where_null(tmp_path: Path) -> None:
+    document = make_match()
+    frames = document["gameRounds"][0]["frames"]
+    name = frames[1]["t"]["players"][0]["name"]
+    for frame, value in ((1, -250.0), (2, None)):  # player order changes from frame to frame
+        for player in frames[frame]["t"]["players"]:
+            if player["name"] == name:
+                player["velocityZ"] = value
+    played = read_match(write_match(tmp_path / "m.json.xz", document)).round(1)
+    row = [p.name for p in played.players].index(name)
+    assert played.vertical_speed[row, 1] == pytest.approx(-250.0 * HAMMER_TO_M)
+    assert np.isnan(played.vertical_speed[row, 2])
+    assert played.vertical_speed[row, 0] == 0.0  # on the ground
+    missing = [p.name for p in played.players].index(MISSING_CT[0])
+    assert np.isnan(played.vertical_speed[missing, MISSING_CT[2]])
+
+
+@pytest.mark.parametrize("value", [1e9, -4000.0])
+def test_a_vertical_speed_beyond_the_engine_cap_fails_the_round(
+    tmp_path: Path, value: float
+) -> None:
+    document = make_match()
+    document["gameRounds"][0]["frames"][1]["t"]["players"][0]["velocityZ"] = value
+    match = read_match(write_match(tmp_path / "m.json.xz", document))
+    assert 1 not in [r.round_num for r in match.rounds]
+    assert "velocityZ" in str(match.round_errors[1])

@@ -113,9 +113,23 @@ def test_positions_within_a_step_of_the_floor_need_no_patch() -> None:
     assert learned(on_a_surface(matches=3, top_u=12.0)) == []
 
 
-def test_a_surface_a_player_could_walk_under_is_a_slab() -> None:
-    boxes = learned(on_a_surface(matches=3, top_u=200.0))
-    assert boxes and all(b.z_bottom == 200.0 - SLAB_U for b in boxes)
+def test_a_surface_players_stood_under_is_a_slab_and_one_no_one_did_is_solid() -> None:
+    high = on_a_surface(matches=3, top_u=200.0)
+    assert learned(high) and all(b.z_bottom == 0.0 for b in learned(high))
+    below = on_a_surface(matches=3, top_u=0.0)
+    walkway = StandingPositions(
+        position=np.concatenate([high.position, below.position[::8]]),
+        match=np.concatenate([high.match, below.match[::8]]),
+        files=high.files,
+    )
+    boxes = learned(walkway)
+    assert boxes and any(b.z_bottom == 200.0 - SLAB_U for b in boxes)
+
+
+def test_a_sloping_surface_is_not_a_box() -> None:
+    ramp = on_a_surface(matches=3, top_u=40.0)
+    ramp.position[:, 2] += (ramp.position[:, 0] - 500.0) * 0.5  # rises 48 u over 96 u
+    assert learned(ramp) == []
 
 
 def test_where_more_players_stood_below_than_on_top_there_is_no_box() -> None:
@@ -144,28 +158,41 @@ def test_the_written_file_is_what_the_world_reads(tmp_path: Path) -> None:
 # ---- the standing rule and bad input, on ESTA files in the real format ------------------------
 
 
-def match_with_heights(heights: dict[str, list[float]]) -> dict:
-    """The fixture match with the z of some T players in round 2 replaced, frame by frame."""
+def match_with_heights(
+    heights: dict[str, list[float]], vertical: dict[str, list[float | None]]
+) -> dict:
+    """The fixture match with the z and velocityZ of some T players in round 2 replaced, frame
+    by frame."""
     document = make_match()
-    for frame in document["gameRounds"][1]["frames"]:
-        index = document["gameRounds"][1]["frames"].index(frame)
+    for index, frame in enumerate(document["gameRounds"][1]["frames"]):
         for player in frame["t"]["players"]:
             if player["name"] in heights:
                 player["z"] = heights[player["name"]][index]
+                player["velocityZ"] = vertical[player["name"]][index]
     return document
 
 
-def test_a_jump_arc_is_not_standing_and_a_steady_height_is(tmp_path: Path) -> None:
-    arc = [10.0, 45.5, 62.5, 47.5, 11.0, 0.0]  # 2 frames per second: never steady
-    steady = [77.5] * 6
-    t_names = [name for name, _ in T_PLAYERS]
-    path = write_match(
-        tmp_path / "m.json.xz", match_with_heights({t_names[0]: arc, t_names[1]: steady})
-    )
+ARC_U = [10.0, 45.5, 62.5, 47.5, 11.0, 0.0]
+"""A jump lasting longer than the frames' half second: in the air in frames 1 to 3."""
+ARC_VZ = [0.0, 180.2, 20.5, -150.3, 0.0, 0.0]
+STEADY_HEIGHT_U = 77.5
+
+
+@pytest.mark.parametrize("with_velocity", [True, False], ids=["velocityZ", "no velocityZ"])
+def test_a_jump_arc_is_not_standing_and_a_steady_height_is(
+    tmp_path: Path, with_velocity: bool
+) -> None:
+    first, second = (name for name, _ in T_PLAYERS[:2])
+    vertical: dict[str, list[float | None]] = {
+        first: list(ARC_VZ) if with_velocity else [None] * 6,
+        second: [0.0] * 6 if with_velocity else [None] * 6,
+    }
+    document = match_with_heights({first: ARC_U, second: [STEADY_HEIGHT_U] * 6}, vertical)
+    path = write_match(tmp_path / "m.json.xz", document)
     standing = standing_positions([path], "de_dust2", load_navmesh("de_dust2"))
     heights = standing.position[:, 2]
-    assert not np.isin(arc[1:4], heights).any()
-    assert np.sum(heights == 77.5) == 6
+    assert not np.isin(ARC_U[1:4], heights).any()
+    assert np.sum(heights == STEADY_HEIGHT_U) == 6
 
 
 def test_a_match_of_another_map_is_an_error_naming_the_file(tmp_path: Path) -> None:

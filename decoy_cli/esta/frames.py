@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M, MAX_VELOCITY_M_S
 from decoy_cli.esta.schema import FrameState, Invalid, PlayerState, TeamState
 from decoy_cli.weapons import is_known
 
@@ -79,6 +79,7 @@ class FrameArrays:
     alive: np.ndarray
     present: np.ndarray
     has_bomb: np.ndarray
+    vertical_speed: np.ndarray
     bomb_position: np.ndarray
     bomb_planted: np.ndarray
     bombsite: np.ndarray
@@ -321,7 +322,23 @@ def _players(
         alive=scatter(alive, False, bool),
         present=scatter(np.ones(len(entries), dtype=bool), False, bool),
         has_bomb=scatter(np.array([pl.hasBomb is True for pl in entries], bool), False, bool),
+        vertical_speed=scatter(_vertical_speed(entries, ticks, frame_idx), np.nan, np.float64),
     )
+
+
+def _vertical_speed(
+    entries: list[PlayerState], ticks: np.ndarray, frame_idx: np.ndarray
+) -> np.ndarray:
+    """awpy's `velocityZ` in m/s (NaN where null: not every export has it); 0 on the ground,
+    where the Source engine keeps no vertical velocity."""
+    values = np.array(
+        [np.nan if pl.velocityZ is None else pl.velocityZ for pl in entries], dtype=np.float64
+    )
+    bad = ~np.isnan(values) & ~(np.abs(values) * HAMMER_TO_M <= MAX_VELOCITY_M_S)
+    if bad.any():
+        e = int(np.flatnonzero(bad)[0])
+        raise Invalid(f"{_where(ticks, int(frame_idx[e]))}: velocityZ {values[e]} is not a speed")
+    return values * HAMMER_TO_M
 
 
 def _check_unique(

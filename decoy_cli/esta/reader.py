@@ -92,6 +92,8 @@ class Round:
     alive: np.ndarray
     present: np.ndarray
     has_bomb: np.ndarray
+    vertical_speed: np.ndarray
+    """(P, F) float64 awpy's `velocityZ` in m/s: 0 on the ground, NaN where absent or null."""
     bomb_position: np.ndarray
     bomb_planted: np.ndarray
     bombsite: np.ndarray
@@ -300,6 +302,7 @@ def _build_round(
         alive=arrays.alive,
         present=arrays.present,
         has_bomb=arrays.has_bomb,
+        vertical_speed=arrays.vertical_speed,
         bomb_position=arrays.bomb_position,
         bomb_planted=arrays.bomb_planted,
         bombsite=arrays.bombsite,

@@ -37,6 +37,7 @@ class PlayerState(msgspec.Struct):
     x: float | None = None
     y: float | None = None
     z: float | None = None
+    velocityZ: float | None = None
     viewX: float | None = None
     hp: float | None = None
     armor: float | None = None

@@ -7,19 +7,26 @@ file the world already reads (`world_patches.csv`), each row with its evidence.
 
 Method:
 
-1. **Standing positions.** An alive position is standing when the same player's height stays
-   within `STEADY_U` over consecutive frames spanning at least `STEADY_S`; a jump or a fall
-   changes height faster than that (a CS:GO jump is in the air for about 0.7 s).
+1. **Standing positions.** An alive position on the ground: awpy's `velocityZ` is 0 (the
+   Source engine keeps no vertical velocity on the ground). Where a file has no `velocityZ`,
+   the same player's height must stay within `STEADY_U` over consecutive frames spanning at
+   least `STEADY_S`; a jump or a fall changes height faster than that (a CS:GO jump is in the
+   air for about 0.7 s).
 2. **Raised.** The first floor of the nav world below the position (a ray down from a step above
    the feet, so a floor fitted a few units too high still counts as under the player) lies more
    than a step (sv_stepsize, 18 u) below: the player stands on something the nav mesh lacks.
 3. **Clusters.** Raised standing positions are binned in `CELL_U` columns and `LAYER_U` layers;
    touching bins form one surface. A surface becomes a patch when it has at least
    `MIN_SAMPLES` positions from at least `min_matches` matches (one match can be one player's
-   habit, or a glitch).
+   habit, or a glitch) and is flat (`MAX_SPREAD_U`): a sloping surface is uneven ground that the
+   nav mesh fits too low, which a box would turn into a cliff.
 4. **Boxes.** Each column of a patch is solid from the floor under it up to the median standing
    height there, unless more players stood on the floor below inside that column than on top
-   (a passage under a ledge, not a box). Columns of equal height are merged into rectangles.
+   (a passage under a ledge, not a box); where some players stood below with room to stand, it
+   is a slab `SLAB_U` thick (a walkway). Gaps between columns are closed, and the patch grows
+   by one column all round where no one stood below: players' centres stay up to half a hull
+   from a surface's edge, so the surface reaches past them. Columns of equal height are merged
+   into rectangles.
 
 Positions are read in Hammer units here (the nav mesh's units); the world is in metres.
 """
@@ -66,6 +73,10 @@ LAYER_U = 16.0
 
 MAX_HEIGHT_U = 256.0
 """Highest surface above the floor below that is learned (Hammer units)."""
+
+MAX_SPREAD_U = 4.0
+"""Largest height spread (10th to 90th percentile) of a learned surface: boxes and ledges are
+flat (Hammer units)."""
 
 MIN_SAMPLES = 10
 """Fewest standing positions a patch needs."""
@@ -147,7 +158,9 @@ def _match_standing(match: Match) -> np.ndarray:
     for round_ in match.rounds:
         z = round_.position[..., 2] / HAMMER_TO_M
         ok = round_.alive & np.isfinite(round_.position).all(axis=-1)
-        standing = _steady(np.where(ok, z, np.nan), round_.frame_seconds) & ok
+        vz = round_.vertical_speed
+        steady = _steady(np.where(ok, z, np.nan), round_.frame_seconds)
+        standing = np.where(np.isnan(vz), steady, vz == 0) & ok
         found.append(round_.position[standing] / HAMMER_TO_M)
     return np.concatenate(found) if found else np.zeros((0, 3))
 
@@ -273,6 +286,8 @@ def _boxes(
         if len(rows) < MIN_SAMPLES or matches < min_matches:
             continue
         z = standing.position[rows, 2]
+        if np.percentile(z, 90) - np.percentile(z, 10) > MAX_SPREAD_U:
+            continue  # not flat: uneven ground the nav mesh fits too low, not a box
         columns = _columns(cells[rows], z, floor[rows], ground)
         if not columns:
             continue
@@ -303,11 +318,12 @@ def _columns(
         mine = (cells[:, 0] == key[0]) & (cells[:, 1] == key[1])
         top = float(np.round(np.median(z[mine])))
         bottom = float(np.floor(np.min(floor[mine])))
-        if top - bottom > PLAYER_HEIGHT_U + SLAB_U:
-            bottom = top - SLAB_U  # a player fits below: a walkway's edge, not a box
         below = ground.get(key, np.zeros(0))
-        if np.sum((below < top - STEP_U) & (below > bottom - STEP_U)) >= mine.sum():
+        under = int(np.sum((below < top - STEP_U) & (below > bottom - STEP_U)))
+        if under >= mine.sum():
             continue  # more players stood under it than on it: a passage, not a box
+        if under and top - bottom > PLAYER_HEIGHT_U + SLAB_U:
+            bottom = top - SLAB_U  # players stood under it: a walkway, not a box
         columns[key] = (top, bottom)
     return _fill_gaps(columns, ground)
 
@@ -341,34 +357,36 @@ def _fill_gaps(
 def _rectangles(
     columns: dict[tuple[int, int], tuple[float, float]],
 ) -> list[tuple[float, float, float, float, float, float]]:
-    """Columns of equal top merged into rectangles: runs along x, then equal runs along y."""
-    runs: dict[tuple[int, int, float], list[tuple[int, float]]] = {}
-    for top in sorted({t for t, _ in columns.values()}):
-        level = sorted((j, i) for (i, j), (t, _) in columns.items() if t == top)
-        for j in sorted({j for j, _ in level}):
-            xs = [i for jj, i in level if jj == j]
-            start = prev = xs[0]
-            for i in [*xs[1:], None]:
-                if i is not None and i == prev + 1:
-                    prev = i
-                    continue
-                bottom = min(columns[(k, j)][1] for k in range(start, prev + 1))
-                runs.setdefault((start, prev, top), []).append((j, bottom))
-                if i is not None:
-                    start = prev = i
+    """Columns of equal top, and alike solid or slab, merged into rectangles (runs along x,
+    then equal runs along y); a merged solid box reaches down to its lowest column's floor."""
+    groups: dict[tuple[float, bool], list[tuple[int, int]]] = {}
+    for (i, j), (top, bottom) in columns.items():
+        groups.setdefault((top, bottom == top - SLAB_U), []).append((j, i))
     out = []
-    for (i0, i1, top), rows in runs.items():
-        rows.sort()
-        first = 0
-        for k in range(1, len(rows) + 1):
-            if k < len(rows) and rows[k][0] == rows[k - 1][0] + 1:
-                continue
-            j0, j1 = rows[first][0], rows[k - 1][0]
-            bottom = min(b for _, b in rows[first:k])
-            out.append(
-                (i0 * CELL_U, j0 * CELL_U, (i1 + 1) * CELL_U, (j1 + 1) * CELL_U, top, bottom)
-            )
-            first = k
+    for (top, _), cells in groups.items():
+        runs: dict[tuple[int, int], list[int]] = {}  # (first i, last i) -> rows j
+        cells.sort()
+        for j in sorted({j for j, _ in cells}):
+            xs = [i for jj, i in cells if jj == j]
+            first = 0
+            for k in range(1, len(xs) + 1):
+                if k < len(xs) and xs[k] == xs[k - 1] + 1:
+                    continue
+                runs.setdefault((xs[first], xs[k - 1]), []).append(j)
+                first = k
+        for (i0, i1), rows in runs.items():
+            first = 0
+            for k in range(1, len(rows) + 1):
+                if k < len(rows) and rows[k] == rows[k - 1] + 1:
+                    continue
+                j0, j1 = rows[first], rows[k - 1]
+                bottom = min(
+                    columns[(i, j)][1] for i in range(i0, i1 + 1) for j in range(j0, j1 + 1)
+                )
+                out.append(
+                    (i0 * CELL_U, j0 * CELL_U, (i1 + 1) * CELL_U, (j1 + 1) * CELL_U, top, bottom)
+                )
+                first = k
     return sorted(out)
 
 
