@@ -159,6 +159,7 @@ def make_round(
         has_defuser=np.zeros((n, frames), dtype=bool),
         weapon=weapon,
         has_bomb=has_bomb,
+        vertical_speed=np.full((n, frames), np.nan),  # unknown, as in files without velocityZ
         bomb_plant_tick=None if plant_frame is None else int(ticks[plant_frame]) - 10,
         bomb_planted=np.arange(frames) >= (frames if plant_frame is None else plant_frame),
         bomb_position=np.full((frames, 3), np.nan),
@@ -332,6 +333,19 @@ def test_data_deaths_are_scripted_and_absent_players_dead_from_the_start(
     assert table["death"].tolist() == ["", "scripted", "", "", ""]
     assert table.loc[ABSENT, "reason"] == "original alive in fewer than 2 frames"
     assert table.loc[[ALIVE, DIES, VANISHES, CT], "reason"].isna().all()
+
+
+def test_a_frame_the_data_says_is_in_the_air_is_not_a_target(physics: PhysicsWorld) -> None:
+    """awpy's velocityZ is 0 on the ground: a frame with a vertical speed is in the air even
+    where its height alone (a hop over a low box) does not tell."""
+    run = straight_run(node_at(RUN_START), direction=0, count=2 * 9 - 1)[::2]
+    round_ = make_round([Track("hopper", "T", run)])
+    round_.vertical_speed[0] = 0.0
+    round_.vertical_speed[0, 4] = 2.5
+    result = replay(round_, physics, "kinematic")
+    status = result.plan.snaps[0].status
+    assert status[4] == SnapStatus.AIRBORNE
+    assert (np.delete(status, 4) == SnapStatus.SNAPPED).all()
 
 
 def test_a_jump_is_not_a_target(physics: PhysicsWorld) -> None:

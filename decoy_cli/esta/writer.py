@@ -9,7 +9,8 @@ degrees, demo ticks) and event records; `match_document` turns it into the JSON 
 Units are converted here, once: metres to Hammer units, stored as float32 values (what awpy
 writes), printed in their shortest form so the file stays small. Values the data does not hold
 (grenades, cash, ammunition) are zeros, empty lists or nulls, as awpy writes for them.
-Derived per frame: `seconds` and `clockTime` from the tick, velocities from consecutive frames,
+Derived per frame: `seconds` and `clockTime` from the tick, horizontal velocities from
+consecutive frames (`velocityZ` is null: a record does not say when a player was in the air),
 eye positions 64 u above the feet (standing), team equipment values and alive counts, buy types
 from team equipment (awpy's "hltv" style thresholds, checked against the real files: Full Eco
 below 5,000, Semi Eco below 10,000, Semi Buy below 20,000, else Full Buy) and the scores before

@@ -72,7 +72,8 @@ def frame_documents(
     position = np.asarray(r.position, dtype=np.float64)
     present = np.all(np.isfinite(position), axis=2)
     hammer = to_hammer(position)
-    # velocity from the previous frame (u/s); 0 in the first frame and next to an absence
+    # horizontal velocity from the previous frame (u/s); 0 in the first frame and next to an
+    # absence
     velocity = np.zeros((p, f, 3), dtype=np.float32)
     if f > 1:
         dt = np.diff(ticks) / rate
@@ -87,7 +88,6 @@ def frame_documents(
         "eyeZ": floats(eye_z),
         "vx": floats(velocity[..., 0]),
         "vy": floats(velocity[..., 1]),
-        "vz": floats(velocity[..., 2]),
         "yaw": floats(np.asarray(r.yaw)),
     }
     flags = {
@@ -122,7 +122,9 @@ def frame_documents(
                     "eyeZ": columns["eyeZ"][k],
                     "velocityX": columns["vx"][k],
                     "velocityY": columns["vy"][k],
-                    "velocityZ": columns["vz"][k],
+                    # awpy's velocityZ is 0 on the ground, not the change of height between
+                    # frames, and a record does not say when a player was in the air: unknown
+                    "velocityZ": None,
                     "viewX": columns["yaw"][k],
                     "viewY": 0.0,
                     "hp": int(r.hp[i, j]),

@@ -125,7 +125,12 @@ def snap_round(
     plans: list[PlayerPlan] = []
     for p in range(len(players)):
         snap = snap_positions(
-            graph, positions[p], alive[p], max_distance=max_distance, floor_z=floor_z[p]
+            graph,
+            positions[p],
+            alive[p],
+            max_distance=max_distance,
+            floor_z=floor_z[p],
+            vertical_speed=None if physics is None else round_.vertical_speed[p],
         )
         if sites is not None and node_site is not None and (sites[p] != "").any():
             snap = snap_into_sites(graph, snap, positions[p], sites[p], node_site, max_distance)

@@ -6,10 +6,11 @@ be snapped keep node -1 and error NaN, and say why in `status`, so they are coun
 silently dropped.
 
 Given the height of the world's floor under each position, frames more than `AIRBORNE_M` above
-it (a jump, a fall off a ledge) are not snapped either: a player in the air is at no waypoint,
-and the floor-aware lookup would put it on whatever lower floor lies nearest (a box beside the
-fall), a target the replay then has to detour to. The plan goes through those frames on the
-path between the frames before and after.
+it (a jump, a fall off a ledge), and frames whose vertical speed is known and not zero (awpy's
+velocityZ: the Source engine keeps none on the ground), are not snapped either: a player in the
+air is at no waypoint, and the floor-aware lookup would put it on whatever lower floor lies
+nearest (a box beside the fall), a target the replay then has to detour to. The plan goes
+through those frames on the path between the frames before and after.
 """
 
 from __future__ import annotations
@@ -86,13 +87,14 @@ def snap_positions(
     alive: np.ndarray,
     max_distance: float = DEFAULT_MAX_SNAP_M,
     floor_z: np.ndarray | None = None,
+    vertical_speed: np.ndarray | None = None,
 ) -> SnapResult:
     """Snap each alive frame's position (metres, shape (F, 3)) to its floor-aware nearest waypoint.
 
     `alive` is (F,) bool. Dead frames, frames without a finite position and positions with no
     waypoint on their floor within `max_distance` get node -1 and error NaN, with their reason.
     `floor_z` (F,), the world's floor height under each position (NaN where none is known), marks
-    the frames in the air.
+    the frames in the air, and so does a known non-zero `vertical_speed` (F,) (m/s) with it.
     """
     pos = np.asarray(positions, dtype=np.float64)
     alive = np.asarray(alive, dtype=bool)
@@ -117,6 +119,9 @@ def snap_positions(
             raise EstaError(f"floor heights have shape {floor_z.shape}, expected ({len(pos)},)")
         with np.errstate(invalid="ignore"):
             airborne = candidates & (pos[:, 2] - floor_z > AIRBORNE_M)
+        if vertical_speed is not None:
+            vertical_speed = np.asarray(vertical_speed, dtype=np.float64)
+            airborne |= candidates & np.isfinite(vertical_speed) & (vertical_speed != 0)
         status[airborne] = SnapStatus.AIRBORNE
         candidates &= ~airborne
     query = np.flatnonzero(candidates)

@@ -48,9 +48,11 @@ def snap_quality(
     pruned_positions: np.ndarray | None = None,
     max_distance: float = 3.0,
     floor_z: np.ndarray | None = None,
+    vertical_speed: np.ndarray | None = None,
 ) -> SnapQuality:
     """Snap every position (metres, (M, 3)) and summarise the distances; `floor_z` (M,), the
-    world's floor height under each position (NaN: unknown), separates the airborne ones."""
+    world's floor height under each position (NaN: unknown), separates the airborne ones, as
+    does a known non-zero `vertical_speed` (M,) (awpy's velocityZ, m/s), as in the replay."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     index, dist = graph.nearest(positions, max_distance=max_distance)
     ok = index >= 0
@@ -94,31 +96,43 @@ def snap_quality(
         if len(horizontal)
         else float("nan"),
         on_pruned=on_pruned,
-        **_grounded(positions, dist, floor_z),
+        **_grounded(positions, dist, floor_z, vertical_speed),
     )
 
 
-def _grounded(positions: np.ndarray, dist: np.ndarray, floor_z: np.ndarray | None) -> dict:
+def _grounded(
+    positions: np.ndarray,
+    dist: np.ndarray,
+    floor_z: np.ndarray | None,
+    vertical_speed: np.ndarray | None,
+) -> dict:
     """The airborne count and the 3-D share within reach on the ground (none without floors)."""
     if floor_z is None:
         return {}
     floor_z = np.asarray(floor_z, dtype=np.float64)
     with np.errstate(invalid="ignore"):
         airborne = positions[:, 2] - floor_z > AIRBORNE_M
+    if vertical_speed is not None:
+        vertical_speed = np.asarray(vertical_speed, dtype=np.float64)
+        airborne |= np.isfinite(vertical_speed) & (vertical_speed != 0)
     ground = dist[~airborne]
     share = float(np.mean(ground <= ALIGNED_WITHIN_M)) if len(ground) else float("nan")
     return {"airborne": int(airborne.sum()), "grounded_within_3d": share}
 
 
-def esta_positions(path: str | Path) -> np.ndarray:
-    """Every alive player position (metres) in the rounds of a match file or folder."""
+def esta_positions(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """Every alive player position (metres) in the rounds of a match file or folder, and its
+    vertical speed (awpy's velocityZ, m/s; NaN where the file has none)."""
     from decoy_cli.esta.reader import iter_match_files, read_match
 
-    chunks = []
+    chunks, speeds = [], []
     for file in iter_match_files(path):
         for round_ in read_match(file).rounds:
             chunks.append(round_.position[round_.alive])
-    return np.concatenate(chunks) if chunks else np.zeros((0, 3))
+            speeds.append(round_.vertical_speed[round_.alive])
+    if not chunks:
+        return np.zeros((0, 3)), np.zeros(0)
+    return np.concatenate(chunks), np.concatenate(speeds)
 
 
 FLOOR_RAY_LIFT_M = 0.1
@@ -135,13 +149,15 @@ def alignment_quality(
     on `world`, with the world's floor under each position (for the on-the-ground share)."""
     from decoy_cli.world.physics import PhysicsWorld
 
-    positions = esta_positions(path)
+    positions, vertical_speed = esta_positions(path)
     floor_z = None
     if len(positions):
         with PhysicsWorld(world) as physics:
             lifted = positions + np.array([0.0, 0.0, FLOOR_RAY_LIFT_M])
             floor_z = physics.first_floor_below(lifted, FLOOR_RAY_DEPTH_M)[0]
-    return snap_quality(graph, positions, pruned_positions, floor_z=floor_z)
+    return snap_quality(
+        graph, positions, pruned_positions, floor_z=floor_z, vertical_speed=vertical_speed
+    )
 
 
 def check_aligned(quality: SnapQuality, min_aligned: float) -> None:
