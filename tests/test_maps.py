@@ -70,6 +70,7 @@ def test_the_environment_plays_every_map(map_name: str) -> None:
         observations, infos = env.reset(seed=0)
         assert env.graph.meta["map"] == map_name
         assert env.setup.map_name == map_name  # the damage models' map one-hot
+        assert env.metadata["name"] == f"decoy_{map_name.removeprefix('de_')}_v0"
         rng = np.random.default_rng(0)
         for _ in range(20):
             actions = {}

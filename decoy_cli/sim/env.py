@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from contextlib import ExitStack
 from numbers import Integral
-from typing import Any, ClassVar, TypeGuard, cast
+from typing import Any, TypeGuard, cast
 
 import gymnasium
 import numpy as np
@@ -158,7 +158,8 @@ class DecoyParallelEnv(ParallelEnv):
     T orange, CT blue, dead agents light grey, the bomb a red star).
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"name": "decoy_dust2_v0", "render_modes": ["rgb_array"]}
+    metadata: dict[str, Any] = {"name": "decoy_v0", "render_modes": ["rgb_array"]}  # noqa: RUF012
+    """Each environment's own copy names its map: "decoy_dust2_v0", "decoy_mirage_v0", ..."""
 
     def __init__(
         self,
@@ -185,6 +186,8 @@ class DecoyParallelEnv(ParallelEnv):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r} (rgb_array or None)")
         self.graph = _map_graph(map, graph)
+        map_name = str(self.graph.meta.get("map", "")).removeprefix("de_") or "custom"
+        self.metadata = {**type(self).metadata, "name": f"decoy_{map_name}_v0"}
         self.world = world
         self.mover_kind = mover
         self.damage_model: DamageModel | None
