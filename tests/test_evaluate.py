@@ -32,10 +32,11 @@ from decoy_cli.evaluate.job import RoundTask, evaluate_round, is_synthetic
 from decoy_cli.evaluate.outputs import FAILURE_COLUMNS
 from decoy_cli.evaluate.record import PlaceFinder, grid_sums, hp_stats, read_grid_sums
 from decoy_cli.evaluate.runner import Evaluation, ProgressEvent, make_settings, run_evaluation
-from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
+from decoy_cli.evaluate.settings import EvalSettings, HeatGrid, round_key
 from decoy_cli.evaluate.tables import Tables, build_tables, hp_metrics_from_sums
 from decoy_cli.metrics import FASTDTW_METRIC, METRIC_NAMES, hp_metrics
-from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.build import GRAPH_FILE, builtin_graph
+from decoy_cli.world.navmesh import asset_dir
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 TSIDE = DATA / "esta_dust2_tside"
@@ -408,6 +409,42 @@ def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path
     ):
         result = _invoke(*args, "--out", str(tmp_path / "out"))
         assert result.exit_code == 1, args
+        assert result.output.startswith("error: ") and expected in result.output, result.output
+        assert len(result.output.strip().splitlines()) == 1
+
+
+def test_a_copy_of_the_shipped_graph_gives_the_shipped_results(
+    clean: Path, reference: tuple[Evaluation, Tables], tmp_path: Path
+) -> None:
+    copy = tmp_path / "my.npz"
+    copy.write_bytes((asset_dir() / GRAPH_FILE).read_bytes())
+    settings = make_settings(
+        map_name="dust2",
+        combat=False,
+        bomb=False,
+        models="shipped",
+        mover="kinematic",
+        seed=0,
+        graph=copy,
+    )
+    assert settings.graph == str(copy.resolve()) and settings.graph_sha
+    assert round_key(settings, "f", 1) != round_key(reference[0].settings, "f", 1)
+    with LocalBackend(1) as backend:
+        evaluation = run_evaluation([clean], settings, tmp_path / "out", backend)
+    assert_same_results(evaluation, reference)
+
+
+def test_a_bad_graph_is_one_line(clean: Path, tmp_path: Path) -> None:
+    other_map = asset_dir("de_mirage") / GRAPH_FILE
+    not_a_graph = tmp_path / "notes.npz"
+    not_a_graph.write_text("not a graph")
+    for graph, expected in (
+        (other_map, "a graph of de_mirage, not de_dust2"),
+        (tmp_path / "missing.npz", "missing.npz"),
+        (not_a_graph, "notes.npz"),
+    ):
+        result = _invoke(str(clean), "--graph", str(graph), "--out", str(tmp_path / "out"))
+        assert result.exit_code == 1, result.output
         assert result.output.startswith("error: ") and expected in result.output, result.output
         assert len(result.output.strip().splitlines()) == 1
 

@@ -5,6 +5,7 @@ fixture for the standing rule and bad input, and the real T-side data when it is
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import numpy as np
@@ -266,3 +267,23 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
         ["replay", f"{files[0]}:2", "--graph", str(out), "--out", str(tmp_path / "replay")],
     )
     assert replay.exit_code == 0, replay.output
+    # and so does a batch evaluation
+    evaluated = tmp_path / "evaluate"
+    result = runner.invoke(
+        app,
+        [
+            "evaluate",
+            str(files[0]),
+            "--graph",
+            str(out),
+            "--no-combat",
+            "--no-bomb",
+            "--workers",
+            "1",
+            "--out",
+            str(evaluated),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads((evaluated / "summary.json").read_text())
+    assert summary["options"]["graph"] == str(out.resolve())

@@ -67,6 +67,12 @@ def evaluate(
     map_name: str = typer.Option(
         "dust2", "--map", help="The map to evaluate; files of other maps are skipped."
     ),
+    graph: Path | None = typer.Option(
+        None,
+        "--graph",
+        help="Waypoint graph (.npz from build-waypoints, e.g. with --learn-patches) to replay "
+        "on, with the world it was built on; its map must be --map. Default: the shipped one.",
+    ),
     sample: int | None = typer.Option(
         None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
     ),
@@ -150,6 +156,7 @@ def evaluate(
         seed=seed,
         implausible=check_policy(implausible),
         fastdtw=fastdtw,
+        graph=graph,
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend

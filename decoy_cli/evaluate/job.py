@@ -31,7 +31,8 @@ from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
 from decoy_cli.esta.batch import UNREADABLE_FILE
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import PlaceFinder, RoundRecord, build_record
-from decoy_cli.evaluate.settings import EvalSettings, round_seed
+from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
+from decoy_cli.waypoints.graph import WaypointGraph
 
 if TYPE_CHECKING:
     from decoy_cli.replay.replayer import ReplayResult
@@ -86,15 +87,14 @@ class FileIndex(msgspec.Struct, frozen=True):
 class _WorkerState:
     """One worker's graph, physics world, damage models and recently read matches."""
 
-    def __init__(self, map_name: str) -> None:
-        from decoy_cli.waypoints.build import builtin_graph
-        from decoy_cli.world.navmesh import nav_world
+    def __init__(self, settings: EvalSettings) -> None:
+        from decoy_cli.waypoints.build import graph_world
         from decoy_cli.world.physics import PhysicsWorld
 
-        self.map_name = map_name
-        self.graph = builtin_graph(map_name)
+        self.key = (settings.map_name, settings.graph, settings.graph_sha)
+        self.graph = run_graph(settings)
         self.places = PlaceFinder(self.graph)
-        self.physics = PhysicsWorld(nav_world(map_name))
+        self.physics = PhysicsWorld(graph_world(self.graph))
         self.models: dict[str, DamageModel | None] = {}
         self.matches: OrderedDict[tuple[str, str, str], Match] = OrderedDict()
 
@@ -135,11 +135,23 @@ class _WorkerState:
 _local = threading.local()
 
 
-def worker_state(map_name: str) -> _WorkerState:
+def run_graph(settings: EvalSettings) -> WaypointGraph:
+    """The waypoint graph a run replays on: the user's `--graph` (checked to be the file the
+    run hashed), else the map's shipped one."""
+    from decoy_cli.waypoints.build import builtin_graph
+
+    if not settings.graph:
+        return builtin_graph(settings.map_name)
+    if file_sha256(Path(settings.graph)) != settings.graph_sha:
+        raise DecoyError(f"{settings.graph}: the graph file changed while the evaluation ran")
+    return WaypointGraph.load(settings.graph)
+
+
+def worker_state(settings: EvalSettings) -> _WorkerState:
     """This thread's worker state, built on first use (one per process in a local pool)."""
     state = getattr(_local, "state", None)
-    if state is None or state.map_name != map_name:
-        state = _WorkerState(map_name)
+    if state is None or state.key != (settings.map_name, settings.graph, settings.graph_sha):
+        state = _WorkerState(settings)
         _local.state = state
     return state
 
@@ -153,7 +165,7 @@ def is_synthetic(match_id: str, provenance: Any) -> bool:
 def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     """Read a match file and list its rounds; the worker keeps the match for its rounds."""
     try:
-        match = worker_state(task.settings.map_name).match(
+        match = worker_state(task.settings).match(
             task.file, task.file_sha, task.settings.implausible
         )
     except Exception as error:
@@ -208,7 +220,7 @@ def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
 
 
 def _evaluate(task: RoundTask) -> RoundRecord:
-    state = worker_state(task.settings.map_name)
+    state = worker_state(task.settings)
     round_ = state.match(task.file, task.file_sha, task.settings.implausible).round(task.round_num)
     settings = task.settings
     model = state.damage_model(settings.models) if settings.combat else None

@@ -202,6 +202,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
             "inputs": [str(p) for p in evaluation.inputs],
             "options": {
                 "map": settings.map_name,
+                "graph": settings.graph or "shipped",
                 "combat": settings.combat,
                 "bomb": settings.bomb,
                 "models": settings.models,

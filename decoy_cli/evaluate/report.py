@@ -69,6 +69,8 @@ def command_line(
 ) -> str:
     """The command with every effective option (what a reader needs to rerun it)."""
     words = ["decoy", "evaluate", *map(str, inputs), "--map", settings.map_name]
+    if settings.graph:
+        words += ["--graph", settings.graph]
     if sample is not None:
         words += ["--sample", str(sample)]
     words += ["--seed", str(settings.seed), "--combat" if settings.combat else "--no-combat"]

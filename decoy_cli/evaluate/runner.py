@@ -27,7 +27,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.errors import DecoyError, EstaError, GraphError
 from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
 from decoy_cli.esta.plausibility import Implausible
@@ -38,6 +38,7 @@ from decoy_cli.evaluate.job import (
     RoundTask,
     evaluate_round,
     index_file,
+    run_graph,
 )
 from decoy_cli.evaluate.record import RoundRecord, place_names
 from decoy_cli.evaluate.settings import (
@@ -50,6 +51,7 @@ from decoy_cli.evaluate.settings import (
     round_key,
 )
 from decoy_cli.evaluate.tables import Accumulator
+from decoy_cli.waypoints.graph import WaypointGraph
 
 
 class Backend(Protocol):
@@ -109,6 +111,7 @@ def make_settings(
     seed: int,
     implausible: Implausible = "fail",
     fastdtw: bool | None = None,
+    graph: Path | None = None,
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round. `fastdtw` None
@@ -118,6 +121,13 @@ def make_settings(
 
     name = canonical_map(map_name)
     check_mover(mover)
+    graph_path, graph_sha = "", ""
+    if graph is not None:  # absolute, for workers elsewhere; its map must be the run's
+        graph_path = str(graph.expanduser().resolve())
+        graph_sha = file_sha256(Path(graph_path))
+        graph_map = str(WaypointGraph.load(graph_path).meta.get("map", ""))
+        if graph_map != name:
+            raise GraphError(f"{graph}: a graph of {graph_map or 'no map'}, not {name} (--map)")
     models_fingerprint = ""
     if combat:
         from decoy_cli.damage import SHIPPED_CHOICES, SHIPPED_MODELS, load_damage_model
@@ -139,6 +149,8 @@ def make_settings(
         models_fingerprint=models_fingerprint,
         implausible=implausible,
         fastdtw=(not combat and not bomb) if fastdtw is None else fastdtw,
+        graph=graph_path,
+        graph_sha=graph_sha,
     )
 
 
@@ -179,8 +191,6 @@ def run_evaluation(
     An OutputError while caching (a full disk) stops the run; what was cached stays.
     """
     started = time.perf_counter()
-    from decoy_cli.waypoints.build import builtin_graph
-
     paths, ignored = collect_match_files(inputs)
     cache = RunCache(out)
     evaluation = Evaluation(
@@ -189,7 +199,7 @@ def run_evaluation(
         files=[],
         ignored=ignored,
         duplicates=[],
-        accumulator=Accumulator(settings, place_names(builtin_graph(settings.map_name))),
+        accumulator=Accumulator(settings, place_names(run_graph(settings))),
     )
     failures = evaluation.failures
     by_sha: dict[str, Path] = {}

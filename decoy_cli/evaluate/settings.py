@@ -111,6 +111,11 @@ class EvalSettings:
     """Also compute `paper_dtw_fastdtw` (the paper's FastDTW; slow, `metrics.fastdtw_metric`)."""
     hp_bin_s: float = HP_BIN_S
     hp_bins: int = HP_BINS
+    graph: str = ""
+    """A user's waypoint graph file, absolute ("": the map's shipped graph); rounds are replayed
+    on it and on the world it was built on (`graph_world`)."""
+    graph_sha: str = ""
+    """SHA-256 of that file (a different graph is a different result)."""
 
     def to_json(self) -> str:
         return json.dumps(asdict(self), sort_keys=True)
