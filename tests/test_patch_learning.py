@@ -21,8 +21,8 @@ from decoy_cli.waypoints.build import graph_world
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.nav_data import NavMesh, read_patches
 from decoy_cli.world.navmesh import load_navmesh
+from decoy_cli.world.patch_boxes import SLAB_U
 from decoy_cli.world.patch_learning import (
-    SLAB_U,
     PatchBox,
     StandingPositions,
     learn_patches,

@@ -26,7 +26,7 @@ Method:
    is a slab `SLAB_U` thick (a walkway). Gaps between columns are closed, and the patch grows
    by one column all round where no one stood below: players' centres stay up to half a hull
    from a surface's edge, so the surface reaches past them. Columns of equal height are merged
-   into rectangles.
+   into rectangles (`decoy_cli/world/patch_boxes.py`).
 
 Positions are read in Hammer units here (the nav mesh's units); the world is in metres.
 """
@@ -42,31 +42,19 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
-from decoy_cli.csgo import HAMMER_TO_M, PLAYER_HEIGHT_M, STEP_HEIGHT_M
+from decoy_cli.csgo import HAMMER_TO_M, STEP_HEIGHT_M
 from decoy_cli.errors import WorldError
 from decoy_cli.esta.reader import Match, read_match
 from decoy_cli.files import write_atomic
 from decoy_cli.world.nav_data import PATCH_COLUMNS, NavMesh
+from decoy_cli.world.patch_boxes import CELL_U, STEP_U, rectangles, surface_columns
 from decoy_cli.world.physics import PhysicsWorld
-
-STEP_U = STEP_HEIGHT_M / HAMMER_TO_M
-"""sv_stepsize: a ledge up to this height is walked up; a player higher than this above the
-floor is not standing on that floor."""
 
 STEADY_U = 1.0
 """Largest height change between consecutive frames of a standing player (Hammer units)."""
 
 STEADY_S = 0.4
 """Shortest time a player's height must stay steady to count as standing (seconds)."""
-
-PLAYER_HEIGHT_U = PLAYER_HEIGHT_M / HAMMER_TO_M
-"""Standing hull height: under a surface higher than this above the floor a player walks."""
-
-SLAB_U = 16.0
-"""Thickness of a patch that a player could walk under (Hammer units)."""
-
-CELL_U = 16.0
-"""Side of a patch column: half the player hull's width (Hammer units)."""
 
 LAYER_U = 16.0
 """Height of a clustering layer; surfaces in touching layers join (Hammer units)."""
@@ -288,12 +276,12 @@ def _boxes(
         z = standing.position[rows, 2]
         if np.percentile(z, 90) - np.percentile(z, 10) > MAX_SPREAD_U:
             continue  # not flat: uneven ground the nav mesh fits too low, not a box
-        columns = _columns(cells[rows], z, floor[rows], ground)
+        columns = surface_columns(cells[rows], z, floor[rows], ground)
         if not columns:
             continue
         centre = standing.position[rows, :2].mean(axis=0)
         spread = float(np.percentile(z, 90) - np.percentile(z, 10))
-        for corners in _rectangles(columns):
+        for corners in rectangles(columns):
             boxes.append(
                 PatchBox(
                     *corners,
@@ -307,87 +295,6 @@ def _boxes(
             )
         patch += 1
     return boxes
-
-
-def _columns(
-    cells: np.ndarray, z: np.ndarray, floor: np.ndarray, ground: dict[tuple[int, int], np.ndarray]
-) -> dict[tuple[int, int], tuple[float, float]]:
-    """(top, bottom) of each solid column of one surface, rounded to whole units."""
-    columns = {}
-    for key in {(int(i), int(j)) for i, j in cells}:
-        mine = (cells[:, 0] == key[0]) & (cells[:, 1] == key[1])
-        top = float(np.round(np.median(z[mine])))
-        bottom = float(np.floor(np.min(floor[mine])))
-        below = ground.get(key, np.zeros(0))
-        under = int(np.sum((below < top - STEP_U) & (below > bottom - STEP_U)))
-        if under >= mine.sum():
-            continue  # more players stood under it than on it: a passage, not a box
-        if under and top - bottom > PLAYER_HEIGHT_U + SLAB_U:
-            bottom = top - SLAB_U  # players stood under it: a walkway, not a box
-        columns[key] = (top, bottom)
-    return _fill_gaps(columns, ground)
-
-
-def _fill_gaps(
-    columns: dict[tuple[int, int], tuple[float, float]],
-    ground: dict[tuple[int, int], np.ndarray],
-) -> dict[tuple[int, int], tuple[float, float]]:
-    """Columns no one happened to stand on, between columns of the surface (a morphological
-    closing), take the nearest column's top and bottom unless players stood on the floor there."""
-    if not columns:
-        return columns
-    keys = np.array(list(columns))
-    origin = keys.min(axis=0) - 2
-    mask = np.zeros(keys.max(axis=0) - origin + 3, dtype=bool)
-    mask[tuple((keys - origin).T)] = True
-    closed = ndimage.binary_fill_holes(ndimage.binary_closing(mask, np.ones((3, 3))) | mask)
-    closed = ndimage.binary_dilation(closed, np.ones((3, 3)))
-    _, nearest = ndimage.distance_transform_edt(~mask, return_indices=True)
-    filled = dict(columns)
-    for i, j in np.argwhere(closed & ~mask):
-        key = (int(i + origin[0]), int(j + origin[1]))
-        source = (int(nearest[0, i, j] + origin[0]), int(nearest[1, i, j] + origin[1]))
-        top, bottom = columns[source]
-        below = ground.get(key, np.zeros(0))
-        if not np.any((below < top - STEP_U) & (below > bottom - STEP_U)):
-            filled[key] = (top, bottom)
-    return filled
-
-
-def _rectangles(
-    columns: dict[tuple[int, int], tuple[float, float]],
-) -> list[tuple[float, float, float, float, float, float]]:
-    """Columns of equal top, and alike solid or slab, merged into rectangles (runs along x,
-    then equal runs along y); a merged solid box reaches down to its lowest column's floor."""
-    groups: dict[tuple[float, bool], list[tuple[int, int]]] = {}
-    for (i, j), (top, bottom) in columns.items():
-        groups.setdefault((top, bottom == top - SLAB_U), []).append((j, i))
-    out = []
-    for (top, _), cells in groups.items():
-        runs: dict[tuple[int, int], list[int]] = {}  # (first i, last i) -> rows j
-        cells.sort()
-        for j in sorted({j for j, _ in cells}):
-            xs = [i for jj, i in cells if jj == j]
-            first = 0
-            for k in range(1, len(xs) + 1):
-                if k < len(xs) and xs[k] == xs[k - 1] + 1:
-                    continue
-                runs.setdefault((xs[first], xs[k - 1]), []).append(j)
-                first = k
-        for (i0, i1), rows in runs.items():
-            first = 0
-            for k in range(1, len(rows) + 1):
-                if k < len(rows) and rows[k] == rows[k - 1] + 1:
-                    continue
-                j0, j1 = rows[first], rows[k - 1]
-                bottom = min(
-                    columns[(i, j)][1] for i in range(i0, i1 + 1) for j in range(j0, j1 + 1)
-                )
-                out.append(
-                    (i0 * CELL_U, j0 * CELL_U, (i1 + 1) * CELL_U, (j1 + 1) * CELL_U, top, bottom)
-                )
-                first = k
-    return sorted(out)
 
 
 def _place(nav: NavMesh, xy: np.ndarray) -> str:
