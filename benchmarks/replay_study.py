@@ -91,6 +91,16 @@ def main() -> None:
         f"p95 lateness median {np.nanmedian(p95):.2f} s, p90 {np.nanpercentile(p95, 90):.2f} s; "
         f"targets reached more than 0.5 s late: {over:.2%} of {int(players['targets'].sum()):,}"
     )
+    causes = {
+        "the plan asked for more than the player's speed": "late_plan",
+        "the target before was already late": "late_carried",
+        "the replay's own delay": "late_replay",
+    }
+    total = max(int(players["late_over_frame"].sum()), 1)
+    print(
+        "why those targets are late: "
+        + "; ".join(f"{what} {players[c].sum() / total:.0%}" for what, c in causes.items())
+    )
     print(
         f"stuck episodes per round: mean {rounds['stuck'].mean():.2f}, "
         f"max {rounds['stuck'].max()}; "

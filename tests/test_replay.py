@@ -61,6 +61,9 @@ PLAYER_COLUMNS = (
     "targets",
     "late_share",
     "late_over_frame",
+    "late_plan",
+    "late_carried",
+    "late_replay",
     "late_p95_s",
     "stuck",
     "recoveries",
@@ -254,6 +257,13 @@ def test_a_plan_twice_too_fast_runs_late_then_catches_up(timed: Timed) -> None:
     assert row["late_max_s"] == pytest.approx(late.max())
     assert row["late_over_frame"] == int(np.sum(late > 0.5 + 1e-9))
     assert row["late_share"] == pytest.approx(3 / TIMING_FRAMES)
+    # why: the two runs asked for more than the player's speed; the standing target after them
+    # inherits their lateness
+    over = late > 0.5 + 1e-9
+    assert row["late_plan"] == int(np.sum(over[1:3]))
+    assert row["late_carried"] == int(np.sum(over[3:]))
+    assert row["late_replay"] == 0
+    assert row["late_plan"] + row["late_carried"] + row["late_replay"] == row["late_over_frame"]
 
 
 def test_survivors_survive_and_the_round_is_undecided(timed: Timed) -> None:

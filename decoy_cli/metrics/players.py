@@ -22,6 +22,9 @@ REPLAY_COLUMNS = (
     "targets",
     "late_share",
     "late_over_frame",
+    "late_plan",
+    "late_carried",
+    "late_replay",
     "late_p95_s",
     "stuck",
     "recoveries",
@@ -41,7 +44,10 @@ class ReplayTrace:
     data shows a death (`died_original`), whether the replay removed the player at its data
     death time rather than by combat (`scripted_death`), the share of plan targets reached late
     and the 95th percentile lateness in seconds (NaN when none was reached), the targets reached
-    and how many of them more than one data frame late, stuck episodes, recoveries (teleports)
+    and how many of them more than one data frame late, split by cause (`late_plan`: the plan
+    asked for more than the player's speed on the way to it; `late_carried`: the target before
+    was already that late; `late_replay`: neither, the replay's own delay), stuck episodes,
+    recoveries (teleports)
     and relocations.
     """
 
@@ -53,6 +59,9 @@ class ReplayTrace:
     late_p95_s: np.ndarray
     targets: np.ndarray
     late_over_frame: np.ndarray
+    late_plan: np.ndarray
+    late_carried: np.ndarray
+    late_replay: np.ndarray
     stuck: np.ndarray
     recoveries: np.ndarray
     relocations: np.ndarray
@@ -87,6 +96,9 @@ def player_metrics(round_: Round, trace: ReplayTrace, *, fastdtw: bool = False) 
                 "targets": int(trace.targets[p]),
                 "late_share": float(trace.late_share[p]),
                 "late_over_frame": int(trace.late_over_frame[p]),
+                "late_plan": int(trace.late_plan[p]),
+                "late_carried": int(trace.late_carried[p]),
+                "late_replay": int(trace.late_replay[p]),
                 "late_p95_s": float(trace.late_p95_s[p]),
                 "stuck": int(trace.stuck[p]),
                 "recoveries": int(trace.recoveries[p]),

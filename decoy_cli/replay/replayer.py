@@ -83,6 +83,9 @@ class ReplayResult:
             late_share=lateness["late_share"].to_numpy(dtype=float),
             targets=lateness["reached"].to_numpy(dtype=np.int64),
             late_over_frame=lateness["late_over_frame"].to_numpy(dtype=np.int64),
+            late_plan=lateness["late_plan"].to_numpy(dtype=np.int64),
+            late_carried=lateness["late_carried"].to_numpy(dtype=np.int64),
+            late_replay=lateness["late_replay"].to_numpy(dtype=np.int64),
             late_p95_s=lateness["late_p95_s"].to_numpy(dtype=float),
             stuck=self.stuck if self.stuck is not None else np.zeros(count, np.int64),
             recoveries=self.recoveries
@@ -93,12 +96,20 @@ class ReplayResult:
 
     def lateness_table(self) -> pd.DataFrame:
         """Per player: targets, those reached, the share reached late (after their tick), how
-        many more than one data frame late (`DATA_FRAME_S`), p95 and max lateness (s),
-        relocations."""
+        many more than one data frame late (`DATA_FRAME_S`) and why (`late_plan`, `late_carried`,
+        `late_replay`: see `ReplayTrace`), p95 and max lateness (s), relocations."""
         rows = []
         for p, log in enumerate(self.logs):
             late = log.lateness_s
             reached = late[np.isfinite(late)]
+            plan = self.plan.plans[p]
+            over = np.isfinite(late) & (late > DATA_FRAME_S + 1e-9)
+            over[:1] = False  # the first target is the start
+            asked_too_much = np.zeros(len(late), dtype=bool)
+            asked_too_much[1:] = plan.interval_infeasible | plan.interval_unreachable
+            carried = np.zeros(len(late), dtype=bool)
+            with np.errstate(invalid="ignore"):
+                carried[1:] = late[:-1] > DATA_FRAME_S + 1e-9
             rows.append(
                 {
                     "player": self.plan.players[p].name,
@@ -108,6 +119,9 @@ class ReplayResult:
                     if len(reached)
                     else np.nan,
                     "late_over_frame": int(np.sum(reached > DATA_FRAME_S + 1e-9)),
+                    "late_plan": int(np.sum(over & asked_too_much)),
+                    "late_carried": int(np.sum(over & ~asked_too_much & carried)),
+                    "late_replay": int(np.sum(over & ~asked_too_much & ~carried)),
                     "late_p95_s": float(np.percentile(reached, 95)) if len(reached) else np.nan,
                     "late_max_s": float(reached.max()) if len(reached) else np.nan,
                     "relocations": log.relocations,
