@@ -28,11 +28,6 @@ from decoy_cli.replay.snapping import (
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
 
-_FLOOR_RAY_LIFT_M = 0.1
-"""The ray down starts this far above the feet, so the floor the player stands on is found."""
-_FLOOR_RAY_DEPTH_M = 4.0
-"""Deeper than any fall in the data between two frames; below that, the floor is unknown."""
-
 SUMMARY_COLUMNS = (
     "player",
     "side",
@@ -115,11 +110,7 @@ def snap_round(
         if array.shape != shape:
             raise EstaError(f"round {name} have shape {array.shape}, expected {shape}")
 
-    floor_z = np.full(shape, np.nan)
-    if physics is not None:
-        finite = np.isfinite(positions).all(axis=2)
-        lifted = positions[finite] + np.array([0.0, 0.0, _FLOOR_RAY_LIFT_M])
-        floor_z[finite] = physics.first_floor_below(lifted, _FLOOR_RAY_DEPTH_M)[0]
+    floor_z = np.full(shape, np.nan) if physics is None else physics.floor_under_feet(positions)
     paths = PathCache(graph)
     snaps: list[SnapResult] = []
     plans: list[PlayerPlan] = []

@@ -21,7 +21,7 @@ from enum import IntEnum
 import numpy as np
 
 from decoy_cli.errors import EstaError, GraphError
-from decoy_cli.waypoints.graph import AIRBORNE_M, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph, in_the_air
 
 DEFAULT_MAX_SNAP_M = 2.0
 """Farthest a position may lie from its waypoint (3-D, metres) and still snap.
@@ -42,7 +42,7 @@ class SnapStatus(IntEnum):
     NOT_ALIVE = 1  # dead (or absent) in this frame: nothing to snap
     NO_POSITION = 2  # alive but without a finite position in the data
     NO_WAYPOINT = 3  # no waypoint on the position's floor within the snap distance
-    AIRBORNE = 4  # more than AIRBORNE_M above the world's floor: jumping or falling
+    AIRBORNE = 4  # in the air (`in_the_air`): jumping or falling
 
 
 @dataclass(frozen=True)
@@ -72,8 +72,8 @@ class SnapResult:
 
     @property
     def num_airborne(self) -> int:
-        """Alive frames more than `AIRBORNE_M` above the world's floor (jumping, falling): not
-        snapped, a player in the air stands at no waypoint."""
+        """Alive frames in the air (`in_the_air`: jumping, falling): not snapped, a player in
+        the air stands at no waypoint."""
         return self.count(SnapStatus.AIRBORNE)
 
     def counts(self) -> dict[str, int]:
@@ -117,11 +117,7 @@ def snap_positions(
         floor_z = np.asarray(floor_z, dtype=np.float64)
         if floor_z.shape != (len(pos),):
             raise EstaError(f"floor heights have shape {floor_z.shape}, expected ({len(pos)},)")
-        with np.errstate(invalid="ignore"):
-            airborne = candidates & (pos[:, 2] - floor_z > AIRBORNE_M)
-        if vertical_speed is not None:
-            vertical_speed = np.asarray(vertical_speed, dtype=np.float64)
-            airborne |= candidates & np.isfinite(vertical_speed) & (vertical_speed != 0)
+        airborne = candidates & in_the_air(pos[:, 2], floor_z, vertical_speed)
         status[airborne] = SnapStatus.AIRBORNE
         candidates &= ~airborne
     query = np.flatnonzero(candidates)

@@ -66,6 +66,23 @@ SNAP_MAX_BELOW_M = 1.25
 AIRBORNE_M = 0.4
 """Height above the world's floor from which a position counts as in the air (a jump or a
 fall; a crouch-jump rises 1.2 m, players on the nav world's floors stand within centimetres)."""
+
+
+def in_the_air(
+    z: np.ndarray, floor_z: np.ndarray, vertical_speed: np.ndarray | None = None
+) -> np.ndarray:
+    """Which positions are in the air: more than `AIRBORNE_M` above the world's floor (NaN:
+    unknown, not in the air), or with a known vertical speed that is not zero (awpy's velocityZ,
+    m/s: the Source engine keeps none on the ground). The one rule of the replay, `decoy snap`
+    and `--check-esta`."""
+    with np.errstate(invalid="ignore"):
+        airborne = np.asarray(z, dtype=np.float64) - floor_z > AIRBORNE_M
+    if vertical_speed is not None:
+        speed = np.asarray(vertical_speed, dtype=np.float64)
+        airborne |= np.isfinite(speed) & (speed != 0)
+    return airborne
+
+
 RUN_SPEED_M_S = KNIFE_SPEED * HAMMER_TO_M
 """The speed that turns seconds in the air into metres of path cost: running with the knife."""
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.waypoints.graph import AIRBORNE_M, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph, in_the_air
 from decoy_cli.world.world import World
 
 ALIGNED_WITHIN_M = 0.5
@@ -35,7 +35,7 @@ class SnapQuality:
     p95_horizontal: float
     within_horizontal: float
     on_pruned: float | None  # share whose nearest lattice node was pruned (None: not known)
-    airborne: int | None = None  # positions more than AIRBORNE_M above the floor (None: unknown)
+    airborne: int | None = None  # positions in the air (`in_the_air`; None: unknown)
     grounded_within_3d: float | None = None  # within_3d over the positions on the ground
 
     def as_dict(self) -> dict[str, float | int | None]:
@@ -109,12 +109,7 @@ def _grounded(
     """The airborne count and the 3-D share within reach on the ground (none without floors)."""
     if floor_z is None:
         return {}
-    floor_z = np.asarray(floor_z, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        airborne = positions[:, 2] - floor_z > AIRBORNE_M
-    if vertical_speed is not None:
-        vertical_speed = np.asarray(vertical_speed, dtype=np.float64)
-        airborne |= np.isfinite(vertical_speed) & (vertical_speed != 0)
+    airborne = in_the_air(positions[:, 2], np.asarray(floor_z, dtype=np.float64), vertical_speed)
     ground = dist[~airborne]
     share = float(np.mean(ground <= ALIGNED_WITHIN_M)) if len(ground) else float("nan")
     return {"airborne": int(airborne.sum()), "grounded_within_3d": share}
@@ -135,13 +130,6 @@ def esta_positions(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(chunks), np.concatenate(speeds)
 
 
-FLOOR_RAY_LIFT_M = 0.1
-"""How far above a position the ray down to its floor starts (a player's feet touch it)."""
-
-FLOOR_RAY_DEPTH_M = 4.0
-"""How far below a position the floor is looked for."""
-
-
 def alignment_quality(
     graph: WaypointGraph, pruned_positions: np.ndarray, world: World, path: str | Path
 ) -> SnapQuality:
@@ -153,8 +141,7 @@ def alignment_quality(
     floor_z = None
     if len(positions):
         with PhysicsWorld(world) as physics:
-            lifted = positions + np.array([0.0, 0.0, FLOOR_RAY_LIFT_M])
-            floor_z = physics.first_floor_below(lifted, FLOOR_RAY_DEPTH_M)[0]
+            floor_z = physics.floor_under_feet(positions)
     return snap_quality(
         graph, positions, pruned_positions, floor_z=floor_z, vertical_speed=vertical_speed
     )

@@ -29,6 +29,12 @@ from decoy_cli.world.world import World
 
 WORLD_GROUP = 1
 AGENT_GROUP = 2
+FEET_LIFT_M = 0.1
+"""How far above a player's feet the ray down to its floor starts, so the floor the player
+stands on is found."""
+FLOOR_DEPTH_M = 4.0
+"""How far below the feet the floor is looked for: deeper than any fall in the data between two
+frames; below that, the floor is unknown."""
 _RAY_BATCH = 4095
 _THREADED_RAYS = 512
 _MAX_VERTEX_ARRAY_TRIANGLES = 150_000
@@ -177,6 +183,17 @@ class PhysicsWorld:
         fraction, normal_z = self.ray_test(points, ends)
         z = np.where(np.isfinite(fraction), points[:, 2] - fraction * depth, np.nan)
         return z, normal_z
+
+    def floor_under_feet(self, positions: np.ndarray) -> np.ndarray:
+        """Height of the floor each player position (metres, (..., 3)) stands on or above: the
+        first surface below a ray start `FEET_LIFT_M` above the feet, looked for down to
+        `FLOOR_DEPTH_M` (NaN there and where the position is not finite)."""
+        positions = np.asarray(positions, dtype=np.float64)
+        floor = np.full(positions.shape[:-1], np.nan)
+        finite = np.isfinite(positions).all(axis=-1)
+        lifted = positions[finite] + np.array([0.0, 0.0, FEET_LIFT_M])
+        floor[finite] = self.first_floor_below(lifted, FLOOR_DEPTH_M)[0]
+        return floor
 
     def line_of_sight(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
         """True where nothing of the world lies between the two points."""
