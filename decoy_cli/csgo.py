@@ -61,6 +61,9 @@ approximate)."""
 JUMP_HEIGHT_M = 64 * HAMMER_TO_M
 """Highest ledge a player reaches with a crouch-jump (a plain jump clears about 55.8 u)."""
 
+GRAVITY_U_S2 = 800.0
+"""sv_gravity: downward acceleration in Hammer units per second squared."""
+
 SAFE_FALL_SPEED_U_S = 580.0
 """Landing speed up to which a fall does no damage (CS_PLAYER_MAX_SAFE_FALL_SPEED in CS:GO's
 cs_gamerules.cpp): a fall of 580² / (2 × 800) = 210 u."""
@@ -71,7 +74,7 @@ cs_gamerules.cpp; the Source SDK's 1024 and Counter-Strike: Source's 1100 x 1.25
 games'). The damage is linear in between. On the real T-side rounds, health lost at falls of
 200-310 u follows it (`python benchmarks/fall_damage_check.py`)."""
 
-SAFE_DROP_M = SAFE_FALL_SPEED_U_S**2 / (2 * 800) * HAMMER_TO_M
+SAFE_DROP_M = SAFE_FALL_SPEED_U_S**2 / (2 * GRAVITY_U_S2) * HAMMER_TO_M
 """The deepest fall that does no damage (210 u)."""
 
 MAX_DROP_M = 620 * HAMMER_TO_M
@@ -85,8 +88,8 @@ MAX_VELOCITY_M_S = 3500 * HAMMER_TO_M
 TICK_RATE = 60
 """Physics ticks per second of the simulator."""
 
-GRAVITY_M_S2 = 800 * HAMMER_TO_M
-"""Gravity (sv_gravity 800 u/s²)."""
+GRAVITY_M_S2 = GRAVITY_U_S2 * HAMMER_TO_M
+"""Gravity (sv_gravity 800 u/s²) in metres."""
 
 JUMP_SPEED_M_S = 301.99 * HAMMER_TO_M
 """Upward speed a jump starts with (sqrt(2 * 800 * 57) u/s): a plain jump rises about 57 u."""
@@ -108,7 +111,7 @@ def tick_at(seconds: float, tick_rate: int = TICK_RATE) -> int:
 def fall_damage(height_m: float) -> int:
     """Damage of a fall from rest through `height_m` metres: the landing speed at sv_gravity 800
     above the safe speed, times 100 / (fatal − safe), rounded to whole health points."""
-    speed_u_s = math.sqrt(2 * 800 * max(height_m, 0.0) / HAMMER_TO_M)
+    speed_u_s = math.sqrt(2 * GRAVITY_U_S2 * max(height_m, 0.0) / HAMMER_TO_M)
     if speed_u_s <= SAFE_FALL_SPEED_U_S:
         return 0
     per_speed = 100 / (FATAL_FALL_SPEED_U_S - SAFE_FALL_SPEED_U_S)

@@ -226,9 +226,7 @@ def _learned_world(
         f"written to {patches_out}",
         highlight=False,
     )
-    return nav_world(
-        map_id, tuple((b.x_min, b.y_min, b.x_max, b.y_max, b.z_top, b.z_bottom) for b in boxes)
-    )
+    return nav_world(map_id, tuple(b.box for b in boxes))
 
 
 def _show_coverage(console: Console, coverage: NavCoverage) -> None:

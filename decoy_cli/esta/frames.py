@@ -331,10 +331,8 @@ def _vertical_speed(
 ) -> np.ndarray:
     """awpy's `velocityZ` in m/s (NaN where null: not every export has it); 0 on the ground,
     where the Source engine keeps no vertical velocity."""
-    values = np.array(
-        [np.nan if pl.velocityZ is None else pl.velocityZ for pl in entries], dtype=np.float64
-    )
-    bad = ~np.isnan(values) & ~(np.abs(values) * HAMMER_TO_M <= MAX_VELOCITY_M_S)
+    values = np.array([pl.velocityZ for pl in entries], dtype=np.float64)  # None -> NaN
+    bad = np.abs(values) * HAMMER_TO_M > MAX_VELOCITY_M_S  # infinities too, not NaN
     if bad.any():
         e = int(np.flatnonzero(bad)[0])
         raise Invalid(f"{_where(ticks, int(frame_idx[e]))}: velocityZ {values[e]} is not a speed")

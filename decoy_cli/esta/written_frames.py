@@ -74,10 +74,11 @@ def frame_documents(
     hammer = to_hammer(position)
     # horizontal velocity from the previous frame (u/s); 0 in the first frame and next to an
     # absence
-    velocity = np.zeros((p, f, 3), dtype=np.float32)
+    velocity = np.zeros((p, f, 2), dtype=np.float32)
     if f > 1:
         dt = np.diff(ticks) / rate
-        step = np.diff(hammer.astype(np.float64), axis=1) / np.where(dt > 0, dt, np.inf)[:, None]
+        moved = np.diff(hammer[..., :2].astype(np.float64), axis=1)
+        step = moved / np.where(dt > 0, dt, np.inf)[:, None]
         moving = present[:, 1:] & present[:, :-1] & np.asarray(r.alive)[:, 1:]
         velocity[:, 1:] = np.where(moving[..., None], step, 0.0).astype(np.float32)
     eye_z = to_hammer(position[..., 2] + EYE_HEIGHT_M)

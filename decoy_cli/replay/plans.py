@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -45,9 +46,9 @@ ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
 RATIO_TOLERANCE = 1e-9
 """An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
 
-MIN_RUN_S = 1.0 / 64
-"""Shortest running time an interval is given (one tick) when its jumps and falls alone take
-all of it: the required speed is then very large, not infinite."""
+MIN_RUN_S = 1.0 / TICK_RATE
+"""Shortest running time an interval is given (one simulator tick) when its jumps and falls
+alone take all of it: the required speed is then very large, not infinite."""
 
 
 class PathCache:

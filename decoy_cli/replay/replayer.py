@@ -103,13 +103,13 @@ class ReplayResult:
             late = log.lateness_s
             reached = late[np.isfinite(late)]
             plan = self.plan.plans[p]
-            over = np.isfinite(late) & (late > DATA_FRAME_S + 1e-9)
-            over[:1] = False  # the first target is the start
+            with np.errstate(invalid="ignore"):
+                over = late > DATA_FRAME_S + 1e-9  # unreached (NaN): not
+            # why: the interval to the target asked too much, or the target before was late
             asked_too_much = np.zeros(len(late), dtype=bool)
             asked_too_much[1:] = plan.interval_infeasible | plan.interval_unreachable
             carried = np.zeros(len(late), dtype=bool)
-            with np.errstate(invalid="ignore"):
-                carried[1:] = late[:-1] > DATA_FRAME_S + 1e-9
+            carried[1:] = over[:-1]
             rows.append(
                 {
                     "player": self.plan.players[p].name,
@@ -118,7 +118,7 @@ class ReplayResult:
                     "late_share": float(np.mean(reached > 1 / TICK_RATE + 1e-9))
                     if len(reached)
                     else np.nan,
-                    "late_over_frame": int(np.sum(reached > DATA_FRAME_S + 1e-9)),
+                    "late_over_frame": int(over.sum()),
                     "late_plan": int(np.sum(over & asked_too_much)),
                     "late_carried": int(np.sum(over & ~asked_too_much & carried)),
                     "late_replay": int(np.sum(over & ~asked_too_much & ~carried)),

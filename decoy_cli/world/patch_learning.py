@@ -109,13 +109,18 @@ class PatchBox:
     above_floor_u: float
     place: str
 
+    @property
+    def box(self) -> tuple[float, ...]:
+        """The box as a patches-file row reads it (`PATCH_COLUMNS`)."""
+        return tuple(float(getattr(self, key)) for key in PATCH_COLUMNS)
+
     def row(self) -> dict[str, object]:
         what = (
             f"learned: {self.samples} standing positions from {self.matches} matches, "
             f"{self.above_floor_u:.0f} u above the nav floor"
         )
         return {
-            **{key: round(float(getattr(self, key)), 1) for key in PATCH_COLUMNS},
+            **{key: round(value, 1) for key, value in zip(PATCH_COLUMNS, self.box, strict=True)},
             "what": what,
             **{key: getattr(self, key) for key in EVIDENCE_COLUMNS},
         }
