@@ -276,6 +276,8 @@ def test_jump_onto_the_box(kind: str) -> None:
     horizontal = np.linalg.norm(graph.positions[v, :2] - graph.positions[u, :2])
     expected = ticks_for(rise_seconds(BOX_Z - graph.positions[u, 2]) + horizontal / speed)
     assert abs(reached[0][1] - expected) <= 1
+    # the time in the air the planner and the replay count (edge_air_s) is the mover's
+    assert graph.edge_air_s[e] == pytest.approx(rise_seconds(BOX_Z - graph.positions[u, 2]))
     moved = np.linalg.norm(feet[:, :2] - feet[0, :2], axis=1) > 1e-9
     assert np.all(feet[moved, 2] >= BOX_Z - 1e-9)
     assert feet[:, 2].max() <= BOX_Z + 1e-9 and feet[:, 2].min() >= -1e-9
@@ -305,6 +307,7 @@ def test_drop_from_the_ledge(kind: str) -> None:
     horizontal = np.linalg.norm(graph.positions[v, :2] - graph.positions[u, :2])
     fall = math.sqrt(2 * LEDGE_Z / GRAVITY_M_S2)
     assert abs(reached[0][1] - ticks_for(horizontal / speed + fall)) <= 1
+    assert graph.edge_air_s[e] == pytest.approx(fall)  # what the planner and the replay count
     assert np.all(np.diff(feet[:, 2]) <= 1e-12)  # down only
 
 
