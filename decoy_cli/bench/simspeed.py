@@ -21,11 +21,11 @@ import numpy as np
 
 from decoy_cli.csgo import BUILTIN_MAP, TICK_RATE
 from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
-from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.random_play import RandomPolicy
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -45,39 +45,6 @@ class NeverHits:
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
         k = len(batch)
         return DamageResult(np.zeros(k, np.int64), np.full(k, -1, np.int8), np.zeros(k, bool))
-
-
-class RandomPolicy:
-    """A uniformly random valid action per decision; STOP holds 0.5 s and plants where it can.
-
-    The valid actions of a node are listed once, the uniform draws come from the generator in
-    blocks, and the nine possible decisions are made once: what the benchmark times is the
-    simulator, not numpy's per-call overhead in the policy.
-    """
-
-    _BLOCK = 4096
-
-    def __init__(self, rng: np.random.Generator) -> None:
-        self.rng = rng
-        self._actions: dict[int, tuple[int, ...]] = {}
-        self._draws = np.zeros(0)
-        self._next = 0
-        self._decisions = [
-            Decision(action, hold_ticks=30, plant=action == STOP_ACTION)
-            for action in range(STOP_ACTION + 1)
-        ]
-
-    def decide(self, sim: Simulator, agent: int) -> Decision:
-        node = int(sim.agents.node[agent])
-        actions = self._actions.get(node)
-        if actions is None:
-            actions = tuple(np.flatnonzero(sim.graph.action_mask(node)).tolist())
-            self._actions[node] = actions
-        if self._next == len(self._draws):
-            self._draws, self._next = self.rng.random(self._BLOCK), 0
-        pick = int(self._draws[self._next] * len(actions))
-        self._next += 1
-        return self._decisions[actions[pick]]
 
 
 class Switches(TypedDict):
@@ -156,12 +123,7 @@ def run_agents(
             seed=int(rng.integers(1 << 31)),
         ) as sim:
             start_tick = sim.tick
-            left = decisions - made
-
-            def enough(s: Simulator, left: int = left) -> bool:
-                return s.decision_count >= left
-
-            sim.run(until=enough)
+            sim.run(max_decisions=decisions - made)
         made += int(sim.decisions.sum())
         ticks += sim.tick - start_tick
         kills += int((~agents.alive).sum())

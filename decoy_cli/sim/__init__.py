@@ -11,19 +11,22 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from decoy_cli.sim.engine import Decision, Simulator
+    from decoy_cli.sim.decisions import Decision
+    from decoy_cli.sim.engine import Simulator
     from decoy_cli.sim.env import DecoyParallelEnv
+    from decoy_cli.sim.random_play import RandomPolicy
     from decoy_cli.sim.setup import RoundSetup, open_round
 
 _EXPORTS = {
-    "Decision": "decoy_cli.sim.engine",
+    "Decision": "decoy_cli.sim.decisions",
     "Simulator": "decoy_cli.sim.engine",
     "DecoyParallelEnv": "decoy_cli.sim.env",
+    "RandomPolicy": "decoy_cli.sim.random_play",
     "RoundSetup": "decoy_cli.sim.setup",
     "open_round": "decoy_cli.sim.setup",
 }
 
-__all__ = ["Decision", "DecoyParallelEnv", "RoundSetup", "Simulator", "open_round"]
+__all__ = ["Decision", "DecoyParallelEnv", "RandomPolicy", "RoundSetup", "Simulator", "open_round"]
 
 
 def __getattr__(name: str) -> Any:

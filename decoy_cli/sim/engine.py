@@ -26,31 +26,15 @@ from typing import Protocol
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE, fall_damage
-from decoy_cli.sim.movement import Mover, MoveStep
+from decoy_cli.sim.decisions import Decision
+from decoy_cli.sim.movement import KinematicMover, Mover, MoveStep
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
+from decoy_cli.sim.random_play import DECIDED
 from decoy_cli.sim.rules import BombRules
-from decoy_cli.sim.schedule import due_agents, next_due, note_arrivals
+from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
-
-
-@dataclass(frozen=True)
-class Decision:
-    """What an agent does next: a compass move (0..7) at a speed, or STOP for `hold_ticks`.
-
-    `speed` is m/s, capped by `max_speed` (None: the weapon's CS:GO maximum); None = full speed.
-    A replay may raise the cap above the weapon's where the data shows the player moving faster
-    (strafe-jumps, falls). `plant` and `defuse` say whether the agent wants to plant or defuse
-    while it stands still.
-    """
-
-    action: int
-    speed: float | None = None
-    max_speed: float | None = None
-    hold_ticks: int = 30
-    plant: bool = False
-    defuse: bool = False
 
 
 class Policy(Protocol):
@@ -121,7 +105,7 @@ class Simulator:
         self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
         self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
         self.goal_node = np.full(n, -1, dtype=np.int64)
-        self.fall_m = [0.0] * n  # depth of the damaging drop each agent is on (0: none)
+        self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
         self._falling = 0  # how many agents are on such a drop
         self._fall_killed = False  # a landing killed since the outcome was last judged
         self.wants_plant = np.zeros(n, dtype=bool)
@@ -226,10 +210,11 @@ class Simulator:
         *,
         to_tick: int | None = None,
         after_end: bool = False,
+        max_decisions: int | None = None,
     ) -> Recording:
-        """Play until the round ends (the tick bound), `to_tick` is reached, or `until(sim)`
-        says stop; with `after_end`, the agents go on moving after the outcome, as
-        `step(after_end=True)` has them, until `to_tick`.
+        """Play until the round ends (the tick bound), `to_tick` is reached, `until(sim)` says
+        stop or `max_decisions` decisions are made; with `after_end`, the agents go on moving
+        after the outcome, as `step(after_end=True)` has them, until `to_tick`.
 
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
@@ -239,25 +224,72 @@ class Simulator:
         whole without a glide and `until` is asked again): wherever anything but motion may have
         happened, so a predicate on decisions, events, deaths or the bomb stops the run at the
         tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
-        to stop at a tick give `to_tick`; to watch positions, `step`."""
+        to stop at a tick give `to_tick`; to watch positions, `step`.
+
+        A policy with `play_quiet` (`random_play.RandomPolicy`) plays whole quiet stretches of
+        decisions and motion in compiled code when the mover is kinematic and no `until` is
+        given (`_play_quiet`), with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
-        while self.tick < end and not (until is not None and until(self)):
+        limit = NEVER if max_decisions is None else int(max_decisions)
+
+        def stop() -> bool:
+            return self.decision_count >= limit or (until is not None and until(self))
+
+        quiet_player = None
+        if until is None and isinstance(self.mover, KinematicMover):
+            quiet_player = getattr(self.policy, "play_quiet", None)
+        while self.tick < end and not stop():
             if self.done:
                 if not (after_end and self.outcome is not None):
                     break
                 self._move_after_end(end)
                 continue
+            if quiet_player is not None and not self._falling:
+                horizon = self._stretch_end(self.tick, end)
+                if horizon > self.tick:
+                    if quiet_player(self, horizon, limit, self._watched()) == DECIDED:
+                        self._after_decisions(end, stop)
+                        continue
+                    if self.tick >= end:
+                        break
             self.tick += 1
             self._decide()
-            if until is not None and until(self):  # the decisions may have done it: play
-                self._finish_tick(self._move())  # the tick whole, then ask again
-                continue
-            last = min(self._quiet_until(self.tick - 1), end)
-            if last >= self.tick:
-                self._glide(last)
-            else:
-                self._finish_tick(self._move())
+            self._after_decisions(end, stop)
         return self.recording
+
+    def _after_decisions(self, end: int, stop: Callable[[], bool]) -> None:
+        """The rest of a tick whose decisions are made: the glide through the quiet ticks from
+        it, or the tick played whole (also when `stop` now says so, to be asked again)."""
+        if stop():
+            self._finish_tick(self._move())
+            return
+        last = min(self._quiet_until(self.tick - 1), end)
+        if last >= self.tick:
+            self._glide(last)
+        else:
+            self._finish_tick(self._move())
+
+    def note_quiet_play(self, tick: int, made: int, falls: int, glided: bool) -> None:
+        """Take over a quiet stretch a policy played itself (`run`): the tick it reached, the
+        decisions it made and the damaging drops they started; if it glided, the positions and
+        the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
+        self.tick = tick
+        self.decision_count += made
+        self._falling += falls
+        if glided:
+            self.agents.position[:] = self.mover.positions
+            self.rules.follow(self.agents, self.bomb)
+
+    def _watched(self) -> np.ndarray:
+        """(N,) the agents whose wish to plant or defuse the bomb rules may act on: the carrier
+        of a carried bomb, everyone once it is planted (a policy playing a quiet stretch hands
+        the tick back when one of them decides to)."""
+        watch = np.zeros(self.agents.count, dtype=bool)
+        if self.bomb.status == BombStatus.CARRIED and self.bomb.carrier >= 0:
+            watch[self.bomb.carrier] = True
+        elif self.bomb.status != BombStatus.CARRIED:
+            watch[:] = True
+        return watch
 
     def relocate(self, agent: int, node: int) -> None:
         """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event.
@@ -322,16 +354,22 @@ class Simulator:
 
     def _quiet_until(self, tick: int) -> int:
         """The last tick through which nothing but motion can happen after `tick`, if no agent
-        arrives before: no decision falls due, no combat step, no recorded tick, the bomb rules
-        have nothing to do and the outcome cannot change (the clock, the detonation). Equal to
-        `tick` when the tick after it is not quiet. Asked once the decisions of the tick after
-        `tick` are made (they are the only part of that tick already played)."""
+        arrives before: no decision falls due, and `_stretch_end`. Equal to `tick` when the
+        tick after it is not quiet. Asked once the decisions of the tick after `tick` are made
+        (they are the only part of that tick already played)."""
+        due = next_due(self.waiting, self.agents.alive, self.hold_until, tick)
+        if due == tick + 1:
+            return tick
+        return max(tick, min(self._stretch_end(tick, self._max_tick), due - 1))
+
+    def _stretch_end(self, tick: int, end: int) -> int:
+        """The last tick, at most `end`, through which nothing but decisions and motion can
+        happen after `tick`: no combat step, no recorded tick, the bomb rules have nothing to
+        do and the outcome cannot change (the clock, the detonation), as long as no agent the
+        rules watch decides (`_watched`); `tick` when the tick after it is not quiet."""
         alive = self.agents.alive
-        due = next_due(self.waiting, alive, self.hold_until, tick)
-        if self.outcome is not None or due == tick + 1:
-            return tick
-        if alive.tobytes() != self._alive_judged:  # not judged yet, or a kill from outside
-            return tick
+        if self.outcome is not None or alive.tobytes() != self._alive_judged:
+            return tick  # judged yet? (not after a kill from outside)
         rules = self.rules.quiet_until(
             tick,
             self.agents,
@@ -340,7 +378,7 @@ class Simulator:
             self.wants_defuse,
             self.mover.is_standing,
         )
-        last = min(self._max_tick - 1, rules, due - 1)
+        last = min(end, self._max_tick - 1, rules)
         if self.combat is not None:
             last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
         if self._next_record < len(self._record_at):
@@ -364,7 +402,7 @@ class Simulator:
 
     def _set_fall(self, agent: int, depth: float) -> None:
         """Note the depth of the damaging drop an agent is on (0: none), keeping the count."""
-        self._falling += (depth > 0) - (self.fall_m[agent] > 0)
+        self._falling += int(depth > 0) - int(self.fall_m[agent] > 0)
         self.fall_m[agent] = depth
 
     def _land(self, arrived: np.ndarray) -> None:
@@ -372,7 +410,7 @@ class Simulator:
         fall (`csgo.fall_damage`); a fall that takes the last health kills. Before the round's
         end only: afterwards nothing changes health."""
         for agent in np.flatnonzero(arrived).tolist():
-            height = self.fall_m[agent]
+            height = float(self.fall_m[agent])
             if not height:
                 continue
             self._set_fall(agent, 0.0)

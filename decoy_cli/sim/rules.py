@@ -244,6 +244,12 @@ class BombRules:
                 events += self._defuse(tick, agents, bomb, wants_defuse, moving)
         return events
 
+    def follow(self, agents: Agents, bomb: Bomb) -> None:
+        """All that `step` does on a quiet tick (`quiet_until`): a carried bomb follows its
+        carrier. The engine calls it instead of `step` after ticks it knows are quiet."""
+        if self.config.bomb_enabled and bomb.status == BombStatus.CARRIED and bomb.carrier >= 0:
+            bomb.position = agents.position[bomb.carrier].copy()
+
     def on_death(self, tick: int, agent: int, agents: Agents, bomb: Bomb) -> list[SimEvent]:
         """An agent died: its plant or defuse stops, and the bomb it carried drops where it
         stood."""

@@ -99,6 +99,8 @@ class LineOfSight:
             self.bodies.append(body)
         self._owner = {body: k for k, body in enumerate(self.bodies)}
         self._placed = np.full((count, 3), np.nan)  # feet each capsule stands on; NaN = parked
+        self._pairs_key: tuple[tuple[str, ...], bytes] | None = None  # `_enemy_pairs`' cache
+        self._pairs = (np.zeros(0, np.int64), np.zeros(0, np.int64))
 
     def close(self) -> None:
         """Remove the capsules from the physics client (the client stays open)."""
@@ -122,20 +124,17 @@ class LineOfSight:
         if len(self.bodies) != self.count:
             raise ValueError("line of sight is closed")
         alive = np.asarray(agents.alive, dtype=bool)
-        t_side = np.flatnonzero(alive & (agents.side == "T"))
-        ct_side = np.flatnonzero(alive & (agents.side == "CT"))
-        if len(t_side) == 0 or len(ct_side) == 0:
+        first, second = self._enemy_pairs(agents, alive)
+        if len(first) == 0:
             return _no_pairs()
         feet = np.asarray(agents.position, dtype=np.float64)
-        if not np.all(np.isfinite(feet[alive])):
+        if not np.isfinite(feet[first]).all() or not np.isfinite(feet[second]).all():
             raise ValueError("an alive agent has a NaN or infinite position")
-        one = np.repeat(t_side, len(ct_side))  # every (T, CT) pair, T-major
-        two = np.tile(ct_side, len(t_side))
-        first = np.minimum(one, two)  # rays run from the lower to the higher index
-        second = np.maximum(one, two)
         eyes = feet + np.array([0.0, 0.0, self.eye_height])
         clear = self.physics.occlusion.clear(eyes[first], eyes[second])
-        if np.any(clear) and np.count_nonzero(alive) > 2:
+        if not clear.any():
+            return _no_pairs()
+        if np.count_nonzero(alive) > 2:
             self._place(feet, alive)
             ray = np.flatnonzero(clear)
             clear[ray] = self._bodies_clear(eyes, first[ray], second[ray])
@@ -143,6 +142,19 @@ class LineOfSight:
         victim = np.concatenate([second[clear], first[clear]])
         order = np.lexsort((victim, attacker))
         return VisiblePairs(attacker[order].astype(np.int64), victim[order].astype(np.int64))
+
+    def _enemy_pairs(self, agents: Agents, alive: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every (T, CT) pair of alive agents, T-major, as (lower index, higher index): the
+        rays run from the lower to the higher. Kept while the sides and the living stay."""
+        key = (tuple(agents.side), alive.tobytes())
+        if key != self._pairs_key:
+            t_side = np.flatnonzero(alive & (agents.side == "T"))
+            ct_side = np.flatnonzero(alive & (agents.side == "CT"))
+            one = np.repeat(t_side, len(ct_side))
+            two = np.tile(ct_side, len(t_side))
+            self._pairs = (np.minimum(one, two), np.maximum(one, two))
+            self._pairs_key = key
+        return self._pairs
 
     def _place(self, feet: np.ndarray, alive: np.ndarray) -> None:
         """Stand the capsules of alive agents on their feet and park the others (only moves

@@ -165,6 +165,16 @@ class WaypointGraph:
         table[self.edge_source, self.edge_direction] = np.arange(self.num_edges)
         return table
 
+    @cached_property
+    def allowed_actions(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every node's possible actions (`action_mask`) in one list: (first, actions), the
+        actions of node i ascending in actions[first[i]:first[i + 1]]; first has N + 1 rows."""
+        mask = np.ones((self.num_nodes, 9), dtype=bool)
+        mask[:, :8] = self.out_edges >= 0
+        first = np.zeros(self.num_nodes + 1, dtype=np.int64)
+        np.cumsum(mask.sum(axis=1), out=first[1:])
+        return first, np.nonzero(mask)[1].astype(np.int64)
+
     def action_mask(self, node: int) -> np.ndarray:
         """Which of the 9 actions (8 moves, STOP) are possible at a node."""
         mask = np.ones(9, dtype=np.int8)

@@ -1,0 +1,129 @@
+"""`RandomPolicy` playing quiet stretches in compiled code (`Simulator.run` with the kinematic
+mover) gives tick for tick what stepping every tick gives, and what deciding one agent at a
+time gives: the same recording, events, outcome and decisions on many seeded busy rounds."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from busy_rounds import Shots, site_agents
+
+from decoy_cli.sim import random_play
+from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.random_play import RandomPolicy
+from decoy_cli.sim.setup import RoundSetup, open_round
+from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.waypoints.graph import STOP_ACTION
+from decoy_cli.world.navmesh import nav_world
+from decoy_cli.world.physics import PhysicsWorld
+
+GRAPH = builtin_graph()
+
+
+class OneAtATime:
+    """The same random policy without its compiled stretches: one `decide` per agent."""
+
+    def __init__(self, policy: RandomPolicy) -> None:
+        self.policy = policy
+
+    def decide(self, sim: Simulator, agent: int) -> Decision:
+        return self.policy.decide(sim, agent)
+
+
+def _policy(seed: int) -> RandomPolicy:
+    return RandomPolicy(np.random.default_rng(seed), hold_ticks=1 + 97 * (seed % 4), defuse=True)
+
+
+def _play(
+    physics: PhysicsWorld, seed: int, policy: object, drive: Callable[[Simulator], None]
+) -> Simulator:
+    setup = RoundSetup(graph=GRAPH, mover="kinematic", damage_model=Shots())
+    with open_round(
+        setup,
+        site_agents(GRAPH, seed),
+        policy,  # type: ignore[arg-type]
+        physics=physics,
+        bomb_carrier=seed % 5,
+        record_ticks=range(0, 8000, 7 + seed % 50),
+        seed=seed,
+    ) as sim:
+        drive(sim)
+    return sim
+
+
+def _every_tick(sim: Simulator) -> None:
+    while not sim.done:
+        sim.step()
+
+
+def _same(a: Simulator, b: Simulator, seed: int) -> None:
+    assert a.outcome == b.outcome, seed
+    assert a.tick == b.tick, seed
+    assert a.events == b.events, seed
+    for name in ("ticks", "position", "yaw", "hp", "alive"):
+        x, y = getattr(a.recording, name), getattr(b.recording, name)
+        np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")
+    np.testing.assert_array_equal(a.decisions, b.decisions)
+
+
+@pytest.fixture(scope="module")
+def physics():
+    with PhysicsWorld(nav_world()) as world:
+        yield world
+
+
+@pytest.fixture()
+def stretches(monkeypatch) -> list[int]:
+    """The decisions made inside compiled stretches, call by call."""
+    made: list[int] = []
+    play = random_play._play
+
+    def counting(*args):
+        out = play(*args)
+        made.append(int(out[2]))
+        return out
+
+    monkeypatch.setattr(random_play, "_play", counting)
+    return made
+
+
+def test_compiled_stretches_give_what_stepping_every_tick_gives(physics, stretches) -> None:
+    kinds: set[str] = set()
+    for seed in range(40):
+        stepped = _play(physics, seed, OneAtATime(_policy(seed)), _every_tick)
+        compiled = _play(physics, seed, _policy(seed), lambda sim: sim.run())
+        _same(compiled, stepped, seed)
+        kinds |= {event.kind for event in stepped.events}
+    assert {"damage", "kill", "plant", "bomb_drop", "defuse_start", "round_end"} <= kinds, kinds
+    assert sum(stretches) > 1000  # most decisions were made in compiled stretches
+
+
+def test_max_decisions_stops_where_a_decision_predicate_stops(physics, stretches) -> None:
+    for seed, count in ((0, 1), (1, 37), (2, 400), (3, 2500)):
+        asked = _play(
+            physics, seed, OneAtATime(_policy(seed)),
+            lambda sim, n=count: sim.run(lambda s: s.decision_count >= n),
+        )  # fmt: skip
+        capped = _play(physics, seed, _policy(seed), lambda sim, n=count: sim.run(max_decisions=n))
+        _same(capped, asked, seed)
+        assert capped.decision_count == asked.decision_count >= min(count, 1)
+    assert sum(stretches) > 0
+
+
+def test_random_policy_picks_only_possible_actions_uniformly() -> None:
+    policy = RandomPolicy(np.random.default_rng(0))
+    node = int(np.argmax((GRAPH.out_edges >= 0).sum(axis=1) == 3))
+    allowed = set(np.flatnonzero(GRAPH.action_mask(node)).tolist())
+
+    class Sim:  # what `decide` reads of a simulator
+        graph = GRAPH
+        agents = type("A", (), {"node": np.array([node])})()
+
+    picks = [policy.decide(Sim(), 0).action for _ in range(4000)]  # type: ignore[arg-type]
+    counts = np.bincount(picks, minlength=9)
+    assert set(np.flatnonzero(counts).tolist()) == allowed
+    assert len(allowed) == 4 and counts[list(allowed)].min() > 4000 / 4 * 0.9
+    stop = next(d for d in map(lambda a: policy._decisions[a], [STOP_ACTION]))
+    assert stop.plant and not stop.defuse and stop.hold_ticks == 30
