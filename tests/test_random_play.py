@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from busy_rounds import Shots, site_agents
 
-from decoy_cli.sim import random_play
+from decoy_cli.sim import quiet_play
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.random_play import RandomPolicy
 from decoy_cli.sim.setup import RoundSetup, open_round
@@ -78,14 +78,14 @@ def physics():
 def stretches(monkeypatch) -> list[int]:
     """The decisions made inside compiled stretches, call by call."""
     made: list[int] = []
-    play = random_play._play
+    play = quiet_play._play
 
     def counting(*args):
         out = play(*args)
         made.append(int(out[2]))
         return out
 
-    monkeypatch.setattr(random_play, "_play", counting)
+    monkeypatch.setattr(quiet_play, "_play", counting)
     return made
 
 
@@ -125,5 +125,5 @@ def test_random_policy_picks_only_possible_actions_uniformly() -> None:
     counts = np.bincount(picks, minlength=9)
     assert set(np.flatnonzero(counts).tolist()) == allowed
     assert len(allowed) == 4 and counts[list(allowed)].min() > 4000 / 4 * 0.9
-    stop = next(d for d in map(lambda a: policy._decisions[a], [STOP_ACTION]))
+    stop = policy._decisions[STOP_ACTION]
     assert stop.plant and not stop.defuse and stop.hold_ticks == 30

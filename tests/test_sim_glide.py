@@ -93,6 +93,8 @@ def test_until_is_asked_whenever_more_than_motion_may_have_happened(physics) -> 
 
 
 def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypatch) -> None:
+    """Its steps play quiet stretches in compiled code (`quiet_play`), stopping where an agent
+    is due, as stepping every tick does."""
     from decoy_cli.sim import DecoyParallelEnv
 
     def play() -> list:
@@ -113,10 +115,25 @@ def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypa
         env.close()
         return trace
 
-    glided = play()
+    from decoy_cli.sim import quiet_play
 
-    def every_tick(sim: Simulator, until=None):
+    made: list[int] = []
+    compiled = quiet_play._play
+
+    def counting(*args):
+        out = compiled(*args)
+        made.append(int(out[2]))
+        return out
+
+    monkeypatch.setattr(quiet_play, "_play", counting)
+    glided = play()
+    assert sum(made) > 1000  # the steps' decisions went through compiled stretches
+
+    def every_tick(sim: Simulator, until=None, *, stop_when_due: bool = False):
+        first = sim.tick
         while not sim.done and not (until is not None and until(sim)):
+            if stop_when_due and sim.tick > first and sim.needs_decision.any():
+                break
             sim.step()
         return sim.recording
 

@@ -29,7 +29,7 @@ from decoy_cli.csgo import TICK_RATE, fall_damage
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.movement import KinematicMover, Mover, MoveStep
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.random_play import DECIDED
+from decoy_cli.sim.quiet_play import DECIDED
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
@@ -211,10 +211,13 @@ class Simulator:
         to_tick: int | None = None,
         after_end: bool = False,
         max_decisions: int | None = None,
+        stop_when_due: bool = False,
     ) -> Recording:
         """Play until the round ends (the tick bound), `to_tick` is reached, `until(sim)` says
-        stop or `max_decisions` decisions are made; with `after_end`, the agents go on moving
-        after the outcome, as `step(after_end=True)` has them, until `to_tick`.
+        stop, `max_decisions` decisions are made or, with `stop_when_due`, after the first tick
+        an agent is due for a decision at the next (`decision_due`: the environment's step);
+        with `after_end`, the agents go on moving after the outcome, as `step(after_end=True)`
+        has them, until `to_tick`. The stopping rules are asked as `until` is.
 
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
@@ -226,14 +229,20 @@ class Simulator:
         tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
-        A policy with `play_quiet` (`random_play.RandomPolicy`) plays whole quiet stretches of
-        decisions and motion in compiled code when the mover is kinematic and no `until` is
-        given (`_play_quiet`), with the same result."""
+        A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy, the
+        environment's actions) plays whole quiet stretches of decisions and motion in compiled
+        code when the mover is kinematic and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else int(max_decisions)
 
+        first = self.tick
+
         def stop() -> bool:
-            return self.decision_count >= limit or (until is not None and until(self))
+            return (
+                self.decision_count >= limit
+                or (stop_when_due and self.tick > first and self.decision_due)
+                or (until is not None and until(self))
+            )
 
         quiet_player = None
         if until is None and isinstance(self.mover, KinematicMover):
@@ -247,11 +256,12 @@ class Simulator:
             if quiet_player is not None and not self._falling:
                 horizon = self._stretch_end(self.tick, end)
                 if horizon > self.tick:
+                    before = (self.tick, self.decision_count)
                     if quiet_player(self, horizon, limit, self._watched()) == DECIDED:
                         self._after_decisions(end, stop)
                         continue
-                    if self.tick >= end:
-                        break
+                    if (self.tick, self.decision_count) != before:
+                        continue  # ask the stopping rules again
             self.tick += 1
             self._decide()
             self._after_decisions(end, stop)
@@ -444,6 +454,12 @@ class Simulator:
         self.wants_defuse[agent] = False
         if self.outcome is None:  # after the end the bomb stays as the round left it
             self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
+
+    @property
+    def decision_due(self) -> bool:
+        """Whether some agent will ask its policy for an action at the next tick."""
+        due = next_due(self.waiting, self.agents.alive, self.hold_until, self.tick)
+        return not self.done and due == self.tick + 1
 
     @property
     def needs_decision(self) -> np.ndarray:

@@ -24,11 +24,13 @@ from pettingzoo import ParallelEnv
 from decoy_cli.csgo import BUILTIN_MAP, seconds_to_ticks
 from decoy_cli.errors import GraphError
 from decoy_cli.sim.combat import DamageModel
-from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.decisions import Decision
+from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.observation import (
     NUM_ACTIONS,
     ObservationEncoder,
 )
+from decoy_cli.sim.quiet_play import QUIET_END, Choices, TopSpeeds, play_stretch
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
@@ -44,20 +46,43 @@ DEFAULT_WEAPONS = {"T": "Glock-18", "CT": "USP-S"}
 
 
 class _ChosenActions:
-    """The engine's policy inside the environment: it hands over the decisions that `step`
-    collected for exactly the agents the engine asks at the step's first tick."""
+    """The engine's policy inside the environment: the actions `step` collected, one per agent
+    the engine asks at the step's first tick (-1: none). A STOP holds `stop_ticks` and plants
+    (a T) or defuses (a CT). With the kinematic mover the step's quiet stretches are played in
+    compiled code (`quiet_play`) up to the next tick at which an agent is due."""
 
-    def __init__(self) -> None:
-        self.pending: dict[int, Decision] = {}
+    def __init__(self, sides: list[str], stop_ticks: int) -> None:
+        is_t = np.array([side == "T" for side in sides])
+        n = len(sides)
+        self.choices = Choices(np.full(n, -1, np.int64), np.zeros(0), 0, stop_ticks, is_t, ~is_t)
+        self.possible = True  # every move handed in has an edge (else Python plays the tick)
+        self._top = TopSpeeds()
 
     def decide(self, sim: Simulator, agent: int) -> Decision:
-        try:
-            return self.pending.pop(agent)
-        except KeyError:
+        action = int(self.choices.given[agent])
+        if action < 0:
             raise RuntimeError(
                 f"the simulator asked agent {agent} for a decision at tick {sim.tick}, "
                 "which the environment did not expect"
-            ) from None
+            )
+        self.choices.given[agent] = -1
+        stop = action == STOP_ACTION
+        return Decision(
+            action,
+            hold_ticks=self.choices.hold_ticks,
+            plant=stop and bool(self.choices.plant[agent]),
+            defuse=stop and bool(self.choices.defuse[agent]),
+        )
+
+    def play_quiet(
+        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
+    ) -> int:
+        """The step's quiet stretches in compiled code; an impossible move is left to Python,
+        which stands the agent still and records it."""
+        if not self.possible:
+            return QUIET_END
+        top = self._top.of(sim.agents.weapon)
+        return play_stretch(sim, horizon, max_decisions, watch, self.choices, top)
 
 
 def _map_graph(map_name: str | None, graph: WaypointGraph | None) -> WaypointGraph:
@@ -241,7 +266,8 @@ class DecoyParallelEnv(ParallelEnv):
 
         self._rng: np.random.Generator | None = None
         self._sim: Simulator | None = None
-        self._policy = _ChosenActions()
+        self._policy = _ChosenActions(self._sides, self.stop_ticks)
+        self._due_next = np.zeros(len(self._sides), dtype=bool)  # who decides at the next step
         self.physics: PhysicsWorld | None = None
         """The pybullet client of the current round (None with the kinematic mover and no
         combat, or after `close()`)."""
@@ -284,7 +310,7 @@ class DecoyParallelEnv(ParallelEnv):
         )
         carrier = int(rng.integers(self.n_t)) if self.bomb and self.n_t else -1
         self._end_round()
-        self._policy = _ChosenActions()
+        self._policy = _ChosenActions(self._sides, self.stop_ticks)
         if self.setup.needs_physics and self.physics is None:
             self.physics = self._world.enter_context(self.setup.open_physics())
         self._sim = self._round.enter_context(
@@ -298,7 +324,7 @@ class DecoyParallelEnv(ParallelEnv):
             )
         )
         self.agents = list(self.possible_agents)
-        due = self._due()
+        due = self._due_next = self._sim.needs_decision
         return self._observe(self.agents, due), self._infos(self.agents, due)
 
     def step(
@@ -317,21 +343,24 @@ class DecoyParallelEnv(ParallelEnv):
         if unknown:
             raise ValueError(f"actions for agents not in the episode: {', '.join(unknown)}")
         live = list(self.agents)
-        due = self._due()
-        pending = {}
+        due = self._due_next
+        given = self._policy.choices.given
+        given[:] = -1
         for name in live:
             agent = self._index[name]
             if due[agent]:
                 if name not in actions:
                     raise ValueError(f"agent {name} needs a decision but was given no action")
-                pending[agent] = self._decision(agent, actions[name])
-        self._policy.pending = pending
-        start = sim.tick  # the first tick takes the decisions, then on to the next ones
-        sim.run(until=lambda s: s.tick > start and bool(s.needs_decision.any()))
-        if self._policy.pending:
+                given[agent] = self._action(agent, actions[name])
+        moves = np.flatnonzero((given >= 0) & (given < STOP_ACTION))
+        self._policy.possible = bool(
+            np.all(self.graph.out_edges[sim.agents.node[moves], given[moves]] >= 0)
+        )
+        sim.run(stop_when_due=True)  # the first tick takes the decisions, then on to the next
+        if np.any(given >= 0):
             raise RuntimeError(
-                f"the simulator did not ask agents {sorted(self._policy.pending)} for the "
-                "decision the environment collected"
+                f"the simulator did not ask agents {np.flatnonzero(given >= 0).tolist()} for "
+                "the decision the environment collected"
             )
 
         outcome = sim.outcome
@@ -344,7 +373,7 @@ class DecoyParallelEnv(ParallelEnv):
             name: bool(outcome is not None or not alive[self._index[name]]) for name in live
         }
         truncations = dict.fromkeys(live, False)
-        due = self._due()
+        due = self._due_next = sim.needs_decision
         observations = self._observe(live, due)
         infos = self._infos(live, due)
         self.agents = [name for name in live if not terminations[name]]
@@ -397,23 +426,15 @@ class DecoyParallelEnv(ParallelEnv):
         self._round = ExitStack()
         self._sim = None
 
-    def _due(self) -> np.ndarray:
-        """(N,) which agents the engine will ask for a decision at the next tick."""
-        return self._require_sim().needs_decision
-
-    def _decision(self, agent: int, action: Any) -> Decision:
-        """The engine decision for an agent's action (see the class docstring)."""
+    def _action(self, agent: int, action: Any) -> int:
+        """An agent's action as the int 0..8 it must be (8: STOP)."""
         if isinstance(action, bool) or not isinstance(action, Integral):
             raise ValueError(
                 f"{self.possible_agents[agent]}: an action is an int 0..8, got {action!r}"
             )
-        action = int(action)
-        if not 0 <= action < NUM_ACTIONS:
+        if not 0 <= int(action) < NUM_ACTIONS:
             raise ValueError(f"{self.possible_agents[agent]}: action {action} is not in 0..8")
-        if action != STOP_ACTION:
-            return Decision(action, hold_ticks=self.stop_ticks)
-        is_t = self._sides[agent] == "T"
-        return Decision(STOP_ACTION, hold_ticks=self.stop_ticks, plant=is_t, defuse=not is_t)
+        return int(action)
 
     def _observe(self, names: list[str], due: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
         sim = self._require_sim()

@@ -1,0 +1,189 @@
+"""Quiet stretches played in compiled code: decisions and kinematic motion, event to event.
+
+A quiet stretch is a run of ticks on which nothing but decisions and motion can happen: up to
+the next combat step, recorded tick, bomb-rule tick or the end (`Simulator._stretch_end`). A
+policy whose choices need no Python per decision (`QuietPlayer`) plays it in one compiled loop
+(`_play`): at each tick the due agents decide, then the motion glides to the next arrival or
+decision, exactly as `Simulator.run` plays it tick by tick. Choices come from either
+
+* uniform draws over each agent's possible actions (`random_play.RandomPolicy`), or
+* actions handed in for the agents due at the stretch's first tick (the environment's step),
+  after which the loop stops before the next tick at which an agent is due.
+
+It hands back to Python when anything else may follow: a damaging drop, the decision limit,
+the stretch's end, or a STOP to plant or defuse by an agent the bomb rules watch (the carrier;
+everyone once the bomb is planted). The engine takes over what the loop did
+(`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+from numba import njit
+
+from decoy_cli.sim.movement import KinematicMover
+from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
+from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
+from decoy_cli.sim.schedule import next_due, note_arrivals
+from decoy_cli.waypoints.graph import STOP_ACTION
+from decoy_cli.weapons import max_speed_m_s
+
+if TYPE_CHECKING:
+    from decoy_cli.sim.engine import Simulator
+
+QUIET_END, NEED_DRAWS, DECIDED, DUE, AIRBORNE = range(5)
+"""How `_play` ended: it reached the stretch's end (the next tick is Python's to play); it has
+too few draws left for the agents due next; it made decisions after which Python goes on with
+the tick; an agent is due with no action handed in (the tick is not begun); an agent asked to
+move is in the air."""
+
+DRAW = -2
+"""In `Choices.given`: the agent's action is drawn (-1: none handed in; 0..8: this action)."""
+
+
+class QuietPlayer(Protocol):
+    """A policy that plays quiet stretches itself (`Simulator.run` hands them over)."""
+
+    def play_quiet(
+        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
+    ) -> int:
+        """Play from `sim.tick` through at most `horizon`; returns how it ended (`_play`)."""
+        ...
+
+
+@dataclass
+class Choices:
+    """Where a stretch's decisions come from, per agent (N,) and for every STOP."""
+
+    given: np.ndarray  # int64: an action handed in (used once), DRAW, or -1 (stop when due)
+    draws: np.ndarray  # float64 uniform draws in [0, 1), used in order from `next_draw`
+    next_draw: int
+    hold_ticks: int  # how long a STOP holds
+    plant: np.ndarray  # bool: a STOP of this agent wants to plant
+    defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
+
+
+class TopSpeeds:
+    """Each agent's full speed with its weapon in hand (m/s), kept while the weapons stay."""
+
+    def __init__(self) -> None:
+        self._weapons: tuple[str, ...] = ()
+        self._top = np.zeros(0)
+
+    def of(self, weapons: np.ndarray) -> np.ndarray:
+        key = tuple(weapons)
+        if key != self._weapons:
+            self._weapons = key
+            self._top = np.array([max_speed_m_s(str(w)) for w in key])
+        return self._top
+
+
+def play_stretch(
+    sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices,
+    top: np.ndarray,
+) -> int:  # fmt: skip
+    """Play one quiet stretch of `sim` through at most `horizon` with `choices` (`_play`), hand
+    what it did to the engine and return how it ended; `choices.next_draw` moves on."""
+    graph, agents, mover = sim.graph, sim.agents, sim.mover
+    if not isinstance(mover, KinematicMover):
+        raise TypeError("compiled stretches need the kinematic mover")
+    first, actions = graph.allowed_actions
+    pos, start, target, fv, iv, flags, params = mover.kernel_arrays()
+    tick, used, made, falls, glide_end, status = _play(
+        sim.tick, horizon, choices.given, choices.draws, choices.next_draw, first, actions,
+        choices.hold_ticks, choices.plant, choices.defuse, max_decisions - sim.decision_count,
+        watch, top, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
+        graph.positions, agents.node, agents.alive, agents.yaw, sim.waiting, sim.hold_until,
+        sim.decisions, sim.wants_plant, sim.wants_defuse, sim.goal_node, sim.fall_m,
+        pos, start, target, fv, iv, flags, params, mover.jump_speed, mover.gravity,
+    )  # fmt: skip
+    choices.next_draw = used
+    sim.note_quiet_play(tick, made, falls, glide_end >= 0)
+    if status == AIRBORNE:
+        raise ValueError("an agent due for a decision is in the air")
+    return status
+
+
+@njit(cache=True)
+def _play(
+    tick, horizon, given, draws, next_draw, first, actions, hold_ticks, plant, defuse,
+    decisions_left, watch, top, out_edges, edge_target, edge_kind, edge_fall, positions,
+    node, alive, yaw, waiting, hold_until, decisions, wants_plant, wants_defuse, goal_node, fall_m,
+    pos, start, target, fv, iv, flags, prm, jump_speed, gravity,
+):  # fmt: skip
+    """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
+    tick: at each tick the due agents (ascending) decide (`Choices`), then if the tick after
+    them is quiet the motion glides to the next arrival or decision or the horizon. Every move
+    handed in must be possible (an edge leaves the agent's node). Returns (tick, next draw,
+    decisions made, damaging drops started, tick of the last glide's end or -1, status)."""
+    n = alive.shape[0]
+    made = falls = 0
+    glide_end = -1
+    one = np.empty(1, np.int64)
+    while True:
+        if tick + 1 > horizon:
+            return tick, next_draw, made, falls, glide_end, QUIET_END
+        drawn = 0
+        for i in range(n):
+            if alive[i] and (waiting[i] or (hold_until[i] > 0 and tick + 1 >= hold_until[i])):
+                if given[i] == -1:
+                    return tick, next_draw, made, falls, glide_end, DUE
+                if given[i] == DRAW:
+                    drawn += 1
+        if drawn > draws.shape[0] - next_draw:
+            return tick, next_draw, made, falls, glide_end, NEED_DRAWS
+        tick += 1
+        hand_back = False
+        for a in range(n):
+            if not (alive[a] and (waiting[a] or (hold_until[a] > 0 and tick >= hold_until[a]))):
+                continue
+            hold_until[a] = 0
+            waiting[a] = False
+            at = node[a]
+            act = given[a]
+            if act == DRAW:
+                act = actions[first[at] + np.int64(draws[next_draw] * (first[at + 1] - first[at]))]
+                next_draw += 1
+            else:
+                given[a] = -1  # used: the agent's next turn stops the stretch
+            decisions[a] += 1
+            made += 1
+            stop = act == STOP_ACTION
+            wants_plant[a] = plant[a] and stop
+            wants_defuse[a] = defuse[a] and stop
+            if watch[a] and stop and (plant[a] or defuse[a]):  # the bomb rules may act on it
+                hand_back = True
+            if stop:
+                one[0] = a
+                stand_still(one, fv, iv)
+                hold_until[a] = tick + hold_ticks
+                continue
+            edge = out_edges[at, act]
+            goal = edge_target[edge]
+            goal_node[a] = goal
+            if edge_fall[edge] > 0.0:
+                fall_m[a] = edge_fall[edge]
+                falls += 1
+                hand_back = True
+            if not begin_edge(
+                a, positions[goal, 0], positions[goal, 1], positions[goal, 2], edge_kind[edge],
+                top[a], top[a], jump_speed, gravity, pos, target, fv, iv,
+            ):  # fmt: skip
+                return tick, next_draw, made, falls, glide_end, AIRBORNE
+        if hand_back or made >= decisions_left:
+            return tick, next_draw, made, falls, glide_end, DECIDED
+        due_at = next_due(waiting, alive, hold_until, tick - 1)
+        last = min(horizon, due_at - 1)
+        if due_at == tick or last < tick:
+            return tick, next_draw, made, falls, glide_end, DECIDED
+        flags[:] = False
+        ticks, _ = kinematic_glide(pos, start, target, fv, iv, flags, prm, last - tick + 1)
+        tick += ticks - 1
+        glide_end = tick
+        for i in range(n):
+            if flags[R_MOVED, i]:
+                yaw[i] = fv[i, F_HEADING]
+        note_arrivals(flags[R_ARRIVED], alive, node, goal_node, waiting)
