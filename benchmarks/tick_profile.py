@@ -4,9 +4,10 @@ Runs the Table 1 protocol (random valid actions, 10,000 decisions, every mechani
 shipped damage models) under cProfile and sorts each function's own time into parts: pybullet
 (world contacts, body moves), Embree (line of sight), compiled movement kernels, the bomb rules,
 line of sight and damage (numpy and the models), the benchmark's random policy, recording, the
-engine, the movers' Python side, numpy's calls, and other Python glue. cProfile adds a
-fixed cost to every Python call, so Python-heavy parts read larger than they are: compare the
-shares between runs of this script, not with `decoy bench`'s ticks per second.
+engine, the compiled stretches of decisions and glides (kinematic mover), the movers' Python
+side, numpy's calls, and other Python glue. cProfile adds a fixed cost to every Python call, so
+Python-heavy parts read larger than they are: compare the shares between runs of this script,
+not with `decoy bench`'s ticks per second.
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ PARTS = (  # (part, substrings of "file:function"), first match wins
     ("movement kernels (numba)", ("collision.py", "kernels.py")),
     ("bomb rules", ("sim/rules.py", "sim/sites.py")),
     ("line of sight and damage", ("sim/sight.py", "sim/combat.py", "damage/", "torch")),
-    ("random policy (the benchmark's)", ("bench/simspeed.py:", "graph.py:")),
+    ("compiled stretches (decisions and glides)", ("quiet_play.py",)),
+    ("random policy (the benchmark's)", ("random_play.py", "bench/simspeed.py:", "graph.py:")),
     ("recording", ("_record",)),
     ("engine (sim/engine.py, sim/schedule.py)", ("sim/engine.py", "sim/schedule.py")),
     ("movers' Python (goals, calls)", ("sim/movement/",)),
