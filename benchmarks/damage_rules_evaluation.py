@@ -36,6 +36,11 @@ def main() -> None:
         f"{len(result.cells)} cells (largest {result.max_wasserstein_hp:.2f}); per fold "
         f"{folds.mean():.2f} ± {folds.std(ddof=1):.2f} HP ({', '.join(f'{v:.2f}' for v in folds)})"
     )
+    floor = result.cells["floor_hp"]
+    print(
+        f"sampling floor (what the model would score were the real hits drawn from it): mean "
+        f"{floor.mean():.2f} HP, largest cell {floor.max():.2f} HP"
+    )
     with pd.option_context("display.width", 160):
         print(result.cells.round(3).to_string(index=False))
         print(result.group_tv.round(3).to_string(index=False))

@@ -19,6 +19,7 @@ from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.damage.scores import (
+    Cell,
     average_precision,
     best_f1_threshold,
     classification_metrics,
@@ -27,6 +28,7 @@ from decoy_cli.damage.scores import (
     regression_metrics,
     roc_auc,
     roc_curve,
+    sampling_floor,
     wasserstein_cells,
 )
 
@@ -114,6 +116,25 @@ def test_wasserstein_cells() -> None:
     ]
     expected = wasserstein_distance(damage[:20], generated_damage[:60])
     assert cells[0].wasserstein_hp == pytest.approx(expected)
+
+
+def test_sampling_floor_is_what_samples_of_the_model_itself_score() -> None:
+    rng = np.random.default_rng(1)
+    generated_damage = np.concatenate([rng.normal(30, 10, 4000), np.full(4000, 77.0)])
+    generated_weapon = np.array(["AK-47"] * 4000 + ["AWP"] * 4000, dtype=object)
+    generated_group = np.full(8000, 2)
+    cells = [Cell("AK-47", "Chest", 5, 4000, 0.0), Cell("AK-47", "Chest", 80, 4000, 0.0),
+             Cell("AWP", "Chest", 5, 4000, 0.0)]  # fmt: skip
+    few, many, constant = sampling_floor(cells, generated_weapon, generated_group, generated_damage)
+    assert constant == 0.0  # a model that always does 77 HP matches any sample of itself
+    assert many < few  # more real samples, less room for chance
+    # the expected Wasserstein distance of n normal samples from their law: about
+    # sigma * 0.8 / sqrt(n) for the mean offset alone, plus the shape; between the two here
+    assert 10 * 0.8 / np.sqrt(5) < few < 10.0
+    by_hand = np.mean(
+        [wasserstein_distance(rng.normal(30, 10, 5), rng.normal(30, 10, 4000)) for _ in range(400)]
+    )
+    assert few == pytest.approx(by_hand, rel=0.15)
 
 
 SPEC = FeatureSpec()

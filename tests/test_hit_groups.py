@@ -11,7 +11,7 @@ import pytest
 
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import shot_damage
-from decoy_cli.damage.rules_evaluation import evaluate_rules
+from decoy_cli.damage.rules_evaluation import _victim_state, evaluate_rules
 from decoy_cli.esta import read_match
 
 EVENTS = (
@@ -106,6 +106,25 @@ def test_the_real_hits_leave_rounds_out() -> None:
     assert len(result.fold_mean_wasserstein_hp) == 5
     assert result.mean_wasserstein_hp <= 5.0  # issue 13's target, half the paper's 9.87
     assert (result.group_tv["tv"] <= 0.15).all()  # every weapon with 30 or more hits
+    floors = result.cells["floor_hp"]
+    assert (floors >= 0).all() and floors.mean() < result.mean_wasserstein_hp
+
+
+def test_what_a_real_hit_says_of_the_victims_armour() -> None:
+    """A hit that costs armour says kevlar (and a helmet on the head); a head hit that costs
+    none says no helmet, whatever the shares say."""
+    shares = {"": (1.0, 1.0)}  # every victim armoured with a helmet unless a hit says otherwise
+    rng = np.random.default_rng(0)
+
+    def state(group: str, armour: int) -> tuple[bool, bool]:
+        hit = pd.Series({"victim_buy": "", "group": group, "armorDamage": armour})
+        return _victim_state(hit, shares, rng)
+
+    assert state("Head", 5) == (True, True)
+    assert state("Head", 0) == (True, False)
+    assert state("Chest", 4) == (True, True)
+    assert state("Chest", 0) == (False, False)
+    assert state("Leg", 0) == (True, True)
 
 
 @pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
@@ -136,6 +155,7 @@ def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
         assert scores.cells > 0 and np.isfinite(scores.mean_wasserstein_hp)
         assert len(scores.fold_means) == FOLDS
         assert set(scores.group_tv) == {"AK-47", "M4A4", "USP-S"}
+        assert 0 <= scores.mean_floor_hp < scores.mean_wasserstein_hp
     # the game's rules beat the DOG trained on most of these very rounds
     assert rules.mean_wasserstein_hp < shipped.mean_wasserstein_hp
 

@@ -31,7 +31,7 @@ from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.rules_model import fit_rules, rules_generate
 from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.scores import hit_group_tv, wasserstein_cells
+from decoy_cli.damage.scores import hit_group_tv, sampling_floor, wasserstein_cells
 from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
@@ -94,6 +94,9 @@ class ModelScores:
     fold_means: list[float]
     group_tv: dict[str, float]
     """weapon -> total variation of the real and generated hit-group shares."""
+    mean_floor_hp: float
+    """The mean over the pooled cells of `scores.sampling_floor`: what this model would score
+    were the real samples drawn from it."""
 
 
 def _score(
@@ -126,6 +129,7 @@ def _score(
             fold_means.append(float(np.mean([c.wasserstein_hp for c in found])))
     tv = hit_group_tv(weapon, real.hit_group, np.tile(weapon, draws), group.ravel())
     values = [c.wasserstein_hp for c in pooled]
+    floors = sampling_floor(pooled, np.tile(weapon, draws), group.ravel(), damage.ravel())
     return ModelScores(
         name,
         float(np.mean(values)) if values else float("nan"),
@@ -133,6 +137,7 @@ def _score(
         len(values),
         fold_means,
         tv,
+        float(np.mean(floors)) if floors else float("nan"),
     )
 
 

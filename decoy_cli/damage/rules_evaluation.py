@@ -16,11 +16,12 @@ and per fold the mean Wasserstein over the cells the fold has (mean and spread o
 
 The victim's armour: where the round has frames, they say it (`armor`, `helmet`). Events without
 frames still tell some of it: a hit that costs armour says the victim wore it there (kevlar, and
-a helmet on a head hit). Where the hit does not say (a leg, or a head without armour damage), the
-victim wears armour with the training hits' share of armoured body hits of victims whose side had
-the same buy type (awpy's `tBuyType`/`ctBuyType`: an eco round buys little armour), and a drawn
-head hit on an armoured victim meets a helmet with the training share of such head hits that
-met one.
+a helmet on a head hit), and a head hit that costs none says there was no helmet (the rules take
+armour from a helmet on every head hit). Where the hit does not say (a leg; kevlar under a bare
+head), the victim wears armour with the training hits' share of armoured body hits of victims
+whose side had the same buy type (awpy's `tBuyType`/`ctBuyType`: an eco round buys little
+armour), and a drawn head hit on an armoured victim meets a helmet with the training share of
+such head hits that met one.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import ARMORED_GROUPS, rule_group, shot_damage
 from decoy_cli.damage.rules_check import firearm_hits
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP
-from decoy_cli.damage.scores import MIN_WEAPON_SAMPLES, wasserstein_cells
+from decoy_cli.damage.scores import MIN_WEAPON_SAMPLES, sampling_floor, wasserstein_cells
 from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.esta import Round
 
@@ -52,7 +53,8 @@ class RulesEvaluation:
     hits: int
     rounds: int
     cells: pd.DataFrame
-    """weapon, group, real, generated, wasserstein_hp over the pooled test predictions."""
+    """weapon, group, real, generated, wasserstein_hp and floor_hp (`scores.sampling_floor`)
+    over the pooled test predictions."""
     mean_wasserstein_hp: float
     max_wasserstein_hp: float
     fold_mean_wasserstein_hp: list[float]
@@ -88,8 +90,8 @@ def _victim_state(
     costs_armour = bool(hit["armorDamage"] > 0)
     if hit["group"] in ARMORED_GROUPS:
         kevlar = costs_armour
-    elif hit["group"] == "Head" and costs_armour:
-        return True, True
+    elif hit["group"] == "Head":  # a helmet takes armour on every head hit: the hit says it
+        return costs_armour or bool(rng.random() < armored_share), costs_armour
     else:
         kevlar = bool(rng.random() < armored_share)
     return kevlar, kevlar and bool(rng.random() < helmet_share)
@@ -159,8 +161,18 @@ def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
         generated["damage"].to_numpy(np.float64),
         min_cell=MIN_CELL,
     )
-    rows = [(c.weapon, c.hit_group, c.real, c.generated, c.wasserstein_hp) for c in found]
-    return pd.DataFrame(rows, columns=["weapon", "group", "real", "generated", "wasserstein_hp"])
+    floors = sampling_floor(
+        found,
+        generated["weapon"].to_numpy(dtype=object),
+        generated["group"].map(GROUPS.index).to_numpy(),
+        generated["damage"].to_numpy(np.float64),
+    )
+    rows = [
+        (c.weapon, c.hit_group, c.real, c.generated, c.wasserstein_hp, floor)
+        for c, floor in zip(found, floors, strict=True)
+    ]
+    columns = ["weapon", "group", "real", "generated", "wasserstein_hp", "floor_hp"]
+    return pd.DataFrame(rows, columns=columns)
 
 
 def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:

@@ -175,6 +175,43 @@ def wasserstein_cells(
     return sorted(cells, key=lambda c: (-c.real, c.weapon, c.hit_group))
 
 
+SAMPLING_DRAWS = 200
+"""Resamplings per cell for `sampling_floor`."""
+
+
+def sampling_floor(
+    cells: list[Cell],
+    generated_weapon: np.ndarray,
+    generated_group: np.ndarray,
+    generated_damage: np.ndarray,
+    seed: int = 0,
+) -> list[float]:
+    """Per cell, the Wasserstein distance a model would score if the real samples came from its
+    own generated distribution: the mean, over `SAMPLING_DRAWS` resamplings, of the distance
+    between `cell.real` values drawn from the cell's generated damage and all of them. A cell of
+    a few real samples scores this much by chance alone, so a model cannot be told apart from
+    the real game below it."""
+    from scipy.stats import wasserstein_distance
+
+    rng = np.random.default_rng(seed)
+    weapons = np.asarray(generated_weapon, dtype=object)
+    floors = []
+    for cell in cells:
+        code = HIT_GROUPS.index(cell.hit_group)
+        values = generated_damage[(weapons == cell.weapon) & (generated_group == code)]
+        floors.append(
+            float(
+                np.mean(
+                    [
+                        wasserstein_distance(rng.choice(values, cell.real), values)
+                        for _ in range(SAMPLING_DRAWS)
+                    ]
+                )
+            )
+        )
+    return floors
+
+
 MIN_WEAPON_SAMPLES = 30
 """Fewest real samples of a weapon for its hit-group total variation."""
 
