@@ -433,6 +433,31 @@ def test_rules_damage_is_the_rules_per_bullet(firing: Path) -> None:
         assert first.armor_damage[k] == min(bullet.armor, int(pairs.victim_armor[k]))
 
 
+def test_penetration_learned_from_hits_below_the_rules() -> None:
+    from decoy_cli.damage.rules import shot_damage
+    from decoy_cli.damage.rules_model import Penetration
+
+    least = shot_damage("AK-47", "Chest", 800.0, armor=100, helmet=True).health
+    bare = shot_damage("AK-47", "Chest", 800.0, armor=0, helmet=False).health
+    through = Penetration.learn(
+        ["AK-47"] * 4, ["Chest", "Chest", "Chest", "LeftArm"], [800.0] * 4,
+        [least, bare, least // 2, 1],
+    )  # fmt: skip
+    assert through.hits == 4  # the rules' own values are clear paths, armour or not
+    assert through.shares == pytest.approx([(least // 2) / least, 1 / shot_damage(
+        "AK-47", "Arm", 800.0, armor=100, helmet=True).health])  # fmt: skip
+    rng = np.random.default_rng(0)
+    factors = np.array([through.factor(rng) for _ in range(4000)])
+    assert abs(np.mean(factors < 1.0) - 0.5) < 0.03  # half the bullets go through something
+    assert set(np.round(factors[factors < 1.0], 6)) == set(np.round(through.shares, 6))
+    clear = Penetration()
+    before = np.random.default_rng(5)
+    assert clear.factor(before) == 1.0
+    after = np.random.default_rng(5)
+    after.random(2)
+    assert before.random() == after.random()  # two draws either way: streams stay aligned
+
+
 def test_the_shipped_rules_are_a_models_choice() -> None:
     from decoy_cli.damage.rules_model import RulesDamage
 

@@ -29,6 +29,7 @@ from decoy_cli.damage.scores import (
     roc_auc,
     roc_curve,
     sampling_floor,
+    tv_floor,
     wasserstein_cells,
 )
 
@@ -135,6 +136,13 @@ def test_sampling_floor_is_what_samples_of_the_model_itself_score() -> None:
         [wasserstein_distance(rng.normal(30, 10, 5), rng.normal(30, 10, 4000)) for _ in range(400)]
     )
     assert few == pytest.approx(by_hand, rel=0.15)
+
+
+def test_tv_floor_by_hand() -> None:
+    # one hit of a 50/50 model always lands on one group: total variation 0.5
+    assert tv_floor(np.array([0.5, 0.5, 0, 0, 0, 0]), 1) == pytest.approx(0.5)
+    assert tv_floor(np.array([1.0, 0, 0, 0, 0, 0]), 7) == 0.0
+    assert tv_floor(np.array([0.4, 0.0, 0.4, 0.2, 0, 0]), 1000) < 0.03
 
 
 SPEC = FeatureSpec()

@@ -31,7 +31,10 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     data = json.loads((folder / "rules.json").read_text())
     assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
     # the shipped rules.json is this very fit
-    assert data["bullets"] == json.loads((ROOT / "models" / "rules.json").read_text())["bullets"]
+    shipped = json.loads((ROOT / "models" / "rules.json").read_text())
+    assert data["bullets"] == shipped["bullets"]
+    assert data["penetration"] == shipped["penetration"]
+    assert data["penetration"]["hits"] == 396 and 0 < len(data["penetration"]["shares"]) < 396 / 5
     assert isinstance(load_damage_model(str(folder)), RulesDamage)  # a DIP and rules, no DOG
 
 
@@ -51,3 +54,14 @@ def test_bad_folders_are_one_error_line(tmp_path: Path) -> None:
     (folder / "rules.json").write_text('{"hit_groups": {}, "bullets": {}, "provenance": "x"}')
     with pytest.raises(ModelError, match="not a rules file"):
         load_damage_model(str(folder))
+    shipped = json.loads((ROOT / "models" / "rules.json").read_text())
+    for through in ({"hits": 3, "shares": [0.5, 1.5]}, {"hits": 1, "shares": [0.5, 0.5]}):
+        (folder / "rules.json").write_text(json.dumps(shipped | {"penetration": through}))
+        with pytest.raises(ModelError, match="penetration shares"):
+            load_damage_model(str(folder))
+    # a rules.json from before penetration was learned: every path clear
+    (folder / "rules.json").write_text(
+        json.dumps({k: v for k, v in shipped.items() if k != "penetration"})
+    )
+    model = load_damage_model(str(folder))
+    assert isinstance(model, RulesDamage) and model.rules.penetration.shares == []

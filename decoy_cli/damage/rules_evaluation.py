@@ -1,10 +1,11 @@
 """The rules-grounded damage outcome model on real hits, leave-rounds-out.
 
 The model: the hit group drawn from a `HitGroupModel` learned from the training hits, the damage
-computed by the game's rules (decoy_cli/damage/rules.py) and capped at 100 HP, as the DOG's
-target is. The protocol is the paper's generative one, made independent of one split: the rounds
-are dealt into `FOLDS` folds; each fold's hits are predicted (`DRAWS` draws each) by a model that
-saw the other folds only, so every hit is a test hit once. On the pooled predictions:
+computed by the game's rules (decoy_cli/damage/rules.py), scaled down for the learned share of
+bullets that pass through something first (`rules_model.Penetration`), and capped at 100 HP, as
+the DOG's target is. The protocol is the paper's generative one, made independent of one split:
+the rounds are dealt into `FOLDS` folds; each fold's hits are predicted (`DRAWS` draws each) by
+a model that saw the other folds only, so every hit is a test hit once. On the pooled predictions:
 
 * mean Wasserstein distance between generated and real damage per (weapon, hit group) cell with
   at least `MIN_CELL` real hits (the real cell by real group, the generated one by drawn group,
@@ -37,8 +38,14 @@ from decoy_cli.damage.fold_comparison import MIN_CELL
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import ARMORED_GROUPS, rule_group, shot_damage
 from decoy_cli.damage.rules_check import firearm_hits
+from decoy_cli.damage.rules_model import Penetration
 from decoy_cli.damage.sample_set import MAX_DAMAGE_HP
-from decoy_cli.damage.scores import MIN_WEAPON_SAMPLES, sampling_floor, wasserstein_cells
+from decoy_cli.damage.scores import (
+    MIN_WEAPON_SAMPLES,
+    sampling_floor,
+    tv_floor,
+    wasserstein_cells,
+)
 from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.esta import Round
 
@@ -59,7 +66,8 @@ class RulesEvaluation:
     max_wasserstein_hp: float
     fold_mean_wasserstein_hp: list[float]
     group_tv: pd.DataFrame
-    """weapon, hits, tv, and the real and drawn shares of every group."""
+    """weapon, hits, tv, tv_floor (`scores.tv_floor`), and the real and drawn shares of every
+    group."""
     armour_shares: dict[str, tuple[float, float]]
     """(kevlar share, helmet share) by the victim side's buy type over all hits, for the report
     (each fold's draws use the shares of its training folds only)."""
@@ -116,6 +124,10 @@ def evaluate_rules(rounds: Sequence[Round], seed: int = 0) -> RulesEvaluation:
         if not len(test):
             continue
         model = HitGroupModel.fit(train["weapon"], train["distance"], train["group"])
+        through = Penetration.learn(
+            train["weapon"].tolist(), train["group"].tolist(), train["distance"].tolist(),
+            train["hpDamage"].tolist(),
+        )  # fmt: skip
         shares = _armour_shares(train)
         rows = []
         for _, hit in test.iterrows():
@@ -124,6 +136,7 @@ def evaluate_rules(rounds: Sequence[Round], seed: int = 0) -> RulesEvaluation:
                 damage = shot_damage(
                     hit["weapon"], group, hit["distance"], armor=100 if kevlar else 0, helmet=helmet
                 ).health
+                damage = int(damage * through.factor(rng))
                 rows.append((hit["weapon"], group, min(damage, MAX_DAMAGE_HP)))
         generated = pd.DataFrame(rows, columns=["weapon", "group", "damage"])
         generated_rows.append(generated)
@@ -184,7 +197,10 @@ def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
         p = group["group"].value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
         drawn = generated[generated["weapon"] == weapon]["group"]
         q = drawn.value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
-        rows.append({"weapon": weapon, "hits": len(group), "tv": 0.5 * float((p - q).abs().sum())})
+        tv = 0.5 * float((p - q).abs().sum())
+        rows.append(
+            {"weapon": weapon, "hits": len(group), "tv": tv, "tv_floor": tv_floor(q, len(group))}
+        )
         rows[-1] |= {f"real_{g}": float(p[g]) for g in GROUPS}
         rows[-1] |= {f"drawn_{g}": float(q[g]) for g in GROUPS}
     return pd.DataFrame(rows)

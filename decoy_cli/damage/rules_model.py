@@ -8,12 +8,13 @@ Per combat step, over every visible ordered pair at once:
    distribution learned from real hits per weapon class (`BulletCounts`), each bullet's hit group
    from `HitGroupModel` (weapon and distance), and each bullet's health and armour damage from
    the rules (decoy_cli/damage/rules.py) against the victim's armour and helmet, the armour worn
-   down bullet by bullet;
+   down bullet by bullet, and a learned share of bullets scaled down as through a wall
+   (`Penetration`);
 3. the pair's damage is the bullets' health damage summed, at least 1 and at most the victim's
    HP (as ESTA's hpDamageTaken), its armour damage the armour they took, its hit group that of
    the bullet that did the most.
 
-The learned parts (`RulesFile`: hit groups and bullet counts) live in a model folder's
+The learned parts (`RulesFile`: hit groups, bullet counts, penetration) live in a model folder's
 `rules.json` beside the DIP (`decoy models fit-rules`). Only an attacker with a firearm of the
 models' vocabulary hits (`DipDecision`), as with the learned DOG; the rule table covers exactly
 that vocabulary (a test checks), so a knife, grenade, Zeus or C4 never hits here.
@@ -31,7 +32,7 @@ import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
-from decoy_cli.damage.rules import shot_damage
+from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
 from decoy_cli.files import write_json
@@ -71,6 +72,49 @@ class BulletCounts:
         return (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
 
 
+PENETRATED_BELOW = 0.9
+"""A real hit whose health damage is below this share of the least the rules give at its range
+and hit group (armour and helmet on) went through something first (measured on the real hits:
+`benchmarks/damage_rules_check.py` finds the rules exact on nearly all others)."""
+
+
+@dataclass
+class Penetration:
+    """Bullets that pass through a wall, a box or a player before they land do less damage
+    (CS:GO's penetration), and the world has no materials to say when. Learned from real hits:
+    the share of hits that did less than the rules allow (`PENETRATED_BELOW`) and what share of
+    the rules' damage each of them did; a drawn bullet is such a hit with that share, its damage
+    scaled by one of those shares."""
+
+    hits: int = 0
+    shares: list[float] = field(default_factory=list)
+
+    @classmethod
+    def learn(
+        cls,
+        weapons: Sequence[str],
+        groups: Sequence[str],
+        distances_u: Sequence[float],
+        health: Sequence[float],
+    ) -> Penetration:
+        """From real hits: weapon, ESTA hit group, distance (u) and raw health damage."""
+        found = cls()
+        for weapon, group, distance, done in zip(weapons, groups, distances_u, health, strict=True):
+            least = shot_damage(weapon, rule_group(group), distance, armor=100, helmet=True).health
+            found.hits += 1
+            if least > 0 and done < PENETRATED_BELOW * least:
+                found.shares.append(float(done) / least)
+        return found
+
+    def factor(self, draw: np.random.Generator) -> float:
+        """1.0 for a bullet with a clear path, else the share of its damage a penetrating one
+        does; two draws either way, so the stream does not depend on the outcome."""
+        through, pick = draw.random(), draw.random()
+        if not self.shares or through >= len(self.shares) / self.hits:
+            return 1.0
+        return self.shares[int(pick * len(self.shares))]
+
+
 @dataclass
 class RulesFile:
     """The learned parts of the rules-grounded model (a model folder's `rules.json`)."""
@@ -78,12 +122,15 @@ class RulesFile:
     hit_groups: HitGroupModel
     bullets: BulletCounts
     provenance: dict[str, object] = field(default_factory=dict)
+    penetration: Penetration = field(default_factory=Penetration)
+    """Empty in a `rules.json` written before it was learned: every path is clear."""
 
     def save(self, folder: Path) -> Path:
         """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
         data = {
             "hit_groups": self.hit_groups.to_dict(),
             "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
+            "penetration": {"hits": self.penetration.hits, "shares": self.penetration.shares},
             "provenance": self.provenance,
         }
         return write_json(Path(folder) / RULES_FILE, data)
@@ -100,6 +147,8 @@ class RulesFile:
                 [float(v) for v in data["bullets"]["every"]],
             )
             provenance = dict(data.get("provenance", {}))
+            through = data.get("penetration", {"hits": 0, "shares": []})
+            penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
         except OSError as error:
             raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
         except (ValueError, KeyError, TypeError, AttributeError) as error:
@@ -108,7 +157,11 @@ class RulesFile:
             len(c) != MAX_BULLETS for c in bullets.by_class.values()
         ):
             raise ModelError(f"{path}: bullet counts of another length than {MAX_BULLETS}")
-        return cls(hit_groups, bullets, provenance)
+        if not (0 <= len(penetration.shares) <= penetration.hits) or not all(
+            0.0 <= v <= 1.0 for v in penetration.shares
+        ):
+            raise ModelError(f"{path}: penetration shares must be in [0, 1], at most one per hit")
+        return cls(hit_groups, bullets, provenance, penetration)
 
 
 def fit_rules(rounds: Sequence[Round]) -> RulesFile:
@@ -122,6 +175,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     weapons: list[str] = []
     distances: list[float] = []
     groups: list[str] = []
+    health: list[float] = []
     bullets = BulletCounts()
     used_rounds = 0
     for round_ in rounds:
@@ -134,6 +188,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         weapons += [str(w) for w in table["weapon"]]
         distances += [float(d) for d in table["distance"]]
         groups += [str(g) for g in table["hitGroup"]]
+        health += [float(h) for h in table["hpDamage"]]
         origin, step_ticks = step_clock(round_)
         steps: dict[tuple[int, object, object], list[str]] = {}
         for r in usable:
@@ -144,13 +199,14 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     if not weapons:
         raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
     model = HitGroupModel.fit(weapons, distances, groups)
+    penetration = Penetration.learn(weapons, groups, distances, health)
     provenance = {
         "hits": len(weapons),
         "steps": int(sum(bullets.every)),
         "rounds": used_rounds,
         "left_out": dict(stats.excluded),
     }
-    return RulesFile(model, bullets, provenance)
+    return RulesFile(model, bullets, provenance, penetration)
 
 
 def pair_outcome(
@@ -169,10 +225,12 @@ def pair_outcome(
     health, taken, largest, largest_group = 0, 0, -1, groups[0]
     for name in groups:
         bullet = shot_damage(weapon, name, distance_u, armor=armor - taken, helmet=helmet)
-        health += bullet.health
-        taken += bullet.armor
-        if bullet.health > largest:
-            largest, largest_group = bullet.health, name
+        factor = rules.penetration.factor(draw)
+        done = int(bullet.health * factor)
+        health += done
+        taken += int(bullet.armor * factor)
+        if done > largest:
+            largest, largest_group = done, name
     return health, taken, largest_group
 
 

@@ -212,6 +212,17 @@ def sampling_floor(
     return floors
 
 
+def tv_floor(shares: np.ndarray, count: int, seed: int = 0) -> float:
+    """The hit-group total variation a model with these group `shares` would score against
+    `count` real hits drawn from it: the mean over `SAMPLING_DRAWS` such draws (see
+    `sampling_floor`)."""
+    p = np.asarray(shares, dtype=np.float64)
+    p = p / p.sum()
+    rng = np.random.default_rng(seed)
+    drawn = rng.multinomial(count, p, size=SAMPLING_DRAWS) / count
+    return float(np.mean(0.5 * np.abs(drawn - p).sum(axis=1)))
+
+
 MIN_WEAPON_SAMPLES = 30
 """Fewest real samples of a weapon for its hit-group total variation."""
 
