@@ -39,6 +39,8 @@ def test_calibrating_the_shipped_dip(tmp_path: Path) -> None:
     assert metrics["ece_calibrated"] < metrics["ece"]
     assert metrics["brier_calibrated"] < metrics["brier"]
     assert "expected calibration error, calibrated" in evaluated.output
+    assert 0.0 < metrics["ece_floor"] < metrics["ece"]
+    assert "ECE floor" in result.output
 
 
 def test_a_folder_without_dip_is_one_error_line(tmp_path: Path) -> None:

@@ -8,6 +8,7 @@ import pytest
 from decoy_cli.damage.calibration import (
     Calibration,
     brier_score,
+    ece_floor,
     expected_calibration_error,
     fit_calibration,
     reliability_curve,
@@ -27,6 +28,16 @@ def test_measures_on_hand_cases() -> None:
     assert (row["count"], row["hit_share"], row["low"]) == (4, 0.5, 0.9)
     with pytest.raises(ValueError, match="within"):
         brier_score(labels, np.array([1.2, 0.0, 0.0, 0.0]))
+
+
+def test_the_ece_floor_is_what_calibrated_labels_score() -> None:
+    rng = np.random.default_rng(3)
+    p = rng.uniform(0.05, 0.6, 234)  # the size of the real test part
+    by_hand = np.mean([expected_calibration_error(rng.random(234) < p, p) for _ in range(400)])
+    assert ece_floor(p) == pytest.approx(by_hand, rel=0.1)
+    assert 0.03 < ece_floor(p) < 0.08  # a few hundred samples cannot show an ECE of 0
+    assert ece_floor(np.tile(p, 100)) < ece_floor(p) / 5
+    assert ece_floor(np.array([0.0, 1.0, 1.0])) == 0.0  # certain outcomes: nothing to miss
 
 
 def miscalibrated(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -136,6 +136,7 @@ def dip_table(metrics: dict[str, Any], title: str) -> Table:
         ("ece", "expected calibration error"),
         ("brier_calibrated", "Brier score, calibrated"),
         ("ece_calibrated", "expected calibration error, calibrated"),
+        ("ece_floor", "its floor: a perfectly calibrated model on these samples"),
     ):
         if name in metrics:
             table.add_row(label, _number(metrics[name]), "–")

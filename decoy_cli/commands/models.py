@@ -199,13 +199,17 @@ def calibrate(
         )
     console = make_console()
     table = Table(title=f"DIP calibration ({result.calibration.kind}) of {model_folder}")
-    for column in ("part", "samples (hits)", "Brier", "Brier after", "ECE", "ECE after"):
+    columns = ("part", "samples (hits)", "Brier", "Brier after", "ECE", "ECE after", "ECE floor")
+    for column in columns:
         table.add_column(column, justify="left" if column == "part" else "right")
     for part, s in result.scores.items():
         table.add_row(
             part,
             f"{s['samples']:.0f} ({s['positives']:.0f})",
-            *(f"{s[k]:.3f}" for k in ("brier", "brier_calibrated", "ece", "ece_calibrated")),
+            *(
+                f"{s[k]:.3f}"
+                for k in ("brier", "brier_calibrated", "ece", "ece_calibrated", "ece_floor")
+            ),
         )
     console.print(table)
     c = result.calibration
@@ -213,6 +217,9 @@ def calibrate(
         f"p' = sigmoid({c.a:.4f} * logit(p) + {c.b:.4f}); threshold {c.threshold:.3f} on the "
         f"calibrated scale; combat decides by {c.decision}; written to {result.path}",
         highlight=False,
+    )
+    console.print(
+        "ECE floor: what a perfectly calibrated model would show on these samples", highlight=False
     )
 
 

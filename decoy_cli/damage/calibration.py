@@ -87,6 +87,28 @@ def expected_calibration_error(
     )
 
 
+FLOOR_DRAWS = 200
+"""Label draws per `ece_floor`."""
+
+
+def ece_floor(probabilities: np.ndarray, bins: int = BINS, seed: int = 0) -> float:
+    """The expected calibration error a perfectly calibrated model would show on these samples:
+    the mean over `FLOOR_DRAWS` draws of labels hit with exactly these probabilities. On a few
+    hundred samples it is far from 0; an ECE near it is as good as the samples can tell."""
+    p = np.clip(np.asarray(probabilities, dtype=np.float64).reshape(-1), 0.0, 1.0)
+    if not len(p):
+        return math.nan
+    rng = np.random.default_rng(seed)
+    return float(
+        np.mean(
+            [
+                expected_calibration_error(rng.random(len(p)) < p, p, bins)
+                for _ in range(FLOOR_DRAWS)
+            ]
+        )
+    )
+
+
 def _logit(p: np.ndarray) -> np.ndarray:
     q = np.clip(p, _EPS, 1 - _EPS)
     return np.log(q / (1 - q))
@@ -193,7 +215,8 @@ def calibration_scores(
     labels: np.ndarray, probabilities: np.ndarray, calibration: Calibration | None
 ) -> dict[str, float]:
     """Brier score and expected calibration error of the probabilities, and of the calibrated
-    ones (`brier_calibrated`, `ece_calibrated`) when there is a calibration."""
+    ones (`brier_calibrated`, `ece_calibrated`, and `ece_floor`: what a perfectly calibrated
+    model would show on these samples) when there is a calibration."""
     scores = {
         "brier": brier_score(labels, probabilities),
         "ece": expected_calibration_error(labels, probabilities),
@@ -202,4 +225,5 @@ def calibration_scores(
         calibrated = calibration.apply(probabilities)
         scores["brier_calibrated"] = brier_score(labels, calibrated)
         scores["ece_calibrated"] = expected_calibration_error(labels, calibrated)
+        scores["ece_floor"] = ece_floor(calibrated)
     return scores
