@@ -606,7 +606,8 @@ def test_real_t_side_rounds(settings: EvalSettings, pool: LocalBackend, tmp_path
 
 def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
     """`decoy evaluate` as the README runs it: the shipped synthetic sample, combat and bomb
-    on with the shipped DIP and DOG (here on 3 sampled rounds, one worker)."""
+    on with the default damage model, the shipped DIP and the game's rules (here on 3 sampled
+    rounds, one worker)."""
     out = tmp_path / "out"
     result = _invoke("--sample", "3", "--workers", "1", "--out", str(out))
     assert result.exit_code == 0, result.output
@@ -619,7 +620,7 @@ def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
     played_on = int((rounds["played_out_s"] > 0).sum())
     assert combat.loc["decided_after_data", "value"] == pytest.approx(played_on / 3)
     report = (out / "report.md").read_text()
-    assert "damage model: shipped" in report
+    assert "damage model: rules" in report
     # FastDTW only on request outside the paper's Table 2 setting
     assert FASTDTW_METRIC not in pd.read_csv(out / "players.csv").columns
     assert "--no-fastdtw" in report

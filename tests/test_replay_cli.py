@@ -223,15 +223,15 @@ SAMPLE = (
 )
 
 
-def test_replay_shoots_with_the_shipped_models_and_decides_the_round(tmp_path: Path) -> None:
-    """By default the replay shoots with the shipped DIP and DOG; a round the data leaves open
-    is played on until the rules end it, and the summary says so."""
+def test_replay_shoots_with_the_default_models_and_decides_the_round(tmp_path: Path) -> None:
+    """By default the replay shoots with the shipped DIP and the game's damage rules; a round the
+    data leaves open is played on until the rules end it, and the summary says so."""
     out = tmp_path / "out"
     result = _invoke(f"{SAMPLE}:2", "--out", str(out))
     assert result.exit_code == 0, result.output
     assert "combat on" in result.stdout
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["damage_models"] == "shipped"
+    assert summary["damage_models"] == "rules"
     assert summary["outcome_replay"]["winner"] in ("T", "CT")
     events = pd.read_csv(out / "events.csv")
     assert "damage" in set(events["kind"])

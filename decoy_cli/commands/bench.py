@@ -53,7 +53,9 @@ def bench(
         "shipped",
         "--models",
         help=f"Damage models of the combat step: {CHOICES_HELP}. If they cannot be loaded, the "
-        "benchmark says so and runs line of sight without inference.",
+        "benchmark says so and runs line of sight without inference. The default is the DOG, "
+        "not the rules that `replay` and `evaluate` default to: every earlier version has it, "
+        "so `--baseline` compares like with like.",
     ),
     data: Path | None = typer.Option(
         None,

@@ -23,7 +23,7 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.esta.plausibility import check_policy
@@ -87,7 +87,7 @@ def evaluate(
         True, "--bomb/--no-bomb", help="Bomb rules: carrier, plant, defuse, detonation."
     ),
     models: str = typer.Option(
-        "shipped", "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
+        DEFAULT_MODELS, "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
     ),
     mover: str = typer.Option(
         "kinematic", "--mover", help="kinematic (default) or physics (capsules that collide)."

@@ -11,7 +11,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage import CHOICES_HELP, load_damage_model
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 from decoy_cli.synth import PlayedRound, write_sample
@@ -26,7 +26,7 @@ def make_sample(
     rounds: int = typer.Option(8, "--rounds", help=f"Rounds to play (1-{MAX_ROUNDS})."),
     seed: int = typer.Option(0, "--seed", help="Seed of every random choice (>= 0)."),
     models: str = typer.Option(
-        "shipped", "--models", help=f"Damage models for combat: {CHOICES_HELP}."
+        DEFAULT_MODELS, "--models", help=f"Damage models for combat: {CHOICES_HELP}."
     ),
     map_name: str = typer.Option("dust2", "--map", help="The map to play on."),
 ) -> None:

@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage import load_damage_model
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.replayer import ReplayOptions
@@ -46,11 +46,10 @@ def replay(
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
     models: str = typer.Option(
-        "shipped",
+        DEFAULT_MODELS,
         "--models",
-        help='Damage models for shooting: "shipped" (models/), "none" (no shooting: '
-        "deaths in the data are scripted) or a model folder (e.g. from `decoy models "
-        "import-decoy`).",
+        help=f"Damage models for shooting: {CHOICES_HELP} (with none, deaths in the data are "
+        "scripted).",
     ),
     implausible: str = typer.Option(
         "fail",

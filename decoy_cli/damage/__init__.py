@@ -33,6 +33,10 @@ if TYPE_CHECKING:
 SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
+DEFAULT_MODELS = "rules"
+"""What `--models` is unless told: the shipped DIP with damage by the game's rules, the
+combination that measures best on the real damage events (README, "Damage models")."""
+
 SHIPPED_CHOICES = ("shipped", "rules")
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from decoy_cli.damage import DEFAULT_MODELS
 from decoy_cli.sim.env import DecoyParallelEnv
 
 ENV_SETTINGS = ("map", "n_t", "n_ct", "mover", "models", "combat", "bomb", "stop_seconds")
@@ -18,14 +19,14 @@ ENV_SETTINGS = ("map", "n_t", "n_ct", "mover", "models", "combat", "bomb", "stop
 
 
 def env_from_config(config: Mapping[str, Any] | None = None) -> DecoyParallelEnv:
-    """An environment from `ENV_SETTINGS`: "models" is "shipped" (default), "rules", "none" or a
+    """An environment from `ENV_SETTINGS`: "models" is "rules" (default), "shipped", "none" or a
     model folder, loaded here; the others are `DecoyParallelEnv`'s arguments. An unknown key is
     a ValueError, so a typo does not silently train the default."""
     settings = dict(config or {})
     unknown = sorted(set(settings) - set(ENV_SETTINGS))
     if unknown:
         raise ValueError(f"unknown environment settings {unknown} (known: {list(ENV_SETTINGS)})")
-    models = str(settings.pop("models", "shipped"))
+    models = str(settings.pop("models", DEFAULT_MODELS))
 
     def load():
         from decoy_cli.damage import load_damage_model
