@@ -92,7 +92,10 @@ def main() -> None:
         f"targets reached more than 0.5 s late: {over:.2%} of {int(players['targets'].sum()):,}"
     )
     causes = {
-        "the plan asked for more than the player's speed": "late_plan",
+        "the lattice's zig-zag (the straight line would be in time)": "late_zigzag",
+        "a way round something (the straight line would be in time)": "late_detour",
+        "faster than the weapon's maximum even straight": "late_speed",
+        "a gap of the graph (relocated)": "late_gap",
         "the target before was already late": "late_carried",
         "the replay's own delay": "late_replay",
     }

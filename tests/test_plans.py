@@ -335,6 +335,31 @@ def test_infeasible_interval_and_ratio() -> None:
     assert plan.interval_infeasible.tolist() == [True, False]
     assert plan.num_infeasible == 1
     assert plan.worst_ratio == pytest.approx(5.6 / AK_M_S)
+    # straight east: too fast even in a straight line, not the graph's way round
+    assert plan.interval_detour.tolist() == [False, False]
+
+
+def test_an_interval_too_fast_only_by_the_way_round_is_a_detour() -> None:
+    """Two nodes 0.7 m apart with no edge between them: the way round is 2.1 m, too far for an
+    AK-47 in 0.5 s, the straight line is not."""
+    graph = make_graph(
+        [(0.0, 0.0, 0.0), (0.7, 0.0, 0.0), (0.7, 0.7, 0.0), (0.0, 0.7, 0.0)],
+        [(0, 3, 0, 2), (3, 2, 0, 0), (2, 1, 0, 6), (1, 0, 0, 4)],
+    )
+    plan = plan_for(graph, at(0, 1, graph=graph), weapons=["AK-47", "AK-47"])
+    assert plan.interval_length_m.tolist() == pytest.approx([2.1])
+    assert plan.interval_infeasible.tolist() == [True]
+    assert plan.interval_detour.tolist() == [True]
+    assert plan.interval_zigzag.tolist() == [False]  # three times the straight line
+
+
+def test_a_detour_within_the_lattices_zig_zag() -> None:
+    """From (0, 0) to (2, 1) on the lattice: one straight step and one diagonal, 1.69 m against
+    1.57 m straight (1.08 times, the most a lattice path takes); in 0.4 s an AK-47 runs 1.64 m."""
+    graph = grid5()
+    plan = plan_for(graph, at(node(0, 0), node(2, 1)), seconds=[0.0, 0.4], weapons=["AK-47"] * 2)
+    assert plan.interval_detour.tolist() == [True]
+    assert plan.interval_zigzag.tolist() == [True]
 
 
 def test_speed_uses_weapon_at_interval_start_and_no_weapon_is_knife() -> None:

@@ -19,7 +19,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.world.navmesh import asset_dir, load_navmesh
 
-RECORD_VERSION = 4
+RECORD_VERSION = 5
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HEAT_CELL_M = 0.5

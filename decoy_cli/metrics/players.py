@@ -22,7 +22,10 @@ REPLAY_COLUMNS = (
     "targets",
     "late_share",
     "late_over_frame",
-    "late_plan",
+    "late_zigzag",
+    "late_detour",
+    "late_speed",
+    "late_gap",
     "late_carried",
     "late_replay",
     "late_p95_s",
@@ -44,11 +47,12 @@ class ReplayTrace:
     data shows a death (`died_original`), whether the replay removed the player at its data
     death time rather than by combat (`scripted_death`), the share of plan targets reached late
     and the 95th percentile lateness in seconds (NaN when none was reached), the targets reached
-    and how many of them more than one data frame late, split by cause (`late_plan`: the plan
-    asked for more than the player's speed on the way to it; `late_carried`: the target before
-    was already that late; `late_replay`: neither, the replay's own delay), stuck episodes,
-    recoveries (teleports)
-    and relocations.
+    and how many of them more than one data frame late, split by cause (the plan asked for more
+    than the player's speed on the way to it: `late_zigzag` only by the lattice's zig-zag and
+    `late_detour` by a longer way round something, the straight line would do; `late_speed`
+    even straight; `late_gap` across a gap of the graph, relocated; `late_carried`: the target
+    before was already that late; `late_replay`: none of these, the replay's own delay), stuck
+    episodes, recoveries (teleports) and relocations.
     """
 
     position: np.ndarray
@@ -59,7 +63,10 @@ class ReplayTrace:
     late_p95_s: np.ndarray
     targets: np.ndarray
     late_over_frame: np.ndarray
-    late_plan: np.ndarray
+    late_zigzag: np.ndarray
+    late_detour: np.ndarray
+    late_speed: np.ndarray
+    late_gap: np.ndarray
     late_carried: np.ndarray
     late_replay: np.ndarray
     stuck: np.ndarray
@@ -96,7 +103,10 @@ def player_metrics(round_: Round, trace: ReplayTrace, *, fastdtw: bool = False) 
                 "targets": int(trace.targets[p]),
                 "late_share": float(trace.late_share[p]),
                 "late_over_frame": int(trace.late_over_frame[p]),
-                "late_plan": int(trace.late_plan[p]),
+                "late_zigzag": int(trace.late_zigzag[p]),
+                "late_detour": int(trace.late_detour[p]),
+                "late_speed": int(trace.late_speed[p]),
+                "late_gap": int(trace.late_gap[p]),
                 "late_carried": int(trace.late_carried[p]),
                 "late_replay": int(trace.late_replay[p]),
                 "late_p95_s": float(trace.late_p95_s[p]),

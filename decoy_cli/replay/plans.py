@@ -27,6 +27,7 @@ How a simulator executes a plan (the contract this module promises):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +46,11 @@ ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
 
 RATIO_TOLERANCE = 1e-9
 """An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
+
+ZIGZAG_MAX = math.cos(math.pi / 8) + (math.sqrt(2) - 1) * math.sin(math.pi / 8) + 1e-6
+"""The longest an eight-way lattice path is against the straight line between its ends: 1.0824,
+22.5° off a lattice axis (straight steps along the axis, then diagonal ones). A way round no
+longer than this is the lattice's zig-zag; a longer one goes round something."""
 
 MIN_RUN_S = 1.0 / TICK_RATE
 """Shortest running time an interval is given (one simulator tick) when its jumps and falls
@@ -123,6 +129,13 @@ class PlayerPlan:
     """(T-1,) bool the ratio exceeds 1: the plan asks for more than the player can run."""
     interval_unreachable: np.ndarray
     """(T-1,) bool the target is not reachable from the previous one: the plan relocates."""
+    interval_detour: np.ndarray
+    """(T-1,) bool infeasible only by the graph's way: the straight line between the two
+    waypoints would be run in time; infeasible and not this, the player was faster than its
+    weapon's maximum even straight."""
+    interval_zigzag: np.ndarray
+    """(T-1,) bool a detour no longer than the lattice's zig-zag allows (`ZIGZAG_MAX`); the other
+    detours go round something (a missing edge, a wall the player got past)."""
 
     path_node: np.ndarray
     """(K,) int64 every waypoint in order; a repeated node is a wait or a relocation target."""
@@ -299,6 +312,12 @@ def build_plan(
         running = np.maximum(interval_seconds - air, MIN_RUN_S)
         required = np.where(length == 0, 0.0, length / running)
     ratio = required / max_speed
+    straight = np.linalg.norm(
+        graph.positions[target_node[1:]] - graph.positions[target_node[:-1]], axis=1
+    )
+    straight_ratio = straight / np.maximum(interval_seconds, MIN_RUN_S) / max_speed
+    infeasible = ratio > 1.0 + RATIO_TOLERANCE
+    detour = infeasible & (straight_ratio <= 1.0 + RATIO_TOLERANCE)
     path_interval = np.concatenate(path_interval_parts)
     action_interval = _concat(act_interval_parts, np.int64)
     entries_per_interval = np.array([len(p) for p in path_parts[1:]], dtype=np.int64)
@@ -315,8 +334,10 @@ def build_plan(
         interval_required_speed_m_s=required,
         interval_max_speed_m_s=max_speed,
         interval_speed_ratio=ratio,
-        interval_infeasible=ratio > 1.0 + RATIO_TOLERANCE,
+        interval_infeasible=infeasible,
         interval_unreachable=unreachable,
+        interval_detour=detour,
+        interval_zigzag=detour & (length <= ZIGZAG_MAX * straight),
         path_node=np.concatenate(path_parts).astype(np.int64),
         path_interval=path_interval,
         path_deadline_s=target_seconds[path_interval + 1],

@@ -83,7 +83,10 @@ class ReplayResult:
             late_share=lateness["late_share"].to_numpy(dtype=float),
             targets=lateness["reached"].to_numpy(dtype=np.int64),
             late_over_frame=lateness["late_over_frame"].to_numpy(dtype=np.int64),
-            late_plan=lateness["late_plan"].to_numpy(dtype=np.int64),
+            late_zigzag=lateness["late_zigzag"].to_numpy(dtype=np.int64),
+            late_detour=lateness["late_detour"].to_numpy(dtype=np.int64),
+            late_speed=lateness["late_speed"].to_numpy(dtype=np.int64),
+            late_gap=lateness["late_gap"].to_numpy(dtype=np.int64),
             late_carried=lateness["late_carried"].to_numpy(dtype=np.int64),
             late_replay=lateness["late_replay"].to_numpy(dtype=np.int64),
             late_p95_s=lateness["late_p95_s"].to_numpy(dtype=float),
@@ -96,8 +99,9 @@ class ReplayResult:
 
     def lateness_table(self) -> pd.DataFrame:
         """Per player: targets, those reached, the share reached late (after their tick), how
-        many more than one data frame late (`DATA_FRAME_S`) and why (`late_plan`, `late_carried`,
-        `late_replay`: see `ReplayTrace`), p95 and max lateness (s), relocations."""
+        many more than one data frame late (`DATA_FRAME_S`) and why (`late_zigzag`,
+        `late_detour`, `late_speed`, `late_gap`, `late_carried`, `late_replay`: see
+        `ReplayTrace`), p95 and max lateness (s), relocations."""
         rows = []
         for p, log in enumerate(self.logs):
             late = log.lateness_s
@@ -105,11 +109,18 @@ class ReplayResult:
             plan = self.plan.plans[p]
             with np.errstate(invalid="ignore"):
                 over = late > DATA_FRAME_S + 1e-9  # unreached (NaN): not
-            # why: the interval to the target asked too much, or the target before was late
-            asked_too_much = np.zeros(len(late), dtype=bool)
-            asked_too_much[1:] = plan.interval_infeasible | plan.interval_unreachable
+            # why it became late: the target before was already late (carried), else the
+            # interval to it asked too much (by the lattice's zig-zag, by a way round, even
+            # straight, or across a gap), else the replay's own delay
+            zigzag, detour, speed, gap = (np.zeros(len(late), dtype=bool) for _ in range(4))
+            zigzag[1:] = plan.interval_zigzag
+            detour[1:] = plan.interval_detour & ~plan.interval_zigzag
+            speed[1:] = plan.interval_infeasible & ~plan.interval_detour
+            gap[1:] = plan.interval_unreachable
+            asked_too_much = zigzag | detour | speed | gap
             carried = np.zeros(len(late), dtype=bool)
             carried[1:] = over[:-1]
+            zigzag, detour, speed, gap = (c & ~carried for c in (zigzag, detour, speed, gap))
             rows.append(
                 {
                     "player": self.plan.players[p].name,
@@ -119,8 +130,11 @@ class ReplayResult:
                     if len(reached)
                     else np.nan,
                     "late_over_frame": int(over.sum()),
-                    "late_plan": int(np.sum(over & asked_too_much)),
-                    "late_carried": int(np.sum(over & ~asked_too_much & carried)),
+                    "late_zigzag": int(np.sum(over & zigzag)),
+                    "late_detour": int(np.sum(over & detour)),
+                    "late_speed": int(np.sum(over & speed)),
+                    "late_gap": int(np.sum(over & gap)),
+                    "late_carried": int(np.sum(over & carried)),
                     "late_replay": int(np.sum(over & ~asked_too_much & ~carried)),
                     "late_p95_s": float(np.percentile(reached, 95)) if len(reached) else np.nan,
                     "late_max_s": float(reached.max()) if len(reached) else np.nan,
