@@ -3,12 +3,16 @@ that plant, defuse and shoot (not real data), so that every mechanic fires withi
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
+
 import numpy as np
 
 from decoy_cli.sim.combat import CombatBatch, DamageResult
-from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.engine import Decision, Policy, Simulator
+from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.world.physics import PhysicsWorld
 
 
 class Shots:
@@ -51,3 +55,43 @@ def site_agents(graph: WaypointGraph, seed: int) -> Agents:
         weapons=["AK-47"] * 5 + ["M4A4"] * 5,
         has_defuser=np.array([False] * 5 + [True] * 5),
     )
+
+
+def play_busy(
+    physics: PhysicsWorld,
+    graph: WaypointGraph,
+    mover: str,
+    seed: int,
+    policy: Policy,
+    drive: Callable[[Simulator], object],
+    record_ticks: Iterable[int],
+) -> Simulator:
+    """A busy round (`site_agents`, `Shots`, carrier by the seed) driven by `drive`."""
+    setup = RoundSetup(graph=graph, mover=mover, damage_model=Shots())
+    with open_round(
+        setup,
+        site_agents(graph, seed),
+        policy,
+        physics=physics,
+        bomb_carrier=seed % 5,
+        record_ticks=list(record_ticks),
+        seed=seed,
+    ) as sim:
+        drive(sim)
+    return sim
+
+
+def every_tick(sim: Simulator) -> None:
+    while not sim.done:
+        sim.step()
+
+
+def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
+    """The same outcome, end tick, events, recording and decisions."""
+    assert a.outcome == b.outcome, seed
+    assert a.tick == b.tick, seed
+    assert a.events == b.events, seed
+    for name in ("ticks", "position", "yaw", "hp", "alive"):
+        x, y = getattr(a.recording, name), getattr(b.recording, name)
+        np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")
+    np.testing.assert_array_equal(a.decisions, b.decisions)

@@ -8,12 +8,11 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from busy_rounds import Shots, site_agents
+from busy_rounds import assert_same_round, every_tick, play_busy
 
 from decoy_cli.sim import quiet_play
-from decoy_cli.sim.engine import Decision, Simulator
+from decoy_cli.sim.engine import Decision, Policy, Simulator
 from decoy_cli.sim.random_play import RandomPolicy
-from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.world.navmesh import nav_world
@@ -37,35 +36,10 @@ def _policy(seed: int) -> RandomPolicy:
 
 
 def _play(
-    physics: PhysicsWorld, seed: int, policy: object, drive: Callable[[Simulator], None]
+    physics: PhysicsWorld, seed: int, policy: Policy, drive: Callable[[Simulator], None]
 ) -> Simulator:
-    setup = RoundSetup(graph=GRAPH, mover="kinematic", damage_model=Shots())
-    with open_round(
-        setup,
-        site_agents(GRAPH, seed),
-        policy,  # type: ignore[arg-type]
-        physics=physics,
-        bomb_carrier=seed % 5,
-        record_ticks=range(0, 8000, 7 + seed % 50),
-        seed=seed,
-    ) as sim:
-        drive(sim)
-    return sim
-
-
-def _every_tick(sim: Simulator) -> None:
-    while not sim.done:
-        sim.step()
-
-
-def _same(a: Simulator, b: Simulator, seed: int) -> None:
-    assert a.outcome == b.outcome, seed
-    assert a.tick == b.tick, seed
-    assert a.events == b.events, seed
-    for name in ("ticks", "position", "yaw", "hp", "alive"):
-        x, y = getattr(a.recording, name), getattr(b.recording, name)
-        np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")
-    np.testing.assert_array_equal(a.decisions, b.decisions)
+    record = range(0, 8000, 7 + seed % 50)
+    return play_busy(physics, GRAPH, "kinematic", seed, policy, drive, record)
 
 
 @pytest.fixture(scope="module")
@@ -92,9 +66,9 @@ def stretches(monkeypatch) -> list[int]:
 def test_compiled_stretches_give_what_stepping_every_tick_gives(physics, stretches) -> None:
     kinds: set[str] = set()
     for seed in range(40):
-        stepped = _play(physics, seed, OneAtATime(_policy(seed)), _every_tick)
+        stepped = _play(physics, seed, OneAtATime(_policy(seed)), every_tick)
         compiled = _play(physics, seed, _policy(seed), lambda sim: sim.run())
-        _same(compiled, stepped, seed)
+        assert_same_round(compiled, stepped, seed)
         kinds |= {event.kind for event in stepped.events}
     assert {"damage", "kill", "plant", "bomb_drop", "defuse_start", "round_end"} <= kinds, kinds
     assert sum(stretches) > 1000  # most decisions were made in compiled stretches
@@ -107,7 +81,7 @@ def test_max_decisions_stops_where_a_decision_predicate_stops(physics, stretches
             lambda sim, n=count: sim.run(lambda s: s.decision_count >= n),
         )  # fmt: skip
         capped = _play(physics, seed, _policy(seed), lambda sim, n=count: sim.run(max_decisions=n))
-        _same(capped, asked, seed)
+        assert_same_round(capped, asked, seed)
         assert capped.decision_count == asked.decision_count >= min(count, 1)
     assert sum(stretches) > 0
 

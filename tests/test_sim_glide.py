@@ -8,7 +8,14 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from busy_rounds import Shots, Wanderers, site_agents
+from busy_rounds import (
+    Shots,
+    Wanderers,
+    assert_same_round,
+    every_tick,
+    play_busy,
+    site_agents,
+)
 
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.setup import RoundSetup, open_round
@@ -22,24 +29,8 @@ GRAPH = builtin_graph()
 def _play(
     physics: PhysicsWorld, mover: str, seed: int, drive: Callable[[Simulator], None]
 ) -> Simulator:
-    setup = RoundSetup(graph=GRAPH, mover=mover, damage_model=Shots())
-    record = range(0, 8000, 7)  # recorded ticks that fall between combat steps too
-    with open_round(
-        setup,
-        site_agents(GRAPH, seed),
-        Wanderers(seed),
-        physics=physics,
-        bomb_carrier=seed % 5,
-        record_ticks=record,
-        seed=seed,
-    ) as sim:
-        drive(sim)
-    return sim
-
-
-def _every_tick(sim: Simulator) -> None:
-    while not sim.done:
-        sim.step()
+    # recorded ticks that fall between combat steps too
+    return play_busy(physics, GRAPH, mover, seed, Wanderers(seed), drive, range(0, 8000, 7))
 
 
 def _event_by_event(sim: Simulator) -> None:
@@ -56,15 +47,9 @@ def physics():
 def test_run_is_tick_for_tick_what_stepping_every_tick_gives(physics, mover) -> None:
     kinds: set[str] = set()
     for seed in range(12):
-        stepped = _play(physics, mover, seed, _every_tick)
+        stepped = _play(physics, mover, seed, every_tick)
         glided = _play(physics, mover, seed, _event_by_event)
-        assert glided.outcome == stepped.outcome, seed
-        assert glided.tick == stepped.tick, seed
-        assert glided.events == stepped.events, seed
-        for name in ("ticks", "position", "yaw", "hp", "alive"):
-            a, b = getattr(glided.recording, name), getattr(stepped.recording, name)
-            np.testing.assert_array_equal(a, b, err_msg=f"seed {seed}: {name}")
-        np.testing.assert_array_equal(glided.decisions, stepped.decisions)
+        assert_same_round(glided, stepped, seed)
         kinds |= {event.kind for event in stepped.events}
     # the rounds exercised what a glide must stop for
     assert {"damage", "kill", "plant", "bomb_drop", "defuse_start", "round_end"} <= kinds, kinds
@@ -145,7 +130,7 @@ def test_moving_on_after_the_end_event_by_event_is_stepping_after_the_end(physic
     """A replay follows the data past the outcome (`after_end`): the same, tick for tick."""
 
     def stepped(sim: Simulator) -> None:
-        _every_tick(sim)
+        every_tick(sim)
         for _ in range(400):
             sim.step(after_end=True)
 
