@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 
 import numpy as np
+import pytest
 
 from decoy_cli.sim.combat import CombatBatch, DamageResult
 from decoy_cli.sim.engine import Decision, Policy, Simulator
@@ -95,3 +96,20 @@ def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
         x, y = getattr(a.recording, name), getattr(b.recording, name)
         np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")
     np.testing.assert_array_equal(a.decisions, b.decisions)
+
+
+def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """From now on, the decisions each compiled stretch makes (`quiet_play._play`), call by
+    call: a test that the compiled path was taken."""
+    from decoy_cli.sim import quiet_play
+
+    made: list[int] = []
+    play = quiet_play._play
+
+    def counting(*args):
+        out = play(*args)
+        made.append(int(out[2]))
+        return out
+
+    monkeypatch.setattr(quiet_play, "_play", counting)
+    return made

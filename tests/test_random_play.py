@@ -8,9 +8,8 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from busy_rounds import assert_same_round, every_tick, play_busy
+from busy_rounds import assert_same_round, count_stretch_decisions, every_tick, play_busy
 
-from decoy_cli.sim import quiet_play
 from decoy_cli.sim.engine import Decision, Policy, Simulator
 from decoy_cli.sim.random_play import RandomPolicy
 from decoy_cli.waypoints.build import builtin_graph
@@ -51,16 +50,7 @@ def physics():
 @pytest.fixture()
 def stretches(monkeypatch) -> list[int]:
     """The decisions made inside compiled stretches, call by call."""
-    made: list[int] = []
-    play = quiet_play._play
-
-    def counting(*args):
-        out = play(*args)
-        made.append(int(out[2]))
-        return out
-
-    monkeypatch.setattr(quiet_play, "_play", counting)
-    return made
+    return count_stretch_decisions(monkeypatch)
 
 
 def test_compiled_stretches_give_what_stepping_every_tick_gives(physics, stretches) -> None:

@@ -12,6 +12,7 @@ from busy_rounds import (
     Shots,
     Wanderers,
     assert_same_round,
+    count_stretch_decisions,
     every_tick,
     play_busy,
     site_agents,
@@ -100,17 +101,7 @@ def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypa
         env.close()
         return trace
 
-    from decoy_cli.sim import quiet_play
-
-    made: list[int] = []
-    compiled = quiet_play._play
-
-    def counting(*args):
-        out = compiled(*args)
-        made.append(int(out[2]))
-        return out
-
-    monkeypatch.setattr(quiet_play, "_play", counting)
+    made = count_stretch_decisions(monkeypatch)
     glided = play()
     assert sum(made) > 1000  # the steps' decisions went through compiled stretches
 
