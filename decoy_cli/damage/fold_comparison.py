@@ -129,7 +129,7 @@ def _score(
             fold_means.append(float(np.mean([c.wasserstein_hp for c in found])))
     tv = hit_group_tv(weapon, real.hit_group, np.tile(weapon, draws), group.ravel())
     values = [c.wasserstein_hp for c in pooled]
-    floors = sampling_floor(pooled, np.tile(weapon, draws), group.ravel(), damage.ravel())
+    floors = sampling_floor(pooled, weapon, group, damage)
     return ModelScores(
         name,
         float(np.mean(values)) if values else float("nan"),

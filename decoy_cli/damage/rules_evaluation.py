@@ -66,8 +66,8 @@ class RulesEvaluation:
     max_wasserstein_hp: float
     fold_mean_wasserstein_hp: list[float]
     group_tv: pd.DataFrame
-    """weapon, hits, tv, tv_floor (`scores.tv_floor`), and the real and drawn shares of every
-    group."""
+    """weapon, hits, tv, tv_floor and tv_floor_above_0.15 (`scores.tv_floor`: its mean, and how
+    often a model exactly right exceeds 0.15), and the real and drawn shares of every group."""
     armour_shares: dict[str, tuple[float, float]]
     """(kevlar share, helmet share) by the victim side's buy type over all hits, for the report
     (each fold's draws use the shares of its training folds only)."""
@@ -174,12 +174,8 @@ def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
         generated["damage"].to_numpy(np.float64),
         min_cell=MIN_CELL,
     )
-    floors = sampling_floor(
-        found,
-        generated["weapon"].to_numpy(dtype=object),
-        generated["group"].map(GROUPS.index).to_numpy(),
-        generated["damage"].to_numpy(np.float64),
-    )
+    weapon, group, damage = _by_draw(generated)
+    floors = sampling_floor(found, weapon, group, damage)
     rows = [
         (c.weapon, c.hit_group, c.real, c.generated, c.wasserstein_hp, floor)
         for c, floor in zip(found, floors, strict=True)
@@ -188,8 +184,18 @@ def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=columns)
 
 
+def _by_draw(generated: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The generated rows (`DRAWS` consecutive rows per hit) as (K,) weapons and (DRAWS, K)
+    hit-group codes and damage, the layout of `scores.sampling_floor`."""
+    k = len(generated) // DRAWS
+    group = generated["group"].map(GROUPS.index).to_numpy().reshape(k, DRAWS).T
+    damage = generated["damage"].to_numpy(np.float64).reshape(k, DRAWS).T
+    return generated["weapon"].to_numpy(dtype=object)[::DRAWS], group, damage
+
+
 def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
     """Per weapon with enough hits: total variation between real and drawn group shares."""
+    drawn_weapon, drawn_groups, _ = _by_draw(generated)
     rows = []
     for weapon, group in real.groupby("weapon"):
         if len(group) < MIN_WEAPON_SAMPLES:
@@ -198,9 +204,11 @@ def _group_tv(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
         drawn = generated[generated["weapon"] == weapon]["group"]
         q = drawn.value_counts(normalize=True).reindex(GROUPS, fill_value=0.0)
         tv = 0.5 * float((p - q).abs().sum())
+        floor, above = tv_floor(drawn_groups[:, drawn_weapon == weapon])
         rows.append(
-            {"weapon": weapon, "hits": len(group), "tv": tv, "tv_floor": tv_floor(q, len(group))}
-        )
+            {"weapon": weapon, "hits": len(group), "tv": tv, "tv_floor": floor,
+             "tv_floor_above_0.15": above}
+        )  # fmt: skip
         rows[-1] |= {f"real_{g}": float(p[g]) for g in GROUPS}
         rows[-1] |= {f"drawn_{g}": float(q[g]) for g in GROUPS}
     return pd.DataFrame(rows)

@@ -175,52 +175,42 @@ def wasserstein_cells(
     return sorted(cells, key=lambda c: (-c.real, c.weapon, c.hit_group))
 
 
-SAMPLING_DRAWS = 200
-"""Resamplings per cell for `sampling_floor`."""
-
-
 def sampling_floor(
-    cells: list[Cell],
-    generated_weapon: np.ndarray,
-    generated_group: np.ndarray,
-    generated_damage: np.ndarray,
-    seed: int = 0,
+    cells: list[Cell], weapon: np.ndarray, group: np.ndarray, damage: np.ndarray
 ) -> list[float]:
-    """Per cell, the Wasserstein distance a model would score if the real samples came from its
-    own generated distribution: the mean, over `SAMPLING_DRAWS` resamplings, of the distance
-    between `cell.real` values drawn from the cell's generated damage and all of them. A cell of
-    a few real samples scores this much by chance alone, so a model cannot be told apart from
-    the real game below it."""
+    """Per cell, the Wasserstein distance the model would score were the real samples drawn from
+    it. `weapon` (K,) is each sample's, `group` and `damage` (D, K) the model's D draws for
+    each. For each draw d, the model's d-th outcome of every sample stands in for the real one
+    (each keeps its own inputs: weapon, range, armour), and its cell is compared with the cell
+    of all draws; the floor is the mean over d. A cell of a few real samples scores about this
+    much by chance alone: a model cannot be told from the real game below it."""
     from scipy.stats import wasserstein_distance
 
-    rng = np.random.default_rng(seed)
-    weapons = np.asarray(generated_weapon, dtype=object)
+    weapons = np.asarray(weapon, dtype=object)
     floors = []
     for cell in cells:
         code = HIT_GROUPS.index(cell.hit_group)
-        values = generated_damage[(weapons == cell.weapon) & (generated_group == code)]
-        floors.append(
-            float(
-                np.mean(
-                    [
-                        wasserstein_distance(rng.choice(values, cell.real), values)
-                        for _ in range(SAMPLING_DRAWS)
-                    ]
-                )
-            )
-        )
+        of_weapon = weapons == cell.weapon
+        drawn, groups = damage[:, of_weapon], group[:, of_weapon]
+        pool = drawn[groups == code]
+        found = [
+            wasserstein_distance(drawn[d][groups[d] == code], pool)
+            for d in range(len(drawn))
+            if np.any(groups[d] == code)
+        ]
+        floors.append(float(np.mean(found)) if found else math.nan)
     return floors
 
 
-def tv_floor(shares: np.ndarray, count: int, seed: int = 0) -> float:
-    """The hit-group total variation a model with these group `shares` would score against
-    `count` real hits drawn from it: the mean over `SAMPLING_DRAWS` such draws (see
-    `sampling_floor`)."""
-    p = np.asarray(shares, dtype=np.float64)
-    p = p / p.sum()
-    rng = np.random.default_rng(seed)
-    drawn = rng.multinomial(count, p, size=SAMPLING_DRAWS) / count
-    return float(np.mean(0.5 * np.abs(drawn - p).sum(axis=1)))
+def tv_floor(groups: np.ndarray, limit: float = 0.15) -> tuple[float, float]:
+    """The hit-group total variation the model would score against real samples drawn from it
+    (as `sampling_floor`): `groups` (D, n) are its D draws for the n samples of one weapon; each
+    draw's shares against all draws' shares. Returns the mean over draws and the share of draws
+    above `limit`."""
+    counts = np.stack([np.bincount(row, minlength=len(HIT_GROUPS)) for row in groups])
+    pooled = counts.sum(axis=0) / counts.sum()
+    tv = 0.5 * np.abs(counts / counts.sum(axis=1, keepdims=True) - pooled).sum(axis=1)
+    return float(tv.mean()), float(np.mean(tv > limit))
 
 
 MIN_WEAPON_SAMPLES = 30

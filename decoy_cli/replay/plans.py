@@ -315,7 +315,7 @@ def build_plan(
     straight = np.linalg.norm(
         graph.positions[target_node[1:]] - graph.positions[target_node[:-1]], axis=1
     )
-    straight_ratio = straight / np.maximum(interval_seconds, MIN_RUN_S) / max_speed
+    straight_ratio = straight / running / max_speed  # the same air time as the path's
     infeasible = ratio > 1.0 + RATIO_TOLERANCE
     detour = infeasible & (straight_ratio <= 1.0 + RATIO_TOLERANCE)
     path_interval = np.concatenate(path_interval_parts)

@@ -214,10 +214,11 @@ class Simulator:
         stop_when_due: bool = False,
     ) -> Recording:
         """Play until the round ends (the tick bound), `to_tick` is reached, `until(sim)` says
-        stop, `max_decisions` decisions are made or, with `stop_when_due`, after the first tick
-        an agent is due for a decision at the next (`decision_due`: the environment's step);
-        with `after_end`, the agents go on moving after the outcome, as `step(after_end=True)`
-        has them, until `to_tick`. The stopping rules are asked as `until` is.
+        stop, this run has made `max_decisions` decisions or, with `stop_when_due`, after the
+        first tick an agent is due for a decision at the next (`decision_due`: the
+        environment's step); with `after_end`, the agents go on moving after the outcome, as
+        `step(after_end=True)` has them, until `to_tick`. The stopping rules are asked as
+        `until` is.
 
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
@@ -233,7 +234,7 @@ class Simulator:
         environment's actions) plays whole quiet stretches of decisions and motion in compiled
         code when the mover is kinematic and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
-        limit = NEVER if max_decisions is None else int(max_decisions)
+        limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 
         first = self.tick
 
@@ -257,7 +258,8 @@ class Simulator:
                 horizon = self._stretch_end(self.tick, end)
                 if horizon > self.tick:
                     before = (self.tick, self.decision_count)
-                    if quiet_player(self, horizon, limit, self._watched()) == DECIDED:
+                    watched = self.rules.watched(self.agents, self.bomb)
+                    if quiet_player(self, horizon, limit, watched) == DECIDED:
                         self._after_decisions(end, stop)
                         continue
                     if (self.tick, self.decision_count) != before:
@@ -289,17 +291,6 @@ class Simulator:
         if glided:
             self.agents.position[:] = self.mover.positions
             self.rules.follow(self.agents, self.bomb)
-
-    def _watched(self) -> np.ndarray:
-        """(N,) the agents whose wish to plant or defuse the bomb rules may act on: the carrier
-        of a carried bomb, everyone once it is planted (a policy playing a quiet stretch hands
-        the tick back when one of them decides to)."""
-        watch = np.zeros(self.agents.count, dtype=bool)
-        if self.bomb.status == BombStatus.CARRIED and self.bomb.carrier >= 0:
-            watch[self.bomb.carrier] = True
-        elif self.bomb.status != BombStatus.CARRIED:
-            watch[:] = True
-        return watch
 
     def relocate(self, agent: int, node: int) -> None:
         """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event.
@@ -376,7 +367,7 @@ class Simulator:
         """The last tick, at most `end`, through which nothing but decisions and motion can
         happen after `tick`: no combat step, no recorded tick, the bomb rules have nothing to
         do and the outcome cannot change (the clock, the detonation), as long as no agent the
-        rules watch decides (`_watched`); `tick` when the tick after it is not quiet."""
+        rules watch decides (`BombRules.watched`); `tick` when the tick after it is not quiet."""
         alive = self.agents.alive
         if self.outcome is not None or alive.tobytes() != self._alive_judged:
             return tick  # judged yet? (not after a kill from outside)

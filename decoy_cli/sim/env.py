@@ -30,7 +30,7 @@ from decoy_cli.sim.observation import (
     NUM_ACTIONS,
     ObservationEncoder,
 )
-from decoy_cli.sim.quiet_play import QUIET_END, Choices, TopSpeeds, play_stretch
+from decoy_cli.sim.quiet_play import Choices, TopSpeeds, play_stretch
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
@@ -55,7 +55,6 @@ class _ChosenActions:
         is_t = np.array([side == "T" for side in sides])
         n = len(sides)
         self.choices = Choices(np.full(n, -1, np.int64), np.zeros(0), 0, stop_ticks, is_t, ~is_t)
-        self.possible = True  # every move handed in has an edge (else Python plays the tick)
         self._top = TopSpeeds()
 
     def decide(self, sim: Simulator, agent: int) -> Decision:
@@ -77,10 +76,8 @@ class _ChosenActions:
     def play_quiet(
         self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
     ) -> int:
-        """The step's quiet stretches in compiled code; an impossible move is left to Python,
-        which stands the agent still and records it."""
-        if not self.possible:
-            return QUIET_END
+        """The step's quiet stretches in compiled code (`quiet_play.play_stretch`); a tick with
+        an impossible move is left to Python, which stands the agent still and records it."""
         top = self._top.of(sim.agents.weapon)
         return play_stretch(sim, horizon, max_decisions, watch, self.choices, top)
 
@@ -352,10 +349,6 @@ class DecoyParallelEnv(ParallelEnv):
                 if name not in actions:
                     raise ValueError(f"agent {name} needs a decision but was given no action")
                 given[agent] = self._action(agent, actions[name])
-        moves = np.flatnonzero((given >= 0) & (given < STOP_ACTION))
-        self._policy.possible = bool(
-            np.all(self.graph.out_edges[sim.agents.node[moves], given[moves]] >= 0)
-        )
         sim.run(stop_when_due=True)  # the first tick takes the decisions, then on to the next
         if np.any(given >= 0):
             raise RuntimeError(

@@ -27,7 +27,7 @@ from numba import njit
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
-from decoy_cli.sim.schedule import next_due, note_arrivals
+from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
 
@@ -35,10 +35,11 @@ if TYPE_CHECKING:
     from decoy_cli.sim.engine import Simulator
 
 QUIET_END, NEED_DRAWS, DECIDED, DUE, AIRBORNE = range(5)
-"""How `_play` ended: it reached the stretch's end (the next tick is Python's to play); it has
-too few draws left for the agents due next; it made decisions after which Python goes on with
-the tick; an agent is due with no action handed in (the tick is not begun); an agent asked to
-move is in the air."""
+"""How `_play` ended: it reached the stretch's end, or an agent due next was handed a move no
+edge makes (the next tick is Python's to play, which records the impossible move); it has too
+few draws left for the agents due next; it made decisions after which Python goes on with the
+tick; an agent is due with no action handed in (the tick is not begun); an agent asked to move
+is in the air."""
 
 DRAW = -2
 """In `Choices.given`: the agent's action is drawn (-1: none handed in; 0..8: this action)."""
@@ -58,10 +59,10 @@ class QuietPlayer(Protocol):
 class Choices:
     """Where a stretch's decisions come from, per agent (N,) and for every STOP."""
 
-    given: np.ndarray  # int64: an action handed in (used once), DRAW, or -1 (stop when due)
+    given: np.ndarray  # int64: an action 0..8 handed in (used once), DRAW, or -1 (stop when due)
     draws: np.ndarray  # float64 uniform draws in [0, 1), used in order from `next_draw`
     next_draw: int
-    hold_ticks: int  # how long a STOP holds
+    hold_ticks: int  # how long a STOP holds, at least 1 tick
     plant: np.ndarray  # bool: a STOP of this agent wants to plant
     defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
 
@@ -90,6 +91,8 @@ def play_stretch(
     graph, agents, mover = sim.graph, sim.agents, sim.mover
     if not isinstance(mover, KinematicMover):
         raise TypeError("compiled stretches need the kinematic mover")
+    if choices.hold_ticks < 1:
+        raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
     first, actions = graph.allowed_actions
     pos, start, target, fv, iv, flags, params = mover.kernel_arrays()
     tick, used, made, falls, glide_end, status = _play(
@@ -116,8 +119,8 @@ def _play(
 ):  # fmt: skip
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
     tick: at each tick the due agents (ascending) decide (`Choices`), then if the tick after
-    them is quiet the motion glides to the next arrival or decision or the horizon. Every move
-    handed in must be possible (an edge leaves the agent's node). Returns (tick, next draw,
+    them is quiet the motion glides to the next arrival or decision or the horizon. A handed-in
+    action must be 0..8 (`Choices`). Returns (tick, next draw,
     decisions made, damaging drops started, tick of the last glide's end or -1, status)."""
     n = alive.shape[0]
     made = falls = 0
@@ -128,17 +131,19 @@ def _play(
             return tick, next_draw, made, falls, glide_end, QUIET_END
         drawn = 0
         for i in range(n):
-            if alive[i] and (waiting[i] or (hold_until[i] > 0 and tick + 1 >= hold_until[i])):
+            if is_due(i, waiting, alive, hold_until, tick + 1):
                 if given[i] == -1:
                     return tick, next_draw, made, falls, glide_end, DUE
                 if given[i] == DRAW:
                     drawn += 1
+                elif given[i] != STOP_ACTION and out_edges[node[i], given[i]] < 0:
+                    return tick, next_draw, made, falls, glide_end, QUIET_END
         if drawn > draws.shape[0] - next_draw:
             return tick, next_draw, made, falls, glide_end, NEED_DRAWS
         tick += 1
         hand_back = False
         for a in range(n):
-            if not (alive[a] and (waiting[a] or (hold_until[a] > 0 and tick >= hold_until[a]))):
+            if not is_due(a, waiting, alive, hold_until, tick):
                 continue
             hold_until[a] = 0
             waiting[a] = False

@@ -244,6 +244,19 @@ class BombRules:
                 events += self._defuse(tick, agents, bomb, wants_defuse, moving)
         return events
 
+    def watched(self, agents: Agents, bomb: Bomb) -> np.ndarray:
+        """(N,) the agents whose wish to plant or defuse may end a quiet stretch
+        (`quiet_until`): the carrier of a carried bomb, everyone once it lies or is planted,
+        nobody when the bomb is off."""
+        watch = np.zeros(agents.count, dtype=bool)
+        if not self.config.bomb_enabled:
+            return watch
+        if bomb.status == BombStatus.CARRIED and bomb.carrier >= 0:
+            watch[bomb.carrier] = True
+        elif bomb.status != BombStatus.CARRIED:
+            watch[:] = True
+        return watch
+
     def follow(self, agents: Agents, bomb: Bomb) -> None:
         """All that `step` does on a quiet tick (`quiet_until`): a carried bomb follows its
         carrier. The engine calls it instead of `step` after ticks it knows are quiet."""

@@ -16,12 +16,18 @@ NEVER = 1 << 62
 
 
 @njit(cache=True)
+def is_due(i, waiting, alive, hold_until, tick):
+    """Whether agent i is due for a decision at `tick` (module doc)."""
+    return alive[i] and (waiting[i] or (hold_until[i] > 0 and tick >= hold_until[i]))
+
+
+@njit(cache=True)
 def due_agents(waiting, alive, hold_until, tick):
     """Indices (ascending) of the agents due for a decision at `tick`."""
     out = np.empty(alive.shape[0], dtype=np.int64)
     count = 0
     for i in range(alive.shape[0]):
-        if alive[i] and (waiting[i] or (hold_until[i] > 0 and tick >= hold_until[i])):
+        if is_due(i, waiting, alive, hold_until, tick):
             out[count] = i
             count += 1
     return out[:count]

@@ -204,21 +204,6 @@ def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target
 
 
 @njit(cache=True)
-def begin_edges(agents, targets, kinds, speeds, caps, jump_speed, gravity, pos, target, fv, iv):
-    """`begin_edge` for several agents at once (row k of `targets`, `kinds`, `speeds`, `caps`
-    for agent `agents[k]`); returns the first agent in the air, which is left unchanged with
-    every agent after it, or -1 when all started."""
-    for k in range(agents.shape[0]):
-        i = agents[k]
-        if not begin_edge(
-            i, targets[k, 0], targets[k, 1], targets[k, 2], kinds[k], speeds[k], caps[k],
-            jump_speed, gravity, pos, target, fv, iv,
-        ):  # fmt: skip
-            return i
-    return -1
-
-
-@njit(cache=True)
 def stand_still(agents, fv, iv):
     """The agents stop where they are, except those on a jump or drop edge, which land first
     (`MoverBase.clear_goal` for several agents)."""

@@ -18,7 +18,7 @@ class KinematicMover(MoverBase):
 
     def kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """The packed state `kinematic_glide` works on, for compiled callers that glide
-        themselves (`decoy_cli.sim.random_play`): positions, edge starts, targets, float and
+        themselves (`decoy_cli.sim.quiet_play`): positions, edge starts, targets, float and
         int slots, flag rows, parameters."""
         return self._pos, self._start, self._target, self._fv, self._iv, self._flags, self._params
 
