@@ -88,10 +88,17 @@ def every_tick(sim: Simulator) -> None:
 
 
 def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
-    """The same outcome, end tick, events, recording and decisions."""
+    """The same outcome, end tick, events, recording, decisions and bomb."""
     assert a.outcome == b.outcome, seed
     assert a.tick == b.tick, seed
     assert a.events == b.events, seed
+    assert a.decision_count == b.decision_count == int(a.decisions.sum()), seed
+    assert (a.bomb.status, a.bomb.carrier, a.bomb.site) == (
+        b.bomb.status,
+        b.bomb.carrier,
+        b.bomb.site,
+    )
+    np.testing.assert_array_equal(a.bomb.position, b.bomb.position, err_msg=f"seed {seed}: bomb")
     for name in ("ticks", "position", "yaw", "hp", "alive"):
         x, y = getattr(a.recording, name), getattr(b.recording, name)
         np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")

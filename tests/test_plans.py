@@ -379,6 +379,7 @@ def test_interval_table_lists_every_interval() -> None:
     table = plan.interval_table()
     assert len(table) == 2
     assert table["infeasible"].tolist() == [True, False]
+    assert table["detour"].tolist() == table["zigzag"].tolist() == [False, False]
     assert table[["from_node", "to_node"]].values.tolist() == [[0, 20], [20, 21]]
     assert table["ratio"].iloc[0] == pytest.approx(5.6 / AK_M_S)
 

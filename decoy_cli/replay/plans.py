@@ -220,6 +220,8 @@ class PlayerPlan:
                 "ratio": self.interval_speed_ratio,
                 "infeasible": self.interval_infeasible,
                 "unreachable": self.interval_unreachable,
+                "detour": self.interval_detour,
+                "zigzag": self.interval_zigzag,
             }
         )
 
