@@ -173,14 +173,30 @@ def test_the_capsules_touch_nothing_and_other_agent_bodies_do_not_block(
         los.close()
 
 
-def test_close_removes_the_capsules(physics: PhysicsWorld) -> None:
-    before = pybullet.getNumBodies(physicsClientId=physics.client)
-    los = LineOfSight(physics, 7)
-    assert pybullet.getNumBodies(physicsClientId=physics.client) == before + 7
-    los.close()
-    assert pybullet.getNumBodies(physicsClientId=physics.client) == before
-    with pytest.raises(ValueError, match="closed"):
-        los.visible_pairs(_agents(["T"] * 7, [(k, 7.0, 0.0) for k in range(7)]))
+def test_close_gives_the_capsules_back_for_the_next_round() -> None:
+    with PhysicsWorld(_room()) as physics:
+        before = pybullet.getNumBodies(physicsClientId=physics.client)
+        los = LineOfSight(physics, 7)
+        lent = list(los.bodies)
+        assert pybullet.getNumBodies(physicsClientId=physics.client) == before + 7
+        los.close()
+        with pytest.raises(ValueError, match="closed"):
+            los.visible_pairs(_agents(["T"] * 7, [(k, 7.0, 0.0) for k in range(7)]))
+        # the next round borrows them: only the two more are new, parked until placed
+        again = LineOfSight(physics, 9)
+        try:
+            assert set(lent) <= set(again.bodies)
+            assert pybullet.getNumBodies(physicsClientId=physics.client) == before + 9
+            for body in again.bodies:
+                where, _ = pybullet.getBasePositionAndOrientation(
+                    body, physicsClientId=physics.client
+                )
+                assert where[2] < -1000.0  # parked far below the map
+            sides = ["T"] * 5 + ["CT"] * 4
+            assert len(again.visible_pairs(_agents(sides, [(k, 7.0, 0.0) for k in range(9)])))
+        finally:
+            again.close()
+        assert pybullet.getNumBodies(physicsClientId=physics.client) == before + 9
 
 
 def test_bad_arguments_are_refused(physics: PhysicsWorld) -> None:

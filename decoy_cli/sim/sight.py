@@ -80,35 +80,29 @@ class LineOfSight:
         self.height = float(height)
         self.eye_height = float(eye_height)
         p = self._p
-        client = physics.client
-        shape = p.createCollisionShape(
-            p.GEOM_CAPSULE,
-            radius=self.radius,
-            height=max(self.height - 2 * self.radius, 1e-6),
-            physicsClientId=client,
+        self.bodies: list[int] = physics.lend_capsules(
+            count, self.radius, self.height, LOS_GROUP, WORLD_GROUP
         )
-        self.bodies: list[int] = []
-        for k in range(count):
-            body = p.createMultiBody(
-                baseMass=0,
-                baseCollisionShapeIndex=shape,
-                basePosition=_park_position(k),
-                physicsClientId=client,
+        for k, body in enumerate(self.bodies):
+            p.resetBasePositionAndOrientation(
+                body, _park_position(k), [0.0, 0.0, 0.0, 1.0], physicsClientId=physics.client
             )
-            p.setCollisionFilterGroupMask(body, -1, LOS_GROUP, WORLD_GROUP, physicsClientId=client)
-            self.bodies.append(body)
         self._owner = {body: k for k, body in enumerate(self.bodies)}
         self._placed = np.full((count, 3), np.nan)  # feet each capsule stands on; NaN = parked
         self._pairs_key: tuple[tuple[str, ...], bytes] | None = None  # `_enemy_pairs`' cache
         self._pairs = (np.zeros(0, np.int64), np.zeros(0, np.int64))
 
     def close(self) -> None:
-        """Remove the capsules from the physics client (the client stays open)."""
-        p = self._p
-        client = self.physics.client
-        if client is not None and p.isConnected(client):
-            for body in self.bodies:
-                p.removeBody(body, physicsClientId=client)
+        """Give the capsules back to the physics client for the next round (the client stays
+        open); parked, they block nothing."""
+        shape = (self.radius, self.height, LOS_GROUP, WORLD_GROUP)
+        if self.physics.client is not None and self._p.isConnected(self.physics.client):
+            for k, body in enumerate(self.bodies):
+                self._p.resetBasePositionAndOrientation(
+                    body, _park_position(k), [0.0, 0.0, 0.0, 1.0],
+                    physicsClientId=self.physics.client,
+                )  # fmt: skip
+            self.physics.take_back(self.bodies, *shape)
         self.bodies = []
         self._owner = {}
 

@@ -81,6 +81,7 @@ class PhysicsWorld:
         self._capsules: list[int] = []
         self._capsule_shape: tuple[float, float] | None = None
         self._occlusion: OcclusionScene | None = None
+        self._lendable: dict[tuple[float, float, int, int], list[int]] = {}
 
     def _load(self, world: World) -> int:
         p = self._p
@@ -120,6 +121,39 @@ class PhysicsWorld:
         """The pybullet module this client belongs to, for code that adds its own bodies (the
         movers' and line of sight's capsules)."""
         return self._p
+
+    def lend_capsules(
+        self, count: int, radius: float, height: float, group: int, mask: int
+    ) -> list[int]:
+        """`count` static upright capsule bodies of this shape in collision `group` against
+        `mask`, taken from those given back (`take_back`) before new ones are made: making a
+        body costs far more than moving one, and a simulator makes its bodies every round. Where
+        they stand is the borrower's to set."""
+        p = self._p
+        key = (float(radius), float(height), int(group), int(mask))
+        spare = self._lendable.setdefault(key, [])
+        lent, spare[:] = spare[:count], spare[count:]
+        if len(lent) < count:
+            shape = p.createCollisionShape(
+                p.GEOM_CAPSULE,
+                radius=radius,
+                height=max(height - 2 * radius, 1e-6),
+                physicsClientId=self.client,
+            )
+            for _ in range(count - len(lent)):
+                body = p.createMultiBody(
+                    baseMass=0, baseCollisionShapeIndex=shape, physicsClientId=self.client
+                )
+                p.setCollisionFilterGroupMask(body, -1, group, mask, physicsClientId=self.client)
+                lent.append(body)
+        return lent
+
+    def take_back(
+        self, bodies: list[int], radius: float, height: float, group: int, mask: int
+    ) -> None:
+        """Bodies lent by `lend_capsules` with this shape, for the next borrower."""
+        key = (float(radius), float(height), int(group), int(mask))
+        self._lendable.setdefault(key, []).extend(bodies)
 
     def close(self) -> None:
         if self.client is not None and self._p.isConnected(self.client):
