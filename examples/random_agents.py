@@ -1,13 +1,14 @@
 """Random agents on de_dust2: every agent picks a uniformly random allowed action whenever it
 needs a decision, for a few rounds; prints how each round ended and what it cost.
 
-    python examples/random_agents.py --rounds 3 --seed 0 --mover kinematic --models shipped
+    python examples/random_agents.py --rounds 3 --seed 0 --mover kinematic --models rules
 
-Combat: `--models shipped` (the default) shoots with the DIP and DOG damage models shipped with
-decoy (`models/`, trained by the project; see their cards), `--models none` turns shooting off
-(nobody dies), and `--models FOLDER` uses another model folder (e.g. from `decoy models
-import-decoy`). In code the environment takes the model, or a function that loads it:
-`DecoyParallelEnv(damage_model=lambda: load_damage_model("shipped"))`; its own default is no
+Combat: `--models rules` (the default, as on every decoy command) shoots with the DIP shipped with
+decoy and damage by the game's rules, `--models shipped` with that DIP and the shipped DOG
+(`models/`, trained by the project; see their cards), `--models none` turns shooting off (nobody
+dies), and `--models FOLDER` uses another model folder (e.g. from `decoy models import-decoy`). In
+code the environment takes the model, or a function that loads it:
+`DecoyParallelEnv(damage_model=lambda: load_damage_model("rules"))`; its own default is no
 combat.
 
 Random walkers stay near their spawns (in the seed-0 round the two sides never come closer than
@@ -22,7 +23,7 @@ import time
 
 import numpy as np
 
-from decoy_cli.damage import load_damage_model
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.sim import DecoyParallelEnv
 
 
@@ -38,12 +39,7 @@ def main() -> None:
         default="kinematic",
         help="kinematic (no collisions) or physics (pybullet capsules that block each other)",
     )
-    parser.add_argument(
-        "--models",
-        default="shipped",
-        help='damage models: "shipped" (the DIP and DOG shipped with decoy), "none" (no '
-        "shooting) or a model folder",
-    )
+    parser.add_argument("--models", default=DEFAULT_MODELS, help=f"damage models: {CHOICES_HELP}")
     args = parser.parse_args()
     if args.rounds < 1:
         parser.error("--rounds must be at least 1")

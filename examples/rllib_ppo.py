@@ -24,6 +24,8 @@ import time
 
 import numpy as np
 
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -36,7 +38,7 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=4000, help="env steps per iteration")
     parser.add_argument("--map", default="dust2", help="a built-in map: dust2, mirage, ...")
     parser.add_argument("--mover", choices=("kinematic", "physics"), default="kinematic")
-    parser.add_argument("--models", default="shipped", help="damage models: shipped, rules, none")
+    parser.add_argument("--models", default=DEFAULT_MODELS, help=f"damage models: {CHOICES_HELP}")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     if args.iterations < 1 or args.env_runners < 0 or args.batch < 8:
