@@ -83,11 +83,11 @@ def test_random_policy_picks_only_possible_actions_uniformly() -> None:
 
     class Sim:  # what `decide` reads of a simulator
         graph = GRAPH
-        agents = type("A", (), {"node": np.array([node])})()
+        agents = type("A", (), {"node": np.array([node]), "count": 1})()
 
     picks = [policy.decide(Sim(), 0).action for _ in range(4000)]  # type: ignore[arg-type]
     counts = np.bincount(picks, minlength=9)
     assert set(np.flatnonzero(counts).tolist()) == allowed
     assert len(allowed) == 4 and counts[list(allowed)].min() > 4000 / 4 * 0.9
-    stop = policy._decisions[STOP_ACTION]
+    stop = policy._choices.decision(0, STOP_ACTION)
     assert stop.plant and not stop.defuse and stop.hold_ticks == 30

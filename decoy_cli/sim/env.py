@@ -30,13 +30,13 @@ from decoy_cli.sim.observation import (
     NUM_ACTIONS,
     ObservationEncoder,
 )
-from decoy_cli.sim.quiet_play import Choices, TopSpeeds, play_stretch
+from decoy_cli.sim.quiet_play import Choices, play_stretch
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.sim.view import TopDownView
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import is_known
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
@@ -55,7 +55,6 @@ class _ChosenActions:
         is_t = np.array([side == "T" for side in sides])
         n = len(sides)
         self.choices = Choices(np.full(n, -1, np.int64), np.zeros(0), 0, stop_ticks, is_t, ~is_t)
-        self._top = TopSpeeds()
 
     def decide(self, sim: Simulator, agent: int) -> Decision:
         action = int(self.choices.given[agent])
@@ -65,21 +64,14 @@ class _ChosenActions:
                 "which the environment did not expect"
             )
         self.choices.given[agent] = -1
-        stop = action == STOP_ACTION
-        return Decision(
-            action,
-            hold_ticks=self.choices.hold_ticks,
-            plant=stop and bool(self.choices.plant[agent]),
-            defuse=stop and bool(self.choices.defuse[agent]),
-        )
+        return self.choices.decision(agent, action)
 
     def play_quiet(
         self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
     ) -> int:
         """The step's quiet stretches in compiled code (`quiet_play.play_stretch`); a tick with
         an impossible move is left to Python, which stands the agent still and records it."""
-        top = self._top.of(sim.agents.weapon)
-        return play_stretch(sim, horizon, max_decisions, watch, self.choices, top)
+        return play_stretch(sim, horizon, max_decisions, watch, self.choices)
 
 
 def _map_graph(map_name: str | None, graph: WaypointGraph | None) -> WaypointGraph:

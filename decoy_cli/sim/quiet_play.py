@@ -18,12 +18,13 @@ everyone once the bomb is planted). The engine takes over what the loop did
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numba import njit
 
+from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
@@ -55,18 +56,6 @@ class QuietPlayer(Protocol):
         ...
 
 
-@dataclass
-class Choices:
-    """Where a stretch's decisions come from, per agent (N,) and for every STOP."""
-
-    given: np.ndarray  # int64: an action 0..8 handed in (used once), DRAW, or -1 (stop when due)
-    draws: np.ndarray  # float64 uniform draws in [0, 1), used in order from `next_draw`
-    next_draw: int
-    hold_ticks: int  # how long a STOP holds, at least 1 tick
-    plant: np.ndarray  # bool: a STOP of this agent wants to plant
-    defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
-
-
 class TopSpeeds:
     """Each agent's full speed with its weapon in hand (m/s), kept while the weapons stay."""
 
@@ -82,10 +71,36 @@ class TopSpeeds:
         return self._top
 
 
+@dataclass
+class Choices:
+    """Where a stretch's decisions come from, per agent (N,) and for every STOP; the same
+    choices decide one agent at a time on the Python path (`decision`)."""
+
+    given: np.ndarray  # int64: an action 0..8 handed in (used once), DRAW, or -1 (stop when due)
+    draws: np.ndarray  # float64 uniform draws in [0, 1), used in order from `next_draw`
+    next_draw: int
+    hold_ticks: int  # how long a STOP holds, at least 1 tick
+    plant: np.ndarray  # bool: a STOP of this agent wants to plant
+    defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
+    top_speeds: TopSpeeds = field(default_factory=TopSpeeds)
+    _decisions: dict[tuple[bool, bool, int], Decision] = field(default_factory=dict)
+
+    def decision(self, agent: int, action: int) -> Decision:
+        """The engine's `Decision` of `action` by `agent`, as `_play` takes it: a move at full
+        speed, or a STOP of `hold_ticks` that plants or defuses as the agent's flags say."""
+        stop = action == STOP_ACTION
+        key = (stop and bool(self.plant[agent]), stop and bool(self.defuse[agent]), action)
+        found = self._decisions.get(key)
+        if found is None:
+            found = self._decisions[key] = Decision(
+                action, hold_ticks=self.hold_ticks, plant=key[0], defuse=key[1]
+            )
+        return found
+
+
 def play_stretch(
-    sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices,
-    top: np.ndarray,
-) -> int:  # fmt: skip
+    sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices
+) -> int:
     """Play one quiet stretch of `sim` through at most `horizon` with `choices` (`_play`), hand
     what it did to the engine and return how it ended; `choices.next_draw` moves on."""
     graph, agents, mover = sim.graph, sim.agents, sim.mover
@@ -95,6 +110,7 @@ def play_stretch(
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
     first, actions = graph.allowed_actions
     pos, start, target, fv, iv, flags, params = mover.kernel_arrays()
+    top = choices.top_speeds.of(agents.weapon)
     tick, used, made, falls, glide_end, status = _play(
         sim.tick, horizon, choices.given, choices.draws, choices.next_draw, first, actions,
         choices.hold_ticks, choices.plant, choices.defuse, max_decisions - sim.decision_count,

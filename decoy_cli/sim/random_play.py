@@ -14,8 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.quiet_play import DRAW, NEED_DRAWS, Choices, TopSpeeds, play_stretch
-from decoy_cli.waypoints.graph import STOP_ACTION
+from decoy_cli.sim.quiet_play import DRAW, NEED_DRAWS, Choices, play_stretch
 
 if TYPE_CHECKING:
     from decoy_cli.sim.engine import Simulator
@@ -31,46 +30,43 @@ class RandomPolicy:
         defuse: bool = False,
     ) -> None:  # fmt: skip
         self.rng = rng
-        self.hold_ticks = max(1, int(hold_ticks))
         self.plant = plant
         self.defuse = defuse
         self._choices = Choices(
-            np.zeros(0, np.int64), np.zeros(0), 0, self.hold_ticks, np.zeros(0, bool),
+            np.zeros(0, np.int64), np.zeros(0), 0, max(1, int(hold_ticks)), np.zeros(0, bool),
             np.zeros(0, bool),
         )  # fmt: skip
-        self._top = TopSpeeds()
-        self._decisions = [
-            Decision(a, hold_ticks=self.hold_ticks, plant=plant and a == STOP_ACTION,
-                     defuse=defuse and a == STOP_ACTION)
-            for a in range(STOP_ACTION + 1)
-        ]  # fmt: skip
 
     def decide(self, sim: Simulator, agent: int) -> Decision:
         first, actions = sim.graph.allowed_actions
         node = int(sim.agents.node[agent])
-        choices = self._choices
+        choices = self._sized(sim.agents.count)
         if choices.next_draw == len(choices.draws):
             self._refill()
         count = int(first[node + 1] - first[node])
         pick = int(choices.draws[choices.next_draw] * count)
         choices.next_draw += 1
-        return self._decisions[int(actions[first[node] + pick])]
+        return choices.decision(agent, int(actions[first[node] + pick]))
 
     def play_quiet(
         self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
     ) -> int:
         """Play from `sim.tick` through at most `horizon` (`quiet_play.play_stretch`)."""
-        choices, n = self._choices, sim.agents.count
+        choices = self._sized(sim.agents.count)
+        while True:
+            status = play_stretch(sim, horizon, max_decisions, watch, choices)
+            if status != NEED_DRAWS:
+                return status
+            self._refill()
+
+    def _sized(self, n: int) -> Choices:
+        """The choices for `n` agents: every action drawn, every STOP alike."""
+        choices = self._choices
         if len(choices.given) != n:
             choices.given = np.full(n, DRAW, np.int64)
             choices.plant = np.full(n, self.plant)
             choices.defuse = np.full(n, self.defuse)
-        top = self._top.of(sim.agents.weapon)
-        while True:
-            status = play_stretch(sim, horizon, max_decisions, watch, choices, top)
-            if status != NEED_DRAWS:
-                return status
-            self._refill()
+        return choices
 
     def _refill(self) -> None:
         """A new block after what is left of the current one."""
