@@ -281,31 +281,14 @@ class PhysicsWorld:
         p.performCollisionDetection(physicsClientId=self.client)
 
     def _ensure_capsules(self, radius: float, height: float, pool: int = 1024) -> None:
-        p = self._p
+        """`pool` capsules of this shape for the overlap tests, parked (`lend_capsules`)."""
         if self._capsule_shape == (radius, height):
             return
-        for body in self._capsules:
-            p.removeBody(body, physicsClientId=self.client)
-        shape = p.createCollisionShape(
-            p.GEOM_CAPSULE,
-            radius=radius,
-            height=max(height - 2 * radius, 1e-3),
-            physicsClientId=self.client,
-        )
-        self._capsules = []
-        for k in range(pool):
-            body = p.createMultiBody(
-                baseMass=0,
-                baseCollisionShapeIndex=shape,
-                basePosition=[0.0, 0.0, 1e6 + 10 * k],
-                physicsClientId=self.client,
-            )
-            p.setCollisionFilterGroupMask(
-                body, -1, AGENT_GROUP, WORLD_GROUP, physicsClientId=self.client
-            )
-            self._capsules.append(body)
+        if self._capsule_shape is not None:
+            self.take_back(self._capsules, *self._capsule_shape, AGENT_GROUP, WORLD_GROUP)
+        self._capsules = self.lend_capsules(pool, radius, height, AGENT_GROUP, WORLD_GROUP)
         self._capsule_shape = (radius, height)
-
+        self._park(pool)
 
 def _write_plain_obj(world: World, path: str) -> None:
     vertices, indices = world.vertices_and_indices()
