@@ -1,0 +1,80 @@
+"""Where a PettingZoo environment step's time goes: python benchmarks/env_step_profile.py [ROUNDS]
+
+Plays `decoy bench`'s environment section (5v5, kinematic mover, the shipped models, each agent
+that needs a decision taking a random allowed action) for ROUNDS rounds after a warm-up round,
+with the environment's parts timed by wrapping them: the whole `step`, the simulator's `run`
+inside it, the combat and other whole ticks (`_finish_tick`), the observation and info
+dictionaries; what `step` spends outside those is its own Python, and what the round costs
+outside `step` is the benchmark's loop of random masked actions. Microseconds per step, on this
+machine: compare the parts with each other, not with another machine's figures.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from decoy_cli.bench.machine import machine_line
+from decoy_cli.bench.portable import _play
+from decoy_cli.damage import load_damage_model
+from decoy_cli.sim import DecoyParallelEnv
+from decoy_cli.sim.engine import Simulator
+
+SPENT: dict[str, float] = defaultdict(float)
+
+
+def timed(owner: type, name: str) -> None:
+    """Wrap `owner.name` so that its time adds up in SPENT[name]."""
+    method: Callable[..., Any] = getattr(owner, name)
+
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        started = time.perf_counter()
+        try:
+            return method(*args, **kwargs)
+        finally:
+            SPENT[name] += time.perf_counter() - started
+
+    setattr(owner, name, wrapper)
+
+
+def main() -> None:
+    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+    for owner, name in ((DecoyParallelEnv, "step"), (DecoyParallelEnv, "_observe"),
+                        (DecoyParallelEnv, "_infos"), (Simulator, "run"),
+                        (Simulator, "_finish_tick")):  # fmt: skip
+        timed(owner, name)
+    env = DecoyParallelEnv(mover="kinematic", damage_model=load_damage_model("shipped"))
+    rng = np.random.default_rng(0)
+    _play(env, rng, seed=0)  # warm-up: compilation
+    SPENT.clear()
+    started = time.perf_counter()
+    played = [_play(env, rng, seed=k + 1) for k in range(rounds)]
+    wall = time.perf_counter() - started
+    env.close()
+    steps = sum(p["steps"] for p in played)
+    decisions = sum(p["decisions"] for p in played)
+    per = {name: seconds / steps * 1e6 for name, seconds in SPENT.items()}
+    print(machine_line())
+    print(f"{rounds} rounds, {steps:,} steps, {decisions:,} decisions, {decisions / wall:,.0f} "
+          f"decisions/s (wrapping adds a little to each part)")  # fmt: skip
+    parts = {
+        "the whole step": wall / steps * 1e6,
+        "  env.step": per["step"],
+        "    simulator run": per["run"],
+        "      of it whole ticks (combat, bomb, recording)": per["_finish_tick"],
+        "    observation dictionaries": per["_observe"],
+        "    info dictionaries": per["_infos"],
+        "    the step's own Python": per["step"] - per["run"] - per["_observe"] - per["_infos"],
+        "  the benchmark's own loop": wall / steps * 1e6 - per["step"],
+    }
+    for part, micros in parts.items():
+        print(f"{part:<52} {micros:7.1f} us/step")
+
+
+if __name__ == "__main__":
+    main()
