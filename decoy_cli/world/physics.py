@@ -290,6 +290,7 @@ class PhysicsWorld:
         self._capsule_shape = (radius, height)
         self._park(pool)
 
+
 def _write_plain_obj(world: World, path: str) -> None:
     vertices, indices = world.vertices_and_indices()
     with open(path, "w") as f:
