@@ -31,7 +31,10 @@ def test_headlines_are_rates_higher_is_better() -> None:
     assert headlines("metrics", {"pairs_per_s": 10.0}) == {"pairs/s": 10.0}
     kinematic = {"agents": 10, "ticks_per_s": 3.0}
     assert headlines("kinematic", kinematic) == {"ticks/s, 10 agents": 3.0}
-    assert headlines("env", {"decisions_per_s": 7.0}) == {"agent decisions/s": 7.0}
+    arrays = "agent decisions/s, arrays (PettingZoo where absent)"
+    assert headlines("env", {"decisions_per_s": 7.0}) == {"agent decisions/s": 7.0, arrays: 7.0}
+    both = {"decisions_per_s": 7.0, "array_decisions_per_s": 9.0}
+    assert headlines("env", both) == {"agent decisions/s": 7.0, arrays: 9.0}
     rows = [{"agents": 2, "ticks_per_s": 5.0}, {"agents": 10, "ticks_per_s": 2.0}]
     assert headlines("table1", {"rows": rows}) == {
         "ticks/s, 2 agents": 5.0,

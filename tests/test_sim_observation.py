@@ -75,7 +75,8 @@ def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
             while not sim.done:
                 sim.step()
                 due = sim.needs_decision
-                vectors, masks = encoder.encode(sim, due)
+                vectors, masks, encoded_due = encoder.encode(sim)
+                np.testing.assert_array_equal(encoded_due, due)
                 expected = reference(encoder, sim, due)
                 np.testing.assert_allclose(vectors, expected, atol=1e-7, err_msg=str(sim.tick))
                 mask = np.zeros((agents.count, NUM_ACTIONS), np.int8)
@@ -87,4 +88,5 @@ def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
                 seen |= {str(sim.bomb.status.name), "planting" * (sim.bomb.planter >= 0)}
                 seen |= {"defusing" * (sim.bomb.defuser >= 0), "dead" * (not agents.alive.all())}
     assert checked > 5000
+    assert not encoder.encode(sim)[2].any()  # nobody decides once the round is done
     assert {"CARRIED", "DROPPED", "PLANTED", "planting", "defusing", "dead"} <= seen, seen

@@ -212,6 +212,8 @@ def headlines(section: str, result: dict[str, Any]) -> dict[str, float]:
         figures = {f"ticks/s, {result.get('agents')} agents": result.get("ticks_per_s")}
     elif section == "env":
         figures = {"agent decisions/s": result.get("decisions_per_s")}
+        arrays = result.get("array_decisions_per_s", result.get("decisions_per_s"))
+        figures["agent decisions/s, arrays (PettingZoo where absent)"] = arrays
     elif section == "table1":
         rows = result.get("rows", [])
         figures = {f"ticks/s, {row.get('agents')} agents": row.get("ticks_per_s") for row in rows}

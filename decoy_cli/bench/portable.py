@@ -12,7 +12,9 @@ one measuring code, two simulators.
 * `env`: agent decisions per second through the PettingZoo environment, 5 T against 5 CT,
   combat with the chosen damage model, the bomb on, each agent that needs a decision taking a
   uniformly random allowed action (its action mask); how far the environment raises the
-  process's peak resident memory is reported beside it.
+  process's peak resident memory is reported beside it. Where the code has the array
+  environment under it (`DecoyArrayEnv`), the same rounds are also played through that, with
+  the random masked actions drawn for all agents at once, as a batched trainer would.
 """
 
 from __future__ import annotations
@@ -80,7 +82,9 @@ def env_section(config: dict[str, Any]) -> dict[str, Any]:
     finally:
         env.close()
     decisions = sum(t["decisions"] for t in totals)
+    arrays = _array_rounds(config, model, rounds)
     return {
+        **arrays,
         "rounds": rounds,
         "mover": "kinematic",
         "decisions": decisions,
@@ -114,6 +118,40 @@ def _play(env: Any, rng: np.random.Generator, seed: int) -> dict[str, Any]:
             tick = max(tick, int(info["tick"]))
             outcome = str(info.get("reason", outcome))
     return {"decisions": decisions, "steps": steps, "game_s": tick / 60.0, "outcome": outcome}
+
+
+def _array_rounds(config: dict[str, Any], model: Callable | None, rounds: int) -> dict[str, Any]:
+    """The environment section's rounds through `DecoyArrayEnv`, if this code has it."""
+    try:
+        from decoy_cli.sim.array_env import DecoyArrayEnv
+    except ImportError:
+        return {}
+    rng = np.random.default_rng(int(config.get("seed", 0)))
+    env = DecoyArrayEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5, map=config.get("map"))
+    try:
+        _play_arrays(env, rng, seed=0)  # warm-up
+        started = time.perf_counter()
+        totals = [_play_arrays(env, rng, seed=k + 1) for k in range(rounds)]
+        wall = time.perf_counter() - started
+    finally:
+        env.close()
+    decisions = sum(totals)
+    return {
+        "array_decisions": decisions,
+        "array_wall_s": wall,
+        "array_decisions_per_s": decisions / wall,
+    }
+
+
+def _play_arrays(env: Any, rng: np.random.Generator, seed: int) -> int:
+    """One round of random masked actions through the array environment; its decisions."""
+    state = env.reset(seed)
+    decisions = 0
+    while state.winner is None:
+        masks = state.action_masks
+        decisions += int(state.needs_decision.sum())
+        state = env.step(np.argmax(rng.random(masks.shape) * masks, axis=1))
+    return decisions
 
 
 def _model(config: dict[str, Any]) -> tuple[Callable | None, str]:

@@ -34,7 +34,7 @@ DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
 TITLES = {
     "table1": "Table 1: simulator speed",
     "kinematic": "kinematic core, Table 1 at 10 agents",
-    "env": "PettingZoo environment, 5v5",
+    "env": "environment, 5v5",
     "combat_step": "one 5v5 combat step",
     "replay": "replay throughput",
     "metrics": "metric throughput",
@@ -365,12 +365,22 @@ def _kinematic_table(result: dict[str, Any]) -> Table:
 
 def _env_table(result: dict[str, Any]) -> Table:
     table = _table(
-        "PettingZoo environment: random masked actions, 5v5, combat and bomb on",
-        ["rounds", "agent decisions", "env steps", "game s", "wall s", "decisions/s", "env MB"],
+        "environment: random masked actions, 5v5, combat and bomb on",
+        [
+            "interface",
+            "rounds",
+            "agent decisions",
+            "env steps",
+            "game s",
+            "wall s",
+            "decisions/s",
+            "env MB",
+        ],
         caption=f"{result['mover']} mover, damage model: {result['damage_model']}; env MB: "
         f"peak resident memory the environment added; peak memory {result['peak_rss_mb']:.0f} MB",
     )
     table.add_row(
+        "PettingZoo",
         str(result["rounds"]),
         f"{result['decisions']:,}",
         f"{result['steps']:,}",
@@ -379,6 +389,17 @@ def _env_table(result: dict[str, Any]) -> Table:
         f"{result['decisions_per_s']:,.0f}",
         f"{result['env_memory_mb']:.0f}",
     )
+    if "array_decisions_per_s" in result:
+        table.add_row(
+            "arrays (DecoyArrayEnv)",
+            str(result["rounds"]),
+            f"{result['array_decisions']:,}",
+            "",
+            "",
+            f"{result['array_wall_s']:.2f}",
+            f"{result['array_decisions_per_s']:,.0f}",
+            "",
+        )
     return table
 
 

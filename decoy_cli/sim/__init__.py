@@ -1,7 +1,8 @@
 """The headless simulator: round state, movement, line of sight and combat, bomb rules, env.
 
 Entry points: `RoundSetup` and `open_round` (decoy_cli/sim/setup.py) build a ready `Simulator`
-for a round; `DecoyParallelEnv` is the PettingZoo environment over it. They are imported on
+for a round; `DecoyArrayEnv` is the environment's game with one array per step for all agents,
+`DecoyParallelEnv` the PettingZoo environment over it. They are imported on
 first use, so importing one part of the simulator does not load PettingZoo or gymnasium.
 """
 
@@ -11,6 +12,7 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from decoy_cli.sim.array_env import DecoyArrayEnv
     from decoy_cli.sim.decisions import Decision
     from decoy_cli.sim.engine import Simulator
     from decoy_cli.sim.env import DecoyParallelEnv
@@ -18,6 +20,7 @@ if TYPE_CHECKING:
     from decoy_cli.sim.setup import RoundSetup, open_round
 
 _EXPORTS = {
+    "DecoyArrayEnv": "decoy_cli.sim.array_env",
     "Decision": "decoy_cli.sim.decisions",
     "Simulator": "decoy_cli.sim.engine",
     "DecoyParallelEnv": "decoy_cli.sim.env",
@@ -26,7 +29,15 @@ _EXPORTS = {
     "open_round": "decoy_cli.sim.setup",
 }
 
-__all__ = ["Decision", "DecoyParallelEnv", "RandomPolicy", "RoundSetup", "Simulator", "open_round"]
+__all__ = [
+    "Decision",
+    "DecoyArrayEnv",
+    "DecoyParallelEnv",
+    "RandomPolicy",
+    "RoundSetup",
+    "Simulator",
+    "open_round",
+]
 
 
 def __getattr__(name: str) -> Any:

@@ -15,8 +15,9 @@ from numba import njit
 
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import RulesConfig
+from decoy_cli.sim.schedule import is_due
 from decoy_cli.sim.state import Bomb, BombStatus
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph
 
 NUM_ACTIONS = 9
 """Actions 0..7 move along the graph edge in compass direction N, NE, E, SE, S, SW, W, NW;
@@ -93,6 +94,7 @@ class ObservationEncoder:
         self._mates, self._enemies = slot_tables(sides, slots)
         self._is_ct = np.asarray(sides) == "CT"
         self._starts = np.array([self.layout[name].start for name in _PER_AGENT], dtype=np.int64)
+        self._bomb_starts = np.array([self.layout[name].start for name in _BOMB], dtype=np.int64)
         lo, hi = graph.positions.min(axis=0), graph.positions.max(axis=0)
         self._centre = (lo + hi) / 2
         self._half = (hi - lo) / 2 + POSITION_MARGIN_M
@@ -107,41 +109,32 @@ class ObservationEncoder:
             block[:, 1:4] = -1.0
         return low, np.ones_like(low)
 
-    def encode(self, sim: Simulator, due: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(N, size) float32 observation vectors and (N, 9) int8 action masks of every agent;
-        `due` says which agents the engine asks for a decision at the next tick."""
-        agents, bomb, cfg, layout = sim.agents, sim.bomb, self.rules, self.layout
-        n = agents.count
-        pos = agents.position
-        obs = np.zeros((n, self.size), dtype=np.float64)
+    def encode(self, sim: Simulator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(N, size) float32 observation vectors, (N, 9) int8 action masks and (N,) bool
+        `needs_decision` of every agent (who the engine asks for a decision at the next tick:
+        nobody once the round is done), in one compiled pass."""
+        agents, bomb, cfg = sim.agents, sim.bomb, self.rules
         state = self._bomb_state(bomb)
-        carrier = bomb.carrier if state == 1 else -1
-        _agent_features(
-            obs, self._starts, pos, agents.yaw, agents.hp, agents.armor, agents.helmet,
-            agents.has_defuser, self._is_ct, due, agents.alive, self._mates, self._enemies,
-            self._centre, self._half, bomb.position, state != 0, carrier,
-        )  # fmt: skip
-        obs[:, layout["bomb_state"].start + state] = 1.0
-        if bomb.site in BOMB_SITES:
-            obs[:, layout["bomb_site"].start + BOMB_SITES.index(bomb.site)] = 1.0
-        if bomb.planter >= 0:
-            obs[:, layout["plant_progress"].start] = bomb.plant_ticks / cfg.plant_ticks
+        site = BOMB_SITES.index(bomb.site) if bomb.site in BOMB_SITES else -1
+        plant = bomb.plant_ticks / cfg.plant_ticks if bomb.planter >= 0 else 0.0
+        defuse = 0.0
         if bomb.defuser >= 0:
             kit = agents.has_defuser[bomb.defuser]
-            needed = cfg.defuse_kit_ticks if kit else cfg.defuse_ticks
-            obs[:, layout["defuse_progress"].start] = bomb.defuse_ticks / needed
+            defuse = bomb.defuse_ticks / (cfg.defuse_kit_ticks if kit else cfg.defuse_ticks)
         clock = bomb.planted_tick if bomb.planted_tick >= 0 else sim.tick
-        round_left = (cfg.round_ticks - clock) / cfg.round_ticks
-        obs[:, layout["round_time_left"].start] = min(1.0, max(0.0, round_left))
+        bomb_left = 0.0
         if bomb.status == BombStatus.PLANTED:
-            left = (bomb.planted_tick + cfg.bomb_ticks - sim.tick) / cfg.bomb_ticks
-            obs[:, layout["bomb_time_left"].start] = min(1.0, max(0.0, left))
-
-        masks = np.zeros((n, NUM_ACTIONS), dtype=np.int8)
-        masks[:, STOP_ACTION] = 1
-        deciding = np.flatnonzero(due)
-        masks[deciding, :STOP_ACTION] = self.graph.out_edges[agents.node[deciding]] >= 0
-        return obs.astype(np.float32), masks
+            bomb_left = (bomb.planted_tick + cfg.bomb_ticks - sim.tick) / cfg.bomb_ticks
+        scalars = np.array(
+            [site, plant, defuse, (cfg.round_ticks - clock) / cfg.round_ticks, bomb_left]
+        )
+        return _encode(
+            self.size, self._starts, self._bomb_starts, agents.position, agents.yaw, agents.hp,
+            agents.armor, agents.helmet, agents.has_defuser, self._is_ct, agents.alive,
+            self._mates, self._enemies, self._centre, self._half, bomb.position, state,
+            bomb.carrier if state == 1 else -1, scalars, sim.done, sim.tick, sim.waiting,
+            sim.hold_until, agents.node, self.graph.out_edges,
+        )  # fmt: skip
 
     def _bomb_state(self, bomb: Bomb) -> int:
         """Index into BOMB_STATES."""
@@ -157,15 +150,38 @@ _PER_AGENT = (
 """The entries `_agent_features` fills, in the order of its `starts`."""
 
 
+_BOMB = (
+    "bomb_state", "bomb_site", "plant_progress", "defuse_progress", "round_time_left",
+    "bomb_time_left",
+)  # fmt: skip
+"""The round's entries, the same for every agent, in the order of `_encode`'s `bomb_starts`."""
+
+
 @njit(cache=True)
-def _agent_features(
-    obs, starts, pos, yaw, hp, armor, helmet, kit, is_ct, due, alive, mates, enemies,
-    centre, half, bomb_pos, bomb_known, carrier,
+def _encode(
+    size, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates, enemies,
+    centre, half, bomb_pos, bomb_state, carrier, scalars, done, tick, waiting, hold_until, node,
+    out_edges,
 ):  # fmt: skip
-    """Fill each agent's own entries, its teammate and enemy slots and the bomb's offset into
-    the zeroed (N, size) `obs` (the entries of `_PER_AGENT`, at `starts`)."""
+    """The observation vectors, action masks and due agents (`ObservationEncoder.encode`):
+    each agent's own entries, its teammate and enemy slots and the bomb's offset at `starts`
+    (`_PER_AGENT`), the round's entries at `bomb_starts` (`_BOMB`; `scalars` holds the bomb
+    site index or -1, plant and defuse progress, round and bomb time left, unclipped)."""
+    n = pos.shape[0]
+    obs = np.zeros((n, size), np.float32)
+    masks = np.zeros((n, out_edges.shape[1] + 1), np.int8)
+    due = np.zeros(n, np.bool_)
     p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = starts
-    for i in range(obs.shape[0]):
+    state0, site0, plant0, defuse0, round0, timer0 = bomb_starts
+    site = np.int64(scalars[0])
+    round_left = min(1.0, max(0.0, scalars[3]))
+    bomb_left = min(1.0, max(0.0, scalars[4]))
+    for i in range(n):
+        due[i] = not done and is_due(i, waiting, alive, hold_until, tick + 1)
+        masks[i, out_edges.shape[1]] = 1  # STOP
+        if due[i]:
+            for action in range(out_edges.shape[1]):
+                masks[i, action] = 1 if out_edges[node[i], action] >= 0 else 0
         for axis in range(3):
             v = (pos[i, axis] - centre[axis]) / half[axis]
             obs[i, p0 + axis] = min(1.0, max(-1.0, v))
@@ -189,7 +205,15 @@ def _agent_features(
                     v = (pos[j, axis] - pos[i, axis]) / (2 * half[axis])
                     obs[i, at + 1 + axis] = min(1.0, max(-1.0, v))
                 obs[i, at + 4] = hp[j] / 100.0
-        if bomb_known:
+        if bomb_state != 0:
             for axis in range(3):
                 v = (bomb_pos[axis] - pos[i, axis]) / (2 * half[axis])
                 obs[i, o0 + axis] = min(1.0, max(-1.0, v))
+        obs[i, state0 + bomb_state] = 1.0
+        if site >= 0:
+            obs[i, site0 + site] = 1.0
+        obs[i, plant0] = scalars[1]
+        obs[i, defuse0] = scalars[2]
+        obs[i, round0] = round_left
+        obs[i, timer0] = bomb_left
+    return obs, masks, due

@@ -60,11 +60,11 @@ class TopSpeeds:
     """Each agent's full speed with its weapon in hand (m/s), kept while the weapons stay."""
 
     def __init__(self) -> None:
-        self._weapons: tuple[str, ...] = ()
+        self._weapons: list[str] = []
         self._top = np.zeros(0)
 
     def of(self, weapons: np.ndarray) -> np.ndarray:
-        key = tuple(weapons)
+        key = weapons.tolist()
         if key != self._weapons:
             self._weapons = key
             self._top = np.array([max_speed_m_s(str(w)) for w in key])

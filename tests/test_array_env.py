@@ -1,0 +1,132 @@
+"""The array environment: the same rounds as the PettingZoo environment over it, step for step,
+its rewards and terminations at deaths and the round's end, and its checks of bad actions."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from decoy_cli.sim.array_env import ArrayStep, DecoyArrayEnv
+from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
+from decoy_cli.sim.env import DecoyParallelEnv
+from decoy_cli.waypoints.graph import STOP_ACTION
+
+
+class AlwaysHits:
+    """Every visible pair is hit in the chest for 40: deaths within a few combat steps."""
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        k = len(batch)
+        groups = np.full(k, HIT_GROUPS.index("Chest"), np.int8)
+        return DamageResult(np.full(k, 40, np.int64), groups, np.ones(k, bool))
+
+
+@pytest.fixture
+def env() -> Iterator[DecoyArrayEnv]:
+    environment = DecoyArrayEnv(damage_model=AlwaysHits())
+    yield environment
+    environment.close()
+
+
+def close_in(env: DecoyArrayEnv | DecoyParallelEnv) -> None:
+    """Put ct_0 and ct_1 on t_0's waypoint: t_0 dies within a few combat steps, mid-round."""
+    sim = env.sim
+    assert sim is not None
+    for ct in (5, 6):
+        sim.relocate(ct, int(sim.agents.node[0]))
+
+
+def random_masked(state: ArrayStep, rng: np.random.Generator) -> np.ndarray:
+    """A uniformly random allowed action for every agent (only the due ones are used)."""
+    return np.argmax(rng.random(state.action_masks.shape) * state.action_masks, axis=1)
+
+
+def test_the_pettingzoo_environment_plays_the_same_rounds_step_for_step() -> None:
+    arrays = DecoyArrayEnv(damage_model=AlwaysHits())
+    dicts = DecoyParallelEnv(damage_model=AlwaysHits())
+    names = dicts.possible_agents
+    deaths = ends = 0
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        state = arrays.reset(seed)
+        obs, infos = dicts.reset(seed=seed)
+        close_in(arrays)
+        close_in(dicts)
+        while True:
+            for k, name in enumerate(names):
+                if name in obs:
+                    np.testing.assert_array_equal(obs[name]["observation"], state.observations[k])
+                    np.testing.assert_array_equal(obs[name]["action_mask"], state.action_masks[k])
+                    assert infos[name]["needs_decision"] == state.needs_decision[k]
+                    assert infos[name]["tick"] == state.tick
+            if state.winner is not None:
+                break
+            actions = random_masked(state, rng)
+            state = arrays.step(actions)
+            live = list(dicts.agents)
+            obs, rewards, terminations, _, infos = dicts.step(
+                {name: int(actions[names.index(name)]) for name in live}
+            )
+            for name in live:
+                k = names.index(name)
+                assert rewards[name] == state.rewards[k]
+                assert terminations[name] == state.terminated[k]
+            assert dicts.agents == [name for k, name in enumerate(names) if state.active[k]]
+            deaths += int((state.terminated & (state.winner is None)).sum())
+        ends += 1
+        assert {info["winner"] for info in infos.values()} == {state.winner}
+    arrays.close()
+    dicts.close()
+    assert ends == 4 and deaths > 0  # rounds that end, with deaths along the way
+
+
+def test_rewards_and_terminations_follow_deaths_and_the_round_end(env: DecoyArrayEnv) -> None:
+    rng = np.random.default_rng(7)
+    state = env.reset(3)
+    close_in(env)
+    assert state.active.all() and not state.terminated.any() and not state.rewards.any()
+    left_early = np.zeros(10, bool)
+    while state.winner is None:
+        before = state.active
+        state = env.step(random_masked(state, rng))
+        assert not (state.terminated & ~before).any()  # only agents still in the episode leave
+        assert (state.active == (before & ~state.terminated)).all()
+        if state.winner is None:
+            assert not state.rewards.any()
+            assert not state.needs_decision[~state.active].any()  # the dead decide nothing
+            left_early |= state.terminated
+    assert left_early.any()
+    assert not state.active.any() and not state.needs_decision.any()
+    won = np.array(env.sides) == state.winner
+    finished = ~left_early
+    np.testing.assert_array_equal(state.rewards[finished], np.where(won, 1.0, -1.0)[finished])
+    assert not state.rewards[left_early].any()  # an agent that died earlier left with 0
+    assert state.rewards.dtype == np.float32
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.full(10, STOP_ACTION))
+
+
+def test_actions_of_agents_not_due_are_ignored_and_bad_actions_named(env: DecoyArrayEnv) -> None:
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros(10, np.int64))
+    state = env.reset(0)
+    assert state.needs_decision.all()
+    actions = np.full(10, STOP_ACTION)
+    for bad in (np.zeros(9, np.int64), np.zeros(10, np.float64), np.zeros((10, 1), np.int64)):
+        with pytest.raises(ValueError, match=r"\(10,\) integers"):
+            env.step(bad)
+    actions[6] = 9
+    with pytest.raises(ValueError, match=r"ct_1: action 9 is not in 0\.\.8"):
+        env.step(actions)
+    actions[6] = STOP_ACTION
+    state = env.step(actions)  # everyone holds a STOP: nobody is due until it ends
+    assert state.tick == env.stop_ticks and state.needs_decision.all()
+    actions = np.full(10, STOP_ACTION, np.int32)  # any integer type
+    actions[0] = int(np.flatnonzero(state.action_masks[0, :STOP_ACTION])[0])  # t_0 walks
+    state = env.step(actions)
+    assert state.needs_decision[0] and not state.needs_decision[1:].any()  # t_0 arrived first
+    actions = np.full(10, -5)  # the agents not due may be given anything
+    actions[0] = STOP_ACTION
+    env.step(actions)
