@@ -2,9 +2,10 @@
 
 Plays `decoy bench`'s environment section (5v5, kinematic mover, the shipped models, each agent
 that needs a decision taking a random allowed action) for ROUNDS rounds after a warm-up round,
-with the environment's parts timed by wrapping them: the whole `step`, the simulator's `run`
-inside it, the combat and other whole ticks (`_finish_tick`), the observation and info
-dictionaries; what `step` spends outside those is its own Python, and what the round costs
+with the environment's parts timed by wrapping them: the whole PettingZoo `step`, the game's
+step under it (`DecoyArrayEnv.step`), the simulator's `run` inside that, the combat and other
+whole ticks (`_finish_tick`), the observation arrays, and the observation and info
+dictionaries; what a step spends outside its parts is its own Python, and what the round costs
 outside `step` is the benchmark's loop of random masked actions. Microseconds per step, on this
 machine: compare the parts with each other, not with another machine's figures.
 """
@@ -23,13 +24,15 @@ from decoy_cli.bench.machine import machine_line
 from decoy_cli.bench.portable import _play
 from decoy_cli.damage import load_damage_model
 from decoy_cli.sim import DecoyParallelEnv
+from decoy_cli.sim.array_env import DecoyArrayEnv
 from decoy_cli.sim.engine import Simulator
+from decoy_cli.sim.observation import ObservationEncoder
 
 SPENT: dict[str, float] = defaultdict(float)
 
 
-def timed(owner: type, name: str) -> None:
-    """Wrap `owner.name` so that its time adds up in SPENT[name]."""
+def timed(owner: type, name: str, label: str) -> None:
+    """Wrap `owner.name` so that its time adds up in SPENT[label]."""
     method: Callable[..., Any] = getattr(owner, name)
 
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -37,17 +40,20 @@ def timed(owner: type, name: str) -> None:
         try:
             return method(*args, **kwargs)
         finally:
-            SPENT[name] += time.perf_counter() - started
+            SPENT[label] += time.perf_counter() - started
 
     setattr(owner, name, wrapper)
 
 
 def main() -> None:
     rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 5
-    for owner, name in ((DecoyParallelEnv, "step"), (DecoyParallelEnv, "_observe"),
-                        (DecoyParallelEnv, "_infos"), (Simulator, "run"),
-                        (Simulator, "_finish_tick")):  # fmt: skip
-        timed(owner, name)
+    for owner, name, label in ((DecoyParallelEnv, "step", "step"),
+                               (DecoyParallelEnv, "_observe", "_observe"),
+                               (DecoyParallelEnv, "_infos", "_infos"),
+                               (DecoyArrayEnv, "step", "game"), (Simulator, "run", "run"),
+                               (ObservationEncoder, "encode", "encode"),
+                               (Simulator, "_finish_tick", "_finish_tick")):  # fmt: skip
+        timed(owner, name, label)
     env = DecoyParallelEnv(mover="kinematic", damage_model=load_damage_model("shipped"))
     rng = np.random.default_rng(0)
     _play(env, rng, seed=0)  # warm-up: compilation
@@ -64,12 +70,17 @@ def main() -> None:
           f"decisions/s (wrapping adds a little to each part)")  # fmt: skip
     parts = {
         "the whole step": wall / steps * 1e6,
-        "  env.step": per["step"],
-        "    simulator run": per["run"],
-        "      of it whole ticks (combat, bomb, recording)": per["_finish_tick"],
+        "  env.step (PettingZoo)": per["step"],
+        "    the game's step (DecoyArrayEnv)": per["game"],
+        "      simulator run": per["run"],
+        "        of it whole ticks (combat, bomb, recording)": per["_finish_tick"],
+        "      observation arrays": per["encode"],
+        "      the game step's own Python": per["game"] - per["run"] - per["encode"],
         "    observation dictionaries": per["_observe"],
         "    info dictionaries": per["_infos"],
-        "    the step's own Python": per["step"] - per["run"] - per["_observe"] - per["_infos"],
+        "    the PettingZoo step's own Python": (
+            per["step"] - per["game"] - per["_observe"] - per["_infos"]
+        ),
         "  the benchmark's own loop": wall / steps * 1e6 - per["step"],
     }
     for part, micros in parts.items():
