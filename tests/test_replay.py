@@ -366,9 +366,10 @@ def test_a_frame_the_data_says_is_in_the_air_is_not_a_target(physics: PhysicsWor
     assert (np.delete(status, 4) == SnapStatus.SNAPPED).all()
 
 
-def test_a_jump_is_not_a_target(physics: PhysicsWorld) -> None:
-    """A frame 1 m above the floor (a jump) is not snapped: the walker passes under it on its
-    path, on time, instead of being sent to some floor near the jump."""
+def test_a_jump_targets_the_floor_under_it(physics: PhysicsWorld) -> None:
+    """A frame 1 m above the floor (a jump) is not snapped; the waypoint under it is a soft
+    target, on the walker's way: it passes under the jump on time, instead of being sent to
+    some floor near the jump."""
     run = straight_run(node_at(RUN_START), direction=0, count=2 * 9 - 1)[::2]
     round_ = make_round([Track("jumper", "T", run)])
     round_.position[0, 4, 2] += 1.0
@@ -376,6 +377,9 @@ def test_a_jump_is_not_a_target(physics: PhysicsWorld) -> None:
     status = result.plan.snaps[0].status
     assert status[4] == SnapStatus.AIRBORNE
     assert (np.delete(status, 4) == SnapStatus.SNAPPED).all()
+    plan = result.plan.plans[0]
+    assert plan.target_frame.tolist() == list(range(len(run)))
+    assert plan.target_node[4] == run[4]
     assert np.nanmax(result.logs[0].lateness_s) == 0
     replayed = result.recording.position[4, 0]
     np.testing.assert_allclose(replayed[:2], round_.position[0, 4, :2], atol=0.15)

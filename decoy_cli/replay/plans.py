@@ -119,8 +119,11 @@ class PlayerPlan:
     """(T-1,) int64 frames between the two targets without a target (absent, unsnappable)."""
     interval_length_m: np.ndarray
     """(T-1,) float64 shortest-path length, 0 when standing still, NaN when unreachable."""
+    interval_air_s: np.ndarray
+    """(T-1,) float64 seconds of the path spent rising or falling (`graph.edge_air_s`)."""
     interval_required_speed_m_s: np.ndarray
-    """(T-1,) float64 length / time: the speed needed to arrive on time (inf for 0 s moves)."""
+    """(T-1,) float64 length / running time (the time less the air time, at least a tick): the
+    speed needed to arrive on time."""
     interval_max_speed_m_s: np.ndarray
     """(T-1,) float64 CS:GO maximum speed with the weapon held at the interval's start."""
     interval_speed_ratio: np.ndarray
@@ -333,6 +336,7 @@ def build_plan(
         interval_seconds=interval_seconds,
         interval_skipped_frames=np.diff(target_frame).astype(np.int64) - 1,
         interval_length_m=length,
+        interval_air_s=air,
         interval_required_speed_m_s=required,
         interval_max_speed_m_s=max_speed,
         interval_speed_ratio=ratio,

@@ -33,7 +33,6 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
-from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
@@ -256,8 +255,7 @@ def replay_round(
     plant = policy_plant(bomb, plan.plans) if bomb is not None else None
     defuse = defuse_windows(bomb) if bomb is not None else {}
 
-    caps = [interval_caps(p, np.asarray(round_.position[i])) for i, p in enumerate(plan.plans)]
-    policy = PlanPolicy(plan.plans, tick_at, graph, plant, defuse, caps)
+    policy = PlanPolicy(plan.plans, tick_at, graph, plant, defuse, plan.caps)
     start_tick = int(frame_ticks[0])
     scripted = np.zeros(n, dtype=bool)
     weapon_frames = np.asarray(round_.weapon)
@@ -376,35 +374,3 @@ def _check_on_map(round_: Round, graph: WaypointGraph, policy: Implausible) -> t
     if policy == "fail":
         raise EstaError(f"{round_.path}: round {round_.round_num}: {problem}")
     return (problem,)
-
-
-MAX_ZIGZAG = 1.3
-"""Largest path-over-straight-line factor by which a replay may outrun the player."""
-
-
-def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
-    """Speed cap (m/s) of every interval of a plan: how fast the replayed agent may run.
-
-    The weapon's CS:GO maximum is the speed of running on flat ground; real players beat it
-    (strafe-jumps, falls: one interval in twenty in the real T rounds), and a path on the
-    8-direction lattice is longer than the straight line the player ran (zig-zag, snapping). So
-    the cap is the larger of the weapon's maximum and the player's own measured speed over the
-    interval, times the path's zig-zag factor: path length over the player's own displacement,
-    at most `MAX_ZIGZAG`. (Measured against the straight line between the two snapped
-    waypoints instead, snap jitter made agents late, and the real rounds' replay error grew.)
-    A replay is never asked to run faster than the player did except for the lattice's
-    geometry; what remains infeasible (a detour around a missing edge) stays late, and the
-    lateness says so.
-    """
-    if len(plan.target_node) < 2:
-        return np.zeros(0)
-    frames = plan.target_frame
-    seconds = np.maximum(plan.interval_seconds, 1e-9)
-    ran = np.linalg.norm(np.diff(original[frames], axis=0), axis=1) / seconds
-    straight = np.where(np.isfinite(ran), ran * seconds, 0.0)
-    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
-    zigzag = np.clip(
-        np.where(straight > 0.05, length / np.maximum(straight, 1e-9), 1.0), 1.0, MAX_ZIGZAG
-    )
-    ran = np.where(np.isfinite(ran), ran, 0.0)
-    return np.maximum(plan.interval_max_speed_m_s, ran) * zigzag

@@ -4,7 +4,8 @@
 module does not import the reader): `position` (P, F, 3) metres, NaN where absent; `alive` (P, F)
 bool; `weapon` (P, F) weapon names; `frame_seconds` (F,); `players`, each with `name` and `side`.
 Given the physics world, frames in the air are found by a ray down from each position and left
-unsnapped (see `decoy_cli.replay.snapping`).
+unsnapped (see `decoy_cli.replay.snapping`); the waypoint on the floor under a low one is a soft
+target of the plan (`plan_player`).
 """
 
 from __future__ import annotations
@@ -14,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
-from decoy_cli.replay.plans import PathCache, PlayerPlan, build_plan
+from decoy_cli.replay.plans import MIN_RUN_S, PathCache, PlayerPlan, build_plan
 from decoy_cli.replay.snapping import (
     DEFAULT_MAX_SNAP_M,
     WITHIN_M,
@@ -58,6 +60,9 @@ class RoundPlan:
     """(F,) frame times, seconds since freeze-time end."""
     snaps: list[SnapResult]
     plans: list[PlayerPlan]
+    caps: list[np.ndarray]
+    """Per plan, (T-1,) how fast the replayed agent may run over each interval, m/s
+    (`interval_caps`)."""
     summary: pd.DataFrame
     """One row per player with `SUMMARY_COLUMNS`: snap quality, plan feasibility, fate.
 
@@ -114,6 +119,7 @@ def snap_round(
     paths = PathCache(graph)
     snaps: list[SnapResult] = []
     plans: list[PlayerPlan] = []
+    caps: list[np.ndarray] = []
     for p in range(len(players)):
         snap = snap_positions(
             graph,
@@ -125,17 +131,108 @@ def snap_round(
         )
         if sites is not None and node_site is not None and (sites[p] != "").any():
             snap = snap_into_sites(graph, snap, positions[p], sites[p], node_site, max_distance)
-        present = np.isfinite(positions[p]).all(axis=1)
-        plan = build_plan(
-            graph, snap.node, seconds, alive[p], weapons[p], present=present, paths=paths
-        )
+        plan, cap = plan_player(graph, snap, positions[p], seconds, alive[p], weapons[p], paths)
         snaps.append(snap)
         plans.append(plan)
+        caps.append(cap)
     rows = [_summary_row(player, alive[p], snaps[p], plans[p]) for p, player in enumerate(players)]
     summary = pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
     return RoundPlan(
-        players=players, frame_seconds=seconds, snaps=snaps, plans=plans, summary=summary
+        players=players,
+        frame_seconds=seconds,
+        snaps=snaps,
+        plans=plans,
+        caps=caps,
+        summary=summary,
     )
+
+
+def plan_player(
+    graph: WaypointGraph,
+    snap: SnapResult,
+    positions: np.ndarray,
+    seconds: np.ndarray,
+    alive: np.ndarray,
+    weapons: np.ndarray,
+    paths: PathCache,
+) -> tuple[PlayerPlan, np.ndarray]:
+    """One player's timed plan (`build_plan`) through its snapped frames and, as soft targets,
+    the waypoints under its frames in the air (`SnapResult.ground_node`), with its speed caps
+    (`interval_caps`; `positions` (F, 3) are the player's real ones, NaN where absent).
+
+    A player in the air is over some spot of the floor, and heading for it keeps the replay
+    near the real path through a jump; but the spot under a jump across a gap or off a ledge
+    may lie a long way round. So a soft target next to an interval the replay would end late
+    (`expected_lateness`) or cannot reach is dropped and the plan rebuilt, until none is: each
+    pass drops at least one target, so it ends.
+    """
+    present = np.isfinite(positions).all(axis=1)
+    soft = (snap.ground_node >= 0) & (snap.node < 0)
+    nodes = np.where(soft, snap.ground_node, snap.node)
+    while True:
+        plan = build_plan(graph, nodes, seconds, alive, weapons, present=present, paths=paths)
+        caps = interval_caps(plan, positions)
+        late = (expected_lateness(plan, caps)[1:] > 1.0 / TICK_RATE) | plan.interval_unreachable
+        beside = np.zeros(len(plan.target_frame), dtype=bool)
+        beside[:-1] |= late
+        beside[1:] |= late
+        drop = plan.target_frame[beside & soft[plan.target_frame]]
+        if not len(drop):
+            return plan, caps
+        nodes[drop] = -1
+        soft[drop] = False
+
+
+def expected_lateness(plan: PlayerPlan, caps: np.ndarray) -> np.ndarray:
+    """(T,) seconds after its deadline at which the replay reaches each target, if the agent
+    leaves each target when it reaches it (or at its deadline, when early it waits) and runs
+    each interval's path at most at its cap, its rises and falls taking their air time; as the
+    replay's policy plays a plan. Across a gap (unreachable) the agent is placed at the
+    target's deadline."""
+    late = np.zeros(len(plan.target_node))
+    deadline = plan.target_seconds
+    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
+    with np.errstate(divide="ignore"):
+        run = np.where(length > 0, length / caps, 0.0) + plan.interval_air_s
+    for k in range(len(length)):
+        if plan.interval_unreachable[k]:
+            continue
+        left = deadline[k] + late[k]
+        late[k + 1] = max(0.0, left + run[k] - deadline[k + 1])
+    return late
+
+
+MAX_ZIGZAG = 1.3
+"""Largest path-over-straight-line factor by which a replay may outrun the player."""
+
+
+def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
+    """Speed cap (m/s) of every interval of a plan: how fast the replayed agent may run.
+
+    The weapon's CS:GO maximum is the speed of running on flat ground; real players beat it
+    (strafe-jumps, falls: one interval in twenty in the real T rounds), and a path on the
+    8-direction lattice is longer than the straight line the player ran (zig-zag, snapping). So
+    the cap is the larger of the weapon's maximum and the player's own measured speed over the
+    interval's running time (as the required speed: without the path's air time), times the
+    path's zig-zag factor: path length over the player's own displacement,
+    at most `MAX_ZIGZAG`. (Measured against the straight line between the two snapped
+    waypoints instead, snap jitter made agents late, and the real rounds' replay error grew.)
+    A replay is never asked to run faster than the player did except for the lattice's
+    geometry; what remains infeasible (a detour around a missing edge) stays late, and the
+    lateness says so.
+    """
+    if len(plan.target_node) < 2:
+        return np.zeros(0)
+    frames = plan.target_frame
+    seconds = np.maximum(plan.interval_seconds - plan.interval_air_s, MIN_RUN_S)  # running
+    ran = np.linalg.norm(np.diff(original[frames], axis=0), axis=1) / seconds
+    straight = np.where(np.isfinite(ran), ran * seconds, 0.0)
+    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
+    zigzag = np.clip(
+        np.where(straight > 0.05, length / np.maximum(straight, 1e-9), 1.0), 1.0, MAX_ZIGZAG
+    )
+    ran = np.where(np.isfinite(ran), ran, 0.0)
+    return np.maximum(plan.interval_max_speed_m_s, ran) * zigzag
 
 
 def _summary_row(player: PlayerInfo, alive: np.ndarray, snap: SnapResult, plan: PlayerPlan) -> list:

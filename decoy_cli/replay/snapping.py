@@ -9,8 +9,10 @@ Given the height of the world's floor under each position, frames more than `AIR
 it (a jump, a fall off a ledge), and frames whose vertical speed is known and not zero (awpy's
 velocityZ: the Source engine keeps none on the ground), are not snapped either: a player in the
 air is at no waypoint, and the floor-aware lookup would put it on whatever lower floor lies
-nearest (a box beside the fall), a target the replay then has to detour to. The plan goes
-through those frames on the path between the frames before and after.
+nearest (a box beside the fall), a target the replay then has to detour to. Such a frame gets
+instead the waypoint nearest the spot on the floor straight under it (`ground_node`), a target
+the plan uses only where it keeps the replay in time (`decoy_cli.replay.rounds.plan_player`);
+elsewhere the plan goes through those frames on the path between the frames before and after.
 """
 
 from __future__ import annotations
@@ -55,6 +57,9 @@ class SnapResult:
     """(F,) float64 3-D distance from the position to its waypoint, NaN where not snapped."""
     status: np.ndarray
     """(F,) int8 `SnapStatus` per frame: why a frame was or was not snapped."""
+    ground_node: np.ndarray
+    """(F,) int64 for frames in the air: the waypoint nearest the spot on the world's floor
+    straight under the position (-1 elsewhere, or none within the snap distance)."""
 
     def count(self, status: SnapStatus) -> int:
         """Number of frames with this status."""
@@ -128,7 +133,15 @@ def snap_positions(
         error[query[found]] = distance[found]
         status[query[found]] = SnapStatus.SNAPPED
         status[query[~found]] = SnapStatus.NO_WAYPOINT
-    return SnapResult(node=node, error_m=error, status=status)
+    ground_node = np.full(frames, -1, dtype=np.int64)
+    if floor_z is not None:
+        in_air = np.flatnonzero((status == SnapStatus.AIRBORNE) & np.isfinite(floor_z))
+        if len(in_air):
+            under = pos[in_air].copy()
+            under[:, 2] = floor_z[in_air]
+            index, _ = graph.nearest(under, max_distance=max_distance)
+            ground_node[in_air] = index
+    return SnapResult(node=node, error_m=error, status=status, ground_node=ground_node)
 
 
 def snap_into_sites(
@@ -158,4 +171,4 @@ def snap_into_sites(
         best = int(np.argmin(distance))
         if distance[best] <= max_distance:
             node[f], error[f] = inside[best], distance[best]
-    return SnapResult(node=node, error_m=error, status=snap.status)
+    return SnapResult(node=node, error_m=error, status=snap.status, ground_node=snap.ground_node)

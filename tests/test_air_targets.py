@@ -1,0 +1,120 @@
+"""Frames in the air as soft targets (the waypoint on the floor under them, kept only where the
+replay stays in time), the speed caps over an interval's running time, and the lateness a plan
+is expected to run into."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from test_plans import SPACING, lattice, make_graph, with_drop
+
+from decoy_cli.csgo import GRAVITY_M_S2
+from decoy_cli.replay import PathCache, SnapStatus, build_plan, snap_positions
+from decoy_cli.replay.rounds import expected_lateness, interval_caps, plan_player
+from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
+from decoy_cli.weapons import max_speed_m_s
+
+FRAMES = 5
+
+
+def over_a_lower_floor() -> WaypointGraph:
+    """An upper walkway (nodes 0..4, z = 3, x = 0 .. 2.8) straight over a lower one (5..9, z = 0);
+    one DROP edge from its east end (4) down to 9, nothing back up."""
+    upper, upper_edges = lattice(FRAMES, 1, z=3.0)
+    lower, lower_edges = lattice(FRAMES, 1, z=0.0, first=FRAMES)
+    return make_graph(upper + lower, [*upper_edges, *lower_edges, (4, 9, EdgeKind.DROP, 2)])
+
+
+def walkway_run(graph: WaypointGraph, floor_under_jump: float) -> dict:
+    """A walk along the upper walkway, 0.7 m per 0.5 s frame, with a jump 1 m up at frame 2,
+    over a floor at `floor_under_jump` (the walkway itself, or the floor below through a gap)."""
+    positions = graph.positions[:FRAMES].copy()
+    positions[2, 2] += 1.0
+    floor = np.full(FRAMES, 3.0)
+    floor[2] = floor_under_jump
+    alive = np.ones(FRAMES, bool)
+    snap = snap_positions(graph, positions, alive, floor_z=floor)
+    return {
+        "graph": graph,
+        "snap": snap,
+        "positions": positions,
+        "seconds": np.arange(FRAMES) * 0.5,
+        "alive": alive,
+        "weapons": np.array(["Knife"] * FRAMES),
+        "paths": PathCache(graph),
+    }
+
+
+def test_a_frame_in_the_air_gets_the_waypoint_on_the_floor_under_it() -> None:
+    graph = over_a_lower_floor()
+    snap = walkway_run(graph, floor_under_jump=3.0)["snap"]
+    assert snap.status[2] == SnapStatus.AIRBORNE and snap.node[2] == -1
+    assert snap.ground_node.tolist() == [-1, -1, 2, -1, -1]
+    through_the_gap = walkway_run(graph, floor_under_jump=0.0)["snap"]
+    assert through_the_gap.ground_node.tolist() == [-1, -1, 7, -1, -1]  # the floor below
+    positions = graph.positions[:FRAMES].copy()
+    positions[2, 2] += 1.0
+    unknown = np.full(FRAMES, 3.0)
+    unknown[2] = np.nan  # no floor found: the usual snap (the walkway, 1 m below)
+    snap = snap_positions(graph, positions, np.ones(FRAMES, bool), floor_z=unknown)
+    assert snap.status[2] == SnapStatus.SNAPPED and (snap.ground_node == -1).all()
+
+
+def test_a_soft_target_the_replay_reaches_in_time_is_kept() -> None:
+    run = walkway_run(over_a_lower_floor(), floor_under_jump=3.0)
+    plan, caps = plan_player(**run)
+    assert plan.target_frame.tolist() == [0, 1, 2, 3, 4]
+    assert plan.target_node.tolist() == [0, 1, 2, 3, 4]
+    assert not expected_lateness(plan, caps).any()
+    assert len(caps) == plan.num_intervals
+
+
+def test_a_soft_target_a_long_way_round_is_dropped() -> None:
+    """The floor under the jump is the lower walkway, reached only by the drop at the far end
+    and never left again: heading there would cross a gap of the graph, so the plan goes on
+    along the upper walkway, as if the frame had no target."""
+    run = walkway_run(over_a_lower_floor(), floor_under_jump=0.0)
+    plan, _ = plan_player(**run)
+    assert plan.target_frame.tolist() == [0, 1, 3, 4]
+    assert not plan.interval_unreachable.any()
+    without = build_plan(
+        run["graph"], run["snap"].node, run["seconds"], run["alive"], run["weapons"]
+    )
+    np.testing.assert_array_equal(plan.path_node, without.path_node)
+
+
+def test_the_cap_measures_the_player_over_the_running_time_as_the_plan_does() -> None:
+    """A drop of 2 m down and 0.7 m across in 1 s with an AWP: the fall takes its air time, so
+    the run needs more than the AWP's speed, which the player showed it had; the replay is
+    allowed it and reaches the landing on time."""
+    graph = with_drop()
+    positions = graph.positions[[10, 7]].copy()
+    seconds = np.array([0.0, 1.0])
+    weapons = np.array(["AWP", "AWP"])
+    snap = snap_positions(graph, positions, np.ones(2, bool))
+    plan = build_plan(graph, snap.node, seconds, np.ones(2, bool), weapons)
+    fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
+    assert plan.interval_air_s[0] == pytest.approx(fall_s)
+    length = math.hypot(SPACING, 2.0)
+    required = length / (1.0 - fall_s)
+    assert plan.interval_required_speed_m_s[0] == pytest.approx(required)
+    assert required > max_speed_m_s("AWP") and plan.interval_infeasible[0]
+    caps = interval_caps(plan, positions)
+    assert caps[0] == pytest.approx(required)  # the player's own speed, straight, no zig-zag
+    assert expected_lateness(plan, caps).tolist() == pytest.approx([0.0, 0.0])
+
+
+def test_expected_lateness_carries_over_and_is_caught_up_at_a_stand() -> None:
+    """Caps of 1.4 m/s over 1.4 m intervals of 0.5 s: each run takes 1 s. Late 0.5 s at the
+    second target; standing there (no run) the agent leaves at once and is on time again; the
+    last run is 0.5 s late once more."""
+    graph = make_graph(*lattice(FRAMES, 1))
+    positions = graph.positions[[0, 2, 2, 4]]
+    snap = snap_positions(graph, positions, np.ones(4, bool))
+    plan = build_plan(
+        graph, snap.node, np.arange(4) * 0.5, np.ones(4, bool), np.array(["Knife"] * 4)
+    )
+    late = expected_lateness(plan, np.array([1.4, 1.4, 1.4]))
+    assert late.tolist() == pytest.approx([0.0, 0.5, 0.0, 0.5])
