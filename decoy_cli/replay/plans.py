@@ -66,11 +66,7 @@ class PathCache:
 
     def __init__(self, graph: WaypointGraph) -> None:
         self.graph = graph
-        # Edge lookup by (source, target): keys sorted, the shortest edge first among duplicates.
-        keys = graph.edge_source.astype(np.int64) * graph.num_nodes + graph.edge_target
-        order = np.lexsort((graph.edge_cost, keys))
-        self._keys = keys[order]
-        self._edge_ids = order
+        self._keys, self._edge_ids = graph.edge_lookup
         self._paths: dict[tuple[int, int], np.ndarray | None] = {}
 
     def __len__(self) -> int:

@@ -227,6 +227,15 @@ class WaypointGraph:
 
     # ---- shortest paths ---------------------------------------------------------------------
 
+    @cached_property
+    def edge_lookup(self) -> tuple[np.ndarray, np.ndarray]:
+        """(keys, edge ids): every edge's `source * num_nodes + target`, sorted, the cheapest edge
+        first among duplicates, and the edge of each key; finds the edge between two nodes by
+        binary search (`np.searchsorted`). Computed once per graph."""
+        keys = self.edge_source.astype(np.int64) * self.num_nodes + self.edge_target
+        order = np.lexsort((self.edge_cost, keys))
+        return keys[order], order
+
     def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
         """Dijkstra from one node: (path cost, `edge_cost`, to every node; predecessor of every
         node)."""
