@@ -44,6 +44,9 @@ RELOCATE_ACTION = 9
 ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
 """Display name of every plan action code: 0..7 compass moves, 8 STOP, 9 RELOCATE."""
 
+_NO_EDGE = np.array([-1], dtype=np.int64)
+"""The action list of an interval without a move (a STOP or a RELOCATE): no edge."""
+
 RATIO_TOLERANCE = 1e-9
 """An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
 
@@ -274,40 +277,37 @@ def build_plan(
     count = len(interval_seconds)
     max_speed = _max_speeds(weapons[target_frame[:-1]])
 
-    length = np.zeros(count)
-    air = np.zeros(count)  # seconds rising or falling, without headway (graph.edge_air_s)
-    unreachable = np.zeros(count, dtype=bool)
-    path_parts = [target_node[:1]]
-    path_interval_parts = [np.full(len(target_node[:1]), -1, dtype=np.int64)]
-    act_parts: list[np.ndarray] = []
-    edge_parts: list[np.ndarray] = []
-    act_node_parts: list[np.ndarray] = []
-    act_interval_parts: list[np.ndarray] = []
-    duration_parts: list[np.ndarray] = []
-    for k in range(count):
-        a, b = int(target_node[k]), int(target_node[k + 1])
-        dt = float(interval_seconds[k])
-        edges = paths.edges(a, b) if a != b else None
-        if edges is None:  # stand still (a == b) or cross a gap (unreachable)
-            unreachable[k] = a != b
-            length[k] = np.nan if a != b else 0.0
-            step_nodes = np.array([b], dtype=np.int64)
-            act_parts.append(np.array([RELOCATE_ACTION if a != b else STOP_ACTION], np.int8))
-            edge_parts.append(np.array([-1], dtype=np.int64))
-            duration_parts.append(np.array([dt]))
-        else:
-            edge_length = graph.edge_length[edges]
-            edge_air = graph.edge_air_s[edges]
-            length[k] = edge_length.sum()
-            air[k] = edge_air.sum()
-            step_nodes = graph.edge_target[edges].astype(np.int64)
-            act_parts.append(graph.edge_direction[edges].astype(np.int8))
-            edge_parts.append(edges.astype(np.int64))
-            duration_parts.append(_edge_durations(dt, edge_length, edge_air))
-        path_parts.append(step_nodes)
-        path_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
-        act_node_parts.append(step_nodes)
-        act_interval_parts.append(np.full(len(step_nodes), k, dtype=np.int64))
+    # Every interval's actions in one array: the edges of its shortest path, or one STOP (the
+    # same waypoint) or RELOCATE (unreachable) with no edge (-1).
+    sources, ends = target_node[:-1], target_node[1:]
+    found = [
+        paths.edges(a, b) if a != b else None
+        for a, b in zip(sources.tolist(), ends.tolist(), strict=True)
+    ]
+    unreachable = np.array([e is None for e in found], dtype=bool) & (sources != ends)
+    steps = np.array([1 if e is None else len(e) for e in found], dtype=np.int64)
+    action_edge = _concat([_NO_EDGE if e is None else e for e in found], np.int64)
+    action_interval = np.repeat(np.arange(count, dtype=np.int64), steps)
+    on_edge = action_edge >= 0
+    edge = np.where(on_edge, action_edge, 0)
+    edge_length = np.where(on_edge, graph.edge_length[edge], 0.0)
+    edge_air = np.where(on_edge, graph.edge_air_s[edge], 0.0)  # without headway
+    starts = np.cumsum(steps) - steps
+    length, air = (
+        _interval_sums(edge_length, starts, steps),
+        _interval_sums(edge_air, starts, steps),
+    )
+    step_nodes = np.where(on_edge, graph.edge_target[edge], ends[action_interval])
+    action = np.where(
+        on_edge,
+        graph.edge_direction[edge],
+        np.where(unreachable[action_interval], RELOCATE_ACTION, STOP_ACTION),
+    ).astype(np.int8)
+    durations = _edge_durations(
+        interval_seconds[action_interval], edge_length, edge_air, length[action_interval],
+        air[action_interval], on_edge,
+    )  # fmt: skip
+    length[unreachable] = np.nan
 
     with np.errstate(divide="ignore", invalid="ignore"):
         running = np.maximum(interval_seconds - air, MIN_RUN_S)
@@ -319,10 +319,8 @@ def build_plan(
     straight_ratio = straight / running / max_speed  # the same air time as the path's
     infeasible = ratio > 1.0 + RATIO_TOLERANCE
     detour = infeasible & (straight_ratio <= 1.0 + RATIO_TOLERANCE)
-    path_interval = np.concatenate(path_interval_parts)
-    action_interval = _concat(act_interval_parts, np.int64)
-    entries_per_interval = np.array([len(p) for p in path_parts[1:]], dtype=np.int64)
-    target_path_index = np.concatenate([[0], np.cumsum(entries_per_interval)])[: len(target_node)]
+    path_interval = np.concatenate([np.full(len(target_node[:1]), -1), action_interval])
+    target_path_index = np.concatenate([[0], np.cumsum(steps)])[: len(target_node)]
     last_alive_frame, death_frame = _fate(alive, present)
     return PlayerPlan(
         target_frame=target_frame.astype(np.int64),
@@ -340,14 +338,14 @@ def build_plan(
         interval_unreachable=unreachable,
         interval_detour=detour,
         interval_zigzag=detour & (length <= ZIGZAG_MAX * straight),
-        path_node=np.concatenate(path_parts).astype(np.int64),
+        path_node=np.concatenate([target_node[:1], step_nodes]).astype(np.int64),
         path_interval=path_interval,
         path_deadline_s=target_seconds[path_interval + 1],
-        action=_concat(act_parts, np.int8),
-        action_edge=_concat(edge_parts, np.int64),
-        action_node=_concat(act_node_parts, np.int64),
+        action=action,
+        action_edge=action_edge,
+        action_node=step_nodes.astype(np.int64),
         action_interval=action_interval,
-        action_duration_s=_concat(duration_parts, np.float64),
+        action_duration_s=durations,
         action_deadline_s=target_seconds[action_interval + 1],
         last_alive_frame=last_alive_frame,
         death_frame=death_frame,
@@ -377,10 +375,40 @@ def _concat(parts: list[np.ndarray], dtype: type) -> np.ndarray:
     return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
 
 
-def _edge_durations(seconds: float, length: np.ndarray, air: np.ndarray) -> np.ndarray:
-    """An interval's seconds shared among its edges: each edge's time in the air, and the rest
-    by length, run at one speed (all of it by air time when the air time alone exceeds it)."""
-    total_air = float(air.sum())
-    if total_air > 0 and seconds <= total_air:
-        return seconds * air / total_air
-    return air + (seconds - total_air) * length / float(length.sum())
+def _interval_sums(values: np.ndarray, starts: np.ndarray, steps: np.ndarray) -> np.ndarray:
+    """The sum of each interval's run of `values`, rounded exactly as `ndarray.sum` rounds it:
+    left to right for runs shorter than 8 (all runs at once, column by column), pairwise for
+    longer ones (one at a time)."""
+    short = np.minimum(steps, 7)
+    columns = np.zeros((len(starts), 7))
+    for j in range(7):
+        has = short > j
+        columns[has, j] = values[starts[has] + j]
+    sums = columns[:, 0].copy()
+    for j in range(1, 7):
+        sums += columns[:, j]
+    for k in np.flatnonzero(steps > 7).tolist():
+        sums[k] = values[starts[k] : starts[k] + steps[k]].sum()
+    return sums
+
+
+def _edge_durations(
+    seconds: np.ndarray,
+    length: np.ndarray,
+    air: np.ndarray,
+    total_length: np.ndarray,
+    total_air: np.ndarray,
+    on_edge: np.ndarray,
+) -> np.ndarray:
+    """Each action's share of its interval's `seconds` (all arrays per action, the totals those
+    of its interval): an edge gets its time in the air, and the rest of the interval by length,
+    run at one speed (all of it by air time when the air time alone exceeds it); a STOP or a
+    RELOCATE gets the whole interval."""
+    by_air = (total_air > 0) & (seconds <= total_air)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shared = np.where(
+            by_air,
+            seconds * air / total_air,
+            air + (seconds - total_air) * length / total_length,
+        )
+    return np.where(on_edge, shared, seconds)
