@@ -118,3 +118,42 @@ def test_expected_lateness_carries_over_and_is_caught_up_at_a_stand() -> None:
     )
     late = expected_lateness(plan, np.array([1.4, 1.4, 1.4]))
     assert late.tolist() == pytest.approx([0.0, 0.5, 0.0, 0.5])
+
+
+def test_a_soft_target_on_the_way_stays_in_a_stretch_late_for_another_reason() -> None:
+    """A walk along y = 0 of a 12 × 12 lattice, 0.7 m per 0.5 s frame, jumping at frames 2 and 4:
+    the floor under the first jump is reported 7.7 m to the side (the replay would run late
+    going there), under the second right on the way. The first is dropped; the second stays,
+    though the replay may still be catching up there."""
+    graph = make_graph(*lattice(12, 12))
+    frames = 8
+    on_line = [12 * i for i in range(frames)]  # node (i, 0)
+    positions = graph.positions[on_line].copy()
+    positions[[2, 4], 2] += 1.0
+    floor = np.zeros(frames)
+    alive = np.ones(frames, bool)
+    snap = snap_positions(graph, positions, alive, floor_z=floor)
+    aside = graph.positions[on_line[2]] + np.array([0.0, 7.7, 0.0])
+    ground = snap.ground_node.copy()
+    ground[2] = int(graph.nearest(aside)[0][0])
+    assert ground[4] == on_line[4]
+    snap = type(snap)(snap.node, snap.error_m, snap.status, ground)
+    seconds = np.arange(frames) * 0.5
+    weapons = np.array(["Knife"] * frames)
+    plan, caps = plan_player(graph, snap, positions, seconds, alive, weapons, PathCache(graph))
+    assert plan.target_frame.tolist() == [0, 1, 3, 4, 5, 6, 7]
+    assert plan.target_node[3] == on_line[4]
+    assert np.diff(expected_lateness(plan, caps)).max() <= 1 / 60  # nothing makes it later
+
+
+def test_after_a_gap_the_replay_is_placed_at_once_when_late() -> None:
+    """Across a gap (unreachable) the agent is placed on the target at its deadline, or at once
+    when already late: lateness carries over a gap, it does not vanish."""
+    graph = with_drop()  # nothing leads from the low floor back up to the high one
+    positions = graph.positions[[0, 6, 10, 10]].copy()  # low, 1.4 m on, high (a gap), high
+    snap = snap_positions(graph, positions, np.ones(4, bool))
+    seconds = np.array([0.0, 0.5, 1.0, 1.5])
+    plan = build_plan(graph, snap.node, seconds, np.ones(4, bool), np.array(["Knife"] * 4))
+    assert plan.interval_unreachable.tolist() == [False, True, False]
+    late = expected_lateness(plan, np.array([0.7, 5.0, 5.0]))  # 1.4 m at 0.7 m/s: 2 s
+    assert late.tolist() == pytest.approx([0.0, 1.5, 1.0, 0.5])

@@ -1,5 +1,7 @@
-"""The array environment: the same rounds as the PettingZoo environment over it, step for step,
-its rewards and terminations at deaths and the round's end, and its checks of bad actions."""
+"""The array environment: the PettingZoo environment over it shows the same rounds step for step
+(what the wrapper adds: dictionaries, names, the agents list), its rewards and terminations at
+deaths and the round's end, and its checks of bad actions. The game's own rules, spawns,
+seeding, masks and timing are tested through the PettingZoo API in tests/test_sim_env.py."""
 
 from __future__ import annotations
 

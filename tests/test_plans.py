@@ -565,3 +565,20 @@ def test_snap_round_rejects_inconsistent_arrays() -> None:
     round_.alive = round_.alive[:, :5]
     with pytest.raises(EstaError, match="alive"):
         snap_round(round_, graph)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(1, 40), min_size=1, max_size=30), st.integers(0, 2**32 - 1))
+def test_interval_sums_round_exactly_as_numpy_sums_each_run(runs: list[int], seed: int) -> None:
+    """`build_plan` sums every interval's edge lengths in one pass; each sum must be bit for bit
+    the `ndarray.sum` of the interval's run, so that plans (and replays) do not move by a
+    rounding when the code is reorganised."""
+    from decoy_cli.replay.plans import _interval_sums
+
+    rng = np.random.default_rng(seed)
+    steps = np.array(runs, dtype=np.int64)
+    values = rng.random(int(steps.sum())) * rng.choice([1e-3, 1.0, 1e3], int(steps.sum()))
+    starts = np.cumsum(steps) - steps
+    sums = _interval_sums(values, starts, steps)
+    expected = np.array([values[a : a + n].sum() for a, n in zip(starts, steps, strict=True)])
+    assert sums.tobytes() == expected.tobytes()

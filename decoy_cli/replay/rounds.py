@@ -4,8 +4,8 @@
 module does not import the reader): `position` (P, F, 3) metres, NaN where absent; `alive` (P, F)
 bool; `weapon` (P, F) weapon names; `frame_seconds` (F,); `players`, each with `name` and `side`.
 Given the physics world, frames in the air are found by a ray down from each position and left
-unsnapped (see `decoy_cli.replay.snapping`); the waypoint on the floor under a low one is a soft
-target of the plan (`plan_player`).
+unsnapped (see `decoy_cli.replay.snapping`); the waypoint on the floor under such a frame is a
+soft target of the plan (`plan_player`).
 """
 
 from __future__ import annotations
@@ -162,9 +162,11 @@ def plan_player(
 
     A player in the air is over some spot of the floor, and heading for it keeps the replay
     near the real path through a jump; but the spot under a jump across a gap or off a ledge
-    may lie a long way round. So a soft target next to an interval the replay would end late
-    (`expected_lateness`) or cannot reach is dropped and the plan rebuilt, until none is: each
-    pass drops at least one target, so it ends.
+    may lie a long way round. So a soft target next to an interval that makes the replay later
+    (its expected lateness, `expected_lateness`, grows over the interval by more than a tick) or
+    that it cannot reach is dropped and the plan rebuilt, until none is: each pass drops at
+    least one target, so it ends. A soft target inside a stretch the replay runs late for
+    another reason, on the way, stays.
     """
     present = np.isfinite(positions).all(axis=1)
     soft = (snap.ground_node >= 0) & (snap.node < 0)
@@ -172,10 +174,11 @@ def plan_player(
     while True:
         plan = build_plan(graph, nodes, seconds, alive, weapons, present=present, paths=paths)
         caps = interval_caps(plan, positions)
-        late = (expected_lateness(plan, caps)[1:] > 1.0 / TICK_RATE) | plan.interval_unreachable
+        late = expected_lateness(plan, caps)
+        worse = (np.diff(late) > 1.0 / TICK_RATE) | plan.interval_unreachable
         beside = np.zeros(len(plan.target_frame), dtype=bool)
-        beside[:-1] |= late
-        beside[1:] |= late
+        beside[:-1] |= worse
+        beside[1:] |= worse
         drop = plan.target_frame[beside & soft[plan.target_frame]]
         if not len(drop):
             return plan, caps
@@ -187,18 +190,17 @@ def expected_lateness(plan: PlayerPlan, caps: np.ndarray) -> np.ndarray:
     """(T,) seconds after its deadline at which the replay reaches each target, if the agent
     leaves each target when it reaches it (or at its deadline, when early it waits) and runs
     each interval's path at most at its cap, its rises and falls taking their air time; as the
-    replay's policy plays a plan. Across a gap (unreachable) the agent is placed at the
-    target's deadline."""
+    replay's policy plays a plan. Across a gap (unreachable) the agent is placed on the target
+    at its deadline, or at once when it is already late."""
     late = np.zeros(len(plan.target_node))
     deadline = plan.target_seconds
     length = np.nan_to_num(plan.interval_length_m, nan=0.0)
     with np.errstate(divide="ignore"):
         run = np.where(length > 0, length / caps, 0.0) + plan.interval_air_s
     for k in range(len(length)):
-        if plan.interval_unreachable[k]:
-            continue
         left = deadline[k] + late[k]
-        late[k + 1] = max(0.0, left + run[k] - deadline[k + 1])
+        took = 0.0 if plan.interval_unreachable[k] else run[k]
+        late[k + 1] = max(0.0, left + took - deadline[k + 1])
     return late
 
 

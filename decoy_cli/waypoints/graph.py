@@ -234,7 +234,10 @@ class WaypointGraph:
         binary search (`np.searchsorted`). Computed once per graph."""
         keys = self.edge_source.astype(np.int64) * self.num_nodes + self.edge_target
         order = np.lexsort((self.edge_cost, keys))
-        return keys[order], order
+        sorted_keys = keys[order]
+        for shared in (sorted_keys, order):  # every path cache of the graph reads them
+            shared.setflags(write=False)
+        return sorted_keys, order
 
     def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
         """Dijkstra from one node: (path cost, `edge_cost`, to every node; predecessor of every
