@@ -177,6 +177,12 @@ class PlayerPlan:
         return self.death_frame >= 0
 
     @property
+    def interval_running_s(self) -> np.ndarray:
+        """(T-1,) float64 each interval's running time: its time less its path's air time, at
+        least a tick (`running_seconds`); the required speed is the length over it."""
+        return running_seconds(self.interval_seconds, self.interval_air_s)
+
+    @property
     def num_intervals(self) -> int:
         return len(self.interval_seconds)
 
@@ -310,7 +316,7 @@ def build_plan(
     length[unreachable] = np.nan
 
     with np.errstate(divide="ignore", invalid="ignore"):
-        running = np.maximum(interval_seconds - air, MIN_RUN_S)
+        running = running_seconds(interval_seconds, air)
         required = np.where(length == 0, 0.0, length / running)
     ratio = required / max_speed
     straight = np.linalg.norm(
@@ -351,6 +357,12 @@ def build_plan(
         death_frame=death_frame,
         death_seconds=float(seconds[death_frame]) if death_frame >= 0 else float("nan"),
     )
+
+
+def running_seconds(seconds: np.ndarray, air: np.ndarray) -> np.ndarray:
+    """The time an interval leaves for running: its `seconds` less the `air` time its path
+    spends rising or falling without headway, at least `MIN_RUN_S`."""
+    return np.maximum(seconds - air, MIN_RUN_S)
 
 
 def _max_speeds(names: np.ndarray) -> np.ndarray:

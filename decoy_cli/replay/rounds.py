@@ -18,7 +18,7 @@ import pandas as pd
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
-from decoy_cli.replay.plans import MIN_RUN_S, PathCache, PlayerPlan, build_plan
+from decoy_cli.replay.plans import PathCache, PlayerPlan, build_plan
 from decoy_cli.replay.snapping import (
     DEFAULT_MAX_SNAP_M,
     WITHIN_M,
@@ -225,15 +225,13 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     """
     if len(plan.target_node) < 2:
         return np.zeros(0)
-    frames = plan.target_frame
-    seconds = np.maximum(plan.interval_seconds - plan.interval_air_s, MIN_RUN_S)  # running
-    ran = np.linalg.norm(np.diff(original[frames], axis=0), axis=1) / seconds
-    straight = np.where(np.isfinite(ran), ran * seconds, 0.0)
+    displacement = np.linalg.norm(np.diff(original[plan.target_frame], axis=0), axis=1)
+    straight = np.nan_to_num(displacement, nan=0.0)  # a frame without a position: no measure
+    ran = straight / plan.interval_running_s
     length = np.nan_to_num(plan.interval_length_m, nan=0.0)
     zigzag = np.clip(
         np.where(straight > 0.05, length / np.maximum(straight, 1e-9), 1.0), 1.0, MAX_ZIGZAG
     )
-    ran = np.where(np.isfinite(ran), ran, 0.0)
     return np.maximum(plan.interval_max_speed_m_s, ran) * zigzag
 
 
