@@ -27,7 +27,7 @@ from decoy_cli.world.patch_learning import (
     StandingPositions,
     learn_patches,
     patches_csv,
-    standing_positions,
+    read_positions,
 )
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -190,7 +190,7 @@ def test_a_jump_arc_is_not_standing_and_a_steady_height_is(
     }
     document = match_with_heights({first: ARC_U, second: [STEADY_HEIGHT_U] * 6}, vertical)
     path = write_match(tmp_path / "m.json.xz", document)
-    standing = standing_positions([path], "de_dust2", load_navmesh("de_dust2"))
+    standing, _ = read_positions([path], "de_dust2", load_navmesh("de_dust2"))
     heights = standing.position[:, 2]
     assert not np.isin(ARC_U[1:4], heights).any()
     assert np.sum(heights == STEADY_HEIGHT_U) == 6
@@ -201,7 +201,7 @@ def test_a_match_of_another_map_is_an_error_naming_the_file(tmp_path: Path) -> N
     document["mapName"] = "de_mirage"
     path = write_match(tmp_path / "mirage.json.xz", document)
     with pytest.raises(WorldError, match=r"mirage\.json\.xz: a de_mirage match"):
-        standing_positions([path], "de_dust2", load_navmesh("de_dust2"))
+        read_positions([path], "de_dust2", load_navmesh("de_dust2"))
 
 
 def in_metres(document: dict) -> dict:
@@ -217,7 +217,7 @@ def in_metres(document: dict) -> dict:
 def test_positions_in_the_wrong_units_are_an_error_naming_the_file(tmp_path: Path) -> None:
     path = write_match(tmp_path / "metres.json.xz", in_metres(make_match()))
     with pytest.raises(WorldError, match=r"metres\.json\.xz: .*wrong units"):
-        standing_positions([path], "de_dust2", load_navmesh("de_dust2"))
+        read_positions([path], "de_dust2", load_navmesh("de_dust2"))
 
 
 def test_the_command_fails_in_one_line_and_writes_nothing(tmp_path: Path) -> None:
@@ -254,9 +254,11 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
     assert result.exit_code == 0, result.output
     patches = out.with_suffix(".patches.csv")
     assert "learned" in result.output and str(patches) in result.output.replace("\n", "")
+    assert "real consecutive-frame paths" in result.output
     with open(patches, newline="") as f:
         rows = list(csv.DictReader(f))
     assert rows and all(int(r["matches"]) >= 2 for r in rows)
+    assert all(r["paths_lengthened"].isdigit() and r["positions_gained"].isdigit() for r in rows)
     graph = WaypointGraph.load(out)
     assert len(graph.meta["patches"]) == len(rows)
     world = graph_world(graph)

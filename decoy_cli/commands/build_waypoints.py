@@ -15,16 +15,16 @@ from decoy_cli.commands._console import make_console
 from decoy_cli.errors import GraphError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.files import check_writable
+from decoy_cli.waypoints import patch_check
 from decoy_cli.waypoints.build import build_graph, canonical_map, read_manual_waypoints
 from decoy_cli.waypoints.coverage import NavCoverage, nav_coverage
-from decoy_cli.waypoints.lattice import LatticeParams
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult
 from decoy_cli.waypoints.plot import plot_graph
 from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_aligned
 from decoy_cli.world import patch_learning
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
-from decoy_cli.world.physics import PhysicsWorld
-from decoy_cli.world.world import World
 
 DEFAULT_OUT = Path("decoy-out") / "waypoints"
 
@@ -113,11 +113,20 @@ def build_waypoints(
     check_writable(out)  # before the build's minutes
     if check_esta is not None:
         collect_match_files([check_esta])  # a missing or empty input fails now, not after
+    params = LatticeParams(spacing=spacing, wall_nodes=wall_nodes)
+    built: tuple[WaypointGraph, LatticeResult] | None = None
     if learn_patches is not None:
         patches_out = patches_out or out.with_suffix(".patches.csv")
         check_writable(patches_out)
-        world = _learned_world(console, map_id, learn_patches, patches_out, min_matches)
-    params = LatticeParams(spacing=spacing, wall_nodes=wall_nodes)
+        files, _ = collect_match_files([learn_patches])
+        with console.status("learning patches, then building graphs without and with them"):
+            learned = patch_check.learn_checked_patches(
+                files, map_id, seed_points, params, manual_points, min_matches
+            )
+        _show_learned(console, learned, len(files))
+        patch_learning.write_patches(patches_out, learned.kept)
+        console.print(f"{_count(learned.kept)} written to {patches_out}", highlight=False)
+        world, built = nav_world(map_id, tuple(b.box for b in learned.kept)), learned.built
 
     started = time.perf_counter()
     with Progress(
@@ -136,7 +145,9 @@ def build_waypoints(
             info = f"{done:,} nodes" if not total else f"{done:,}/{total:,} capsule steps"
             progress.update(tasks[stage], completed=done, total=total or None, info=info)
 
-        graph, result = build_graph(world, map_id, seed_points, params, manual_points, report)
+        graph, result = built or build_graph(
+            world, map_id, seed_points, params, manual_points, report
+        )
         for task in tasks.values():
             progress.update(task, total=progress.tasks[task].completed or 1)
     graph.save(out)
@@ -209,24 +220,40 @@ def build_waypoints(
         check_aligned(quality, min_aligned)
 
 
-def _learned_world(
-    console: Console, map_id: str, data: Path, patches_out: Path, min_matches: int
-) -> World:
-    """Learn patches from `data` on the bare nav world, write them, and return the nav world
-    with them (which the graph records, so replays use the same world)."""
-    files, _ = collect_match_files([data])
-    nav = load_navmesh(map_id)
-    standing = patch_learning.standing_positions(files, map_id, nav)
-    with PhysicsWorld(nav_world(map_id, ())) as physics:
-        boxes = patch_learning.learn_patches(standing, physics, nav, min_matches=min_matches)
-    patch_learning.write_patches(patches_out, boxes)
+def _count(boxes: list[patch_learning.PatchBox]) -> str:
+    return f"{len({b.patch for b in boxes})} patches ({len(boxes)} boxes)"
+
+
+def _show_learned(console: Console, learned: patch_check.LearnedPatches, files: int) -> None:
     console.print(
-        f"learned {len({b.patch for b in boxes})} patches ({len(boxes)} boxes) from "
-        f"{len(standing.position):,} standing positions in {len(files)} matches; "
-        f"written to {patches_out}",
+        f"learned {_count(learned.candidates)} from {learned.standing_positions:,} standing "
+        f"positions in {files} matches",
         highlight=False,
     )
-    return nav_world(map_id, tuple(b.box for b in boxes))
+    if learned.check is None:
+        return
+    check = learned.check
+    left_out = [v for v in check.verdicts if not v.kept]
+    console.print(
+        f"checked on {check.pairs:,} real consecutive-frame paths: {check.lengthened_pairs:,} "
+        f"lengthened; {len(left_out)} patches left out",
+        highlight=False,
+    )
+    if not left_out:
+        return
+    table = Table(title="left out: they lengthen more real paths than they give positions")
+    table.add_column("patch", justify="right")
+    table.add_column("paths lengthened", justify="right")
+    table.add_column("in matches", justify="right")
+    table.add_column("positions gained", justify="right")
+    for verdict in left_out:
+        table.add_row(
+            str(verdict.patch),
+            f"{verdict.lengthened:,}",
+            str(verdict.lengthened_matches),
+            f"{verdict.gained:,}",
+        )
+    console.print(table)
 
 
 def _show_coverage(console: Console, coverage: NavCoverage) -> None:

@@ -28,6 +28,9 @@ Method:
    from a surface's edge, so the surface reaches past them. Columns of equal height are merged
    into rectangles (`decoy_cli/world/patch_boxes.py`).
 
+These are candidates: `decoy build-waypoints --learn-patches` keeps those the learning matches'
+real paths are better with (`decoy_cli/waypoints/patch_check.py`).
+
 Positions are read in Hammer units here (the nav mesh's units); the world is in metres.
 """
 
@@ -36,7 +39,7 @@ from __future__ import annotations
 import csv
 import io
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,7 +83,16 @@ MIN_SPAN = 0.05
 """Least share of the nav mesh's width and depth a match's positions must span; less means
 positions in the wrong units (metres read as Hammer units cover a few units of the map)."""
 
-EVIDENCE_COLUMNS = ("patch", "samples", "matches", "height_spread_u", "above_floor_u", "place")
+EVIDENCE_COLUMNS = (
+    "patch",
+    "samples",
+    "matches",
+    "height_spread_u",
+    "above_floor_u",
+    "place",
+    "paths_lengthened",
+    "positions_gained",
+)
 
 
 @dataclass(frozen=True)
@@ -90,6 +102,16 @@ class StandingPositions:
     position: np.ndarray  # (N, 3)
     match: np.ndarray  # (N,) index into `files`
     files: tuple[Path, ...]
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """Every alive position of the same matches' players, metres, player by player in frame
+    order: the real paths a learned patch must not lengthen (`waypoints/patch_check.py`)."""
+
+    position: np.ndarray  # (N, 3)
+    match: np.ndarray  # (N,) index into the files
+    follows: np.ndarray  # (N,) bool: the same player's position one frame after position i - 1
 
 
 @dataclass(frozen=True)
@@ -108,6 +130,14 @@ class PatchBox:
     height_spread_u: float
     above_floor_u: float
     place: str
+    paths_lengthened: int | None = None
+    """Real consecutive-frame paths the patch lengthens (None: not checked)."""
+    positions_gained: int | None = None
+    """Real positions only the patch puts near a waypoint (None: not checked)."""
+
+    def with_check(self, lengthened: int, gained: int) -> PatchBox:
+        """The same box with the counts of its patch's check as evidence."""
+        return replace(self, paths_lengthened=lengthened, positions_gained=gained)
 
     @property
     def box(self) -> tuple[float, ...]:
@@ -126,22 +156,40 @@ class PatchBox:
         }
 
 
-def standing_positions(files: Sequence[Path], map_name: str, nav: NavMesh) -> StandingPositions:
-    """The standing positions of every round of `files` (see the module docstring); a
-    WorldError naming the file for one of another map or with positions in the wrong units."""
-    chunks, owners = [], []
+def read_positions(
+    files: Sequence[Path], map_name: str, nav: NavMesh
+) -> tuple[StandingPositions, Tracks]:
+    """The standing positions of every round of `files` (see the module docstring) and every
+    alive position as tracks; a WorldError naming the file for one of another map or with
+    positions in the wrong units."""
+    standing, tracks, owners, track_owners = [], [], [], []
     for index, file in enumerate(files):
         match = read_match(file)
         if match.map_name and match.map_name != map_name:
             raise WorldError(f"{file}: a {match.map_name} match, not {map_name}")
         position = _match_standing(match)
         _check_spread(file, position, nav)
-        chunks.append(position)
+        standing.append(position)
         owners.append(np.full(len(position), index, dtype=np.int64))
-    return StandingPositions(
-        position=np.concatenate(chunks) if chunks else np.zeros((0, 3)),
-        match=np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64),
-        files=tuple(files),
+        track = _match_tracks(match)
+        tracks.append(track)
+        track_owners.append(np.full(len(track[0]), index, dtype=np.int64))
+    if not standing:
+        empty = np.zeros((0, 3))
+        nothing = np.zeros(0, dtype=np.int64)
+        return (
+            StandingPositions(position=empty, match=nothing, files=tuple(files)),
+            Tracks(position=empty, match=nothing, follows=np.zeros(0, dtype=bool)),
+        )
+    return (
+        StandingPositions(
+            position=np.concatenate(standing), match=np.concatenate(owners), files=tuple(files)
+        ),
+        Tracks(
+            position=np.concatenate([t[0] for t in tracks]),
+            match=np.concatenate(track_owners),
+            follows=np.concatenate([t[1] for t in tracks]),
+        ),
     )
 
 
@@ -156,6 +204,21 @@ def _match_standing(match: Match) -> np.ndarray:
         standing = np.where(np.isnan(vz), steady, vz == 0) & ok
         found.append(round_.position[standing] / HAMMER_TO_M)
     return np.concatenate(found) if found else np.zeros((0, 3))
+
+
+def _match_tracks(match: Match) -> tuple[np.ndarray, np.ndarray]:
+    """(alive positions in metres, player by player in frame order; whether each follows the
+    previous one frame later) of one match."""
+    positions, follows = [], []
+    for round_ in match.rounds:
+        ok = round_.alive & np.isfinite(round_.position).all(axis=-1)  # (P, F)
+        after_ok = np.zeros_like(ok)
+        after_ok[:, 1:] = ok[:, :-1]
+        positions.append(round_.position[ok])
+        follows.append(after_ok[ok])
+    if not positions:
+        return np.zeros((0, 3)), np.zeros(0, dtype=bool)
+    return np.concatenate(positions), np.concatenate(follows)
 
 
 def _steady(z: np.ndarray, seconds: np.ndarray) -> np.ndarray:

@@ -1,0 +1,264 @@
+"""Which learned floor patches a waypoint graph is better with: real paths against real positions.
+
+Why: a learned patch (`decoy_cli/world/patch_learning.py`) is a solid box where players stood
+again and again. It gives the graph waypoints on its top, where those players were; but a solid
+box also takes floor and headroom from the ways players walk beside or under it (a slab learned
+over half of a walkway, a box that fills a doorway because players stood on its edge), and a
+replay sent round it arrives late. Counting both on the learning matches decides which patches
+stay.
+
+Method, on the graph built without any learned patch (bare) and with every candidate (patched):
+
+1. **What a patch costs.** For each pair of consecutive frames of a real player with a waypoint
+   within `ALIGNED_WITHIN_M` on both graphs, the shortest-path cost (`edge_cost`) on each. The
+   patched path is *lengthened* when it costs more than `LENGTHENED_RATIO` times the bare one
+   plus `LENGTHENED_EXTRA_M`. Each lengthened pair is blamed on the patches whose box, grown by
+   one lattice spacing sideways and `BLAME_REACH_M` up and down, holds a waypoint of the bare
+   path: the box took that way.
+2. **What a patch gives.** Real positions within `ALIGNED_WITHIN_M` of a patched waypoint on the
+   patch's top (within a step of it) that have no bare waypoint that near.
+3. **Verdict.** A patch is left out when the pairs blamed on it come from at least
+   `MIN_MATCHES` matches (one match's detour can be one player's habit) and outnumber the
+   positions it gives.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.sparse.csgraph import dijkstra
+
+from decoy_cli.csgo import HAMMER_TO_M, JUMP_HEIGHT_M, PLAYER_HEIGHT_M, STEP_HEIGHT_M
+from decoy_cli.waypoints.build import build_graph
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeResult
+from decoy_cli.waypoints.lattice_params import LatticeParams
+from decoy_cli.waypoints.quality import ALIGNED_WITHIN_M
+from decoy_cli.world import patch_learning
+from decoy_cli.world.navmesh import load_navmesh, nav_world
+from decoy_cli.world.patch_learning import MIN_MATCHES, PatchBox, Tracks
+from decoy_cli.world.physics import PhysicsWorld
+
+LENGTHENED_RATIO = 1.5
+"""A patched path longer than this many times the bare one is a detour, not the lattice's
+zig-zag (which differs between two builds by a few tenths of a metre)."""
+
+LENGTHENED_EXTRA_M = 3.0
+"""...plus this much: more than a data frame's run at the fastest speed (250 u/s for 0.5 s,
+2.4 m), so a lengthened pair makes a replay at least a frame late."""
+
+BARE_LIMIT_M = 20.0
+"""Longest bare path between consecutive frames that is compared; longer ones (a teleport, a
+position glitch) say nothing about a patch."""
+
+BLAME_REACH_M = PLAYER_HEIGHT_M + JUMP_HEIGHT_M
+"""How far above and below a box its bare-path waypoints are blamed: a standing player's height
+plus a crouch-jump's rise (game rules) is the most headroom a box can take from a path."""
+
+_SOURCES_PER_SEARCH = 256
+"""Dijkstra sources searched together (each a row of the graph's size)."""
+
+
+@dataclass(frozen=True)
+class PatchVerdict:
+    """What one learned patch costs and gives on the learning matches, and whether it stays."""
+
+    patch: int
+    lengthened: int
+    """Consecutive-frame pairs of real players whose path the patch lengthens."""
+    lengthened_matches: int
+    """Matches those pairs come from."""
+    gained: int
+    """Real positions on the patch's top that only the patched graph has a waypoint near."""
+
+    @property
+    def kept(self) -> bool:
+        return not (self.lengthened_matches >= MIN_MATCHES and self.lengthened > self.gained)
+
+
+@dataclass(frozen=True)
+class PatchCheck:
+    """The verdict on every patch, and the pairs compared."""
+
+    verdicts: tuple[PatchVerdict, ...]
+    pairs: int
+    lengthened_pairs: int
+
+    def kept_boxes(self, boxes: Sequence[PatchBox]) -> list[PatchBox]:
+        """The boxes of the patches that stay, each with its verdict's counts as evidence."""
+        verdict = {v.patch: v for v in self.verdicts}
+        return [
+            b.with_check(verdict[b.patch].lengthened, verdict[b.patch].gained)
+            for b in boxes
+            if verdict[b.patch].kept
+        ]
+
+
+@dataclass(frozen=True)
+class LearnedPatches:
+    """The patches learned from a set of matches, the check that weighed them, those kept."""
+
+    candidates: list[PatchBox]
+    check: PatchCheck | None
+    """None when nothing was learned."""
+    kept: list[PatchBox]
+    standing_positions: int
+    built: tuple[WaypointGraph, LatticeResult] | None
+    """The graph on the kept patches when the check already built it (all were kept)."""
+
+
+def learn_checked_patches(
+    files: Sequence[Path],
+    map_id: str,
+    seeds: np.ndarray | None = None,
+    params: LatticeParams = LatticeParams(),
+    manual: np.ndarray | None = None,
+    min_matches: int = MIN_MATCHES,
+) -> LearnedPatches:
+    """Learn patches from `files` on the map's bare nav world, build the graph without and with
+    them (as the final graph will be built: same seeds, lattice and manual points) and keep the
+    patches the learning matches' paths are better with."""
+    nav = load_navmesh(map_id)
+    standing, tracks = patch_learning.read_positions(files, map_id, nav)
+    bare_world = nav_world(map_id, ())
+    with PhysicsWorld(bare_world) as physics:
+        candidates = patch_learning.learn_patches(standing, physics, nav, min_matches=min_matches)
+    if not candidates:
+        return LearnedPatches([], None, [], len(standing.position), None)
+    bare, _ = build_graph(bare_world, map_id, seeds, params, manual)
+    patched_world = nav_world(map_id, tuple(b.box for b in candidates))
+    built = build_graph(patched_world, map_id, seeds, params, manual)
+    check = check_patches(bare, built[0], candidates, tracks, params)
+    kept = check.kept_boxes(candidates)
+    return LearnedPatches(
+        candidates=candidates,
+        check=check,
+        kept=kept,
+        standing_positions=len(standing.position),
+        built=built if len(kept) == len(candidates) else None,
+    )
+
+
+def check_patches(
+    bare: WaypointGraph,
+    patched: WaypointGraph,
+    boxes: Sequence[PatchBox],
+    tracks: Tracks,
+    params: LatticeParams = LatticeParams(),
+) -> PatchCheck:
+    """Weigh every learned patch of `boxes` (built into `patched`, absent from `bare`) on the
+    real players' `tracks` (see the module docstring)."""
+    box_m = np.array([_box_m(b) for b in boxes]).reshape(-1, 6)
+    patch_of_box = np.array([b.patch for b in boxes], dtype=np.int64)
+    patches = sorted(set(patch_of_box.tolist()))
+    blamed, pairs, lengthened = _lengthened(bare, patched, box_m, patch_of_box, tracks, params)
+    gained = _gained(bare, patched, box_m, patch_of_box, tracks)
+    verdicts = tuple(
+        PatchVerdict(
+            patch=p,
+            lengthened=len(blamed.get(p, ())),
+            lengthened_matches=len(set(blamed.get(p, ()))),
+            gained=int(gained.get(p, 0)),
+        )
+        for p in patches
+    )
+    return PatchCheck(verdicts=verdicts, pairs=pairs, lengthened_pairs=lengthened)
+
+
+def _box_m(box: PatchBox) -> tuple[float, ...]:
+    return tuple(
+        v * HAMMER_TO_M
+        for v in (box.x_min, box.y_min, box.x_max, box.y_max, box.z_bottom, box.z_top)
+    )
+
+
+def _snapped(graph: WaypointGraph, position: np.ndarray) -> np.ndarray:
+    index, _ = graph.nearest(position, max_distance=ALIGNED_WITHIN_M)
+    return index
+
+
+def _lengthened(
+    bare: WaypointGraph,
+    patched: WaypointGraph,
+    box_m: np.ndarray,
+    patch_of_box: np.ndarray,
+    tracks: Tracks,
+    params: LatticeParams,
+) -> tuple[dict[int, list[int]], int, int]:
+    """({patch: match of each pair blamed on it}, pairs compared, pairs lengthened)."""
+    if len(tracks.position) == 0:
+        return {}, 0, 0
+    on_bare, on_patched = _snapped(bare, tracks.position), _snapped(patched, tracks.position)
+    end = np.flatnonzero(tracks.follows)
+    start = end - 1
+    a0, b0, a1, b1 = on_bare[start], on_bare[end], on_patched[start], on_patched[end]
+    use = (np.minimum.reduce([a0, b0, a1, b1]) >= 0) & (a0 != b0)
+    a0, b0, a1, b1, end = a0[use], b0[use], a1[use], b1[use], end[use]
+    bare_cost = _path_costs(bare, a0, b0, BARE_LIMIT_M)
+    compared = np.isfinite(bare_cost)
+    patched_limit = LENGTHENED_RATIO * BARE_LIMIT_M + LENGTHENED_EXTRA_M
+    patched_cost = _path_costs(patched, a1[compared], b1[compared], patched_limit)
+    worse = patched_cost > LENGTHENED_RATIO * bare_cost[compared] + LENGTHENED_EXTRA_M
+    blamed: dict[int, list[int]] = {}
+    grow = np.array([-params.spacing, -params.spacing, params.spacing, params.spacing])
+    low = box_m[:, :4] + grow
+    for source, target, row in zip(
+        a0[compared][worse], b0[compared][worse], end[compared][worse], strict=True
+    ):
+        nodes = bare.positions[bare.shortest_path(int(source), int(target))]
+        hit = (
+            (nodes[:, None, 0] >= low[:, 0])
+            & (nodes[:, None, 1] >= low[:, 1])
+            & (nodes[:, None, 0] <= low[:, 2])
+            & (nodes[:, None, 1] <= low[:, 3])
+            & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_REACH_M)
+            & (nodes[:, None, 2] <= box_m[:, 5] + BLAME_REACH_M)
+        ).any(axis=0)
+        for patch in set(patch_of_box[hit].tolist()):
+            blamed.setdefault(patch, []).append(int(tracks.match[row]))
+    return blamed, int(compared.sum()), int(worse.sum())
+
+
+def _path_costs(
+    graph: WaypointGraph, source: np.ndarray, target: np.ndarray, limit: float
+) -> np.ndarray:
+    """Shortest-path cost from each source to its target; inf beyond `limit` metres."""
+    cost = np.full(len(source), np.inf)
+    unique, inverse = np.unique(source, return_inverse=True)
+    for first in range(0, len(unique), _SOURCES_PER_SEARCH):
+        rows = unique[first : first + _SOURCES_PER_SEARCH]
+        dist = dijkstra(graph.adjacency, directed=True, indices=rows, limit=limit)
+        mine = np.flatnonzero((inverse >= first) & (inverse < first + len(rows)))
+        cost[mine] = dist[inverse[mine] - first, target[mine]]
+    return cost
+
+
+def _gained(
+    bare: WaypointGraph,
+    patched: WaypointGraph,
+    box_m: np.ndarray,
+    patch_of_box: np.ndarray,
+    tracks: Tracks,
+) -> dict[int, int]:
+    """{patch: real positions near a patched waypoint on its top and far from every bare one}."""
+    if len(tracks.position) == 0:
+        return {}
+    node = patched.positions
+    node_patch = np.full(patched.num_nodes, -1, dtype=np.int64)
+    for box, patch in zip(box_m, patch_of_box, strict=True):
+        on_top = (
+            (node[:, 0] >= box[0])
+            & (node[:, 0] <= box[2])
+            & (node[:, 1] >= box[1])
+            & (node[:, 1] <= box[3])
+            & (np.abs(node[:, 2] - box[5]) <= STEP_HEIGHT_M)
+        )
+        node_patch[on_top] = patch
+    near_patched = _snapped(patched, tracks.position)
+    only_patched = (near_patched >= 0) & (_snapped(bare, tracks.position) < 0)
+    owner = node_patch[near_patched[only_patched]]
+    patches, counts = np.unique(owner[owner >= 0], return_counts=True)
+    return dict(zip(patches.tolist(), counts.tolist(), strict=True))
