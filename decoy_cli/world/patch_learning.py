@@ -141,8 +141,9 @@ class PatchBox:
 
     @property
     def box(self) -> tuple[float, ...]:
-        """The box as a patches-file row reads it (`PATCH_COLUMNS`)."""
-        return tuple(float(getattr(self, key)) for key in PATCH_COLUMNS)
+        """The box as its patches-file row reads back (`PATCH_COLUMNS`, to 0.1 u), so a world
+        built from learned boxes is the world built from their file."""
+        return tuple(round(float(getattr(self, key)), 1) for key in PATCH_COLUMNS)
 
     def row(self) -> dict[str, object]:
         what = (
@@ -150,7 +151,7 @@ class PatchBox:
             f"{self.above_floor_u:.0f} u above the nav floor"
         )
         return {
-            **{key: round(value, 1) for key, value in zip(PATCH_COLUMNS, self.box, strict=True)},
+            **dict(zip(PATCH_COLUMNS, self.box, strict=True)),
             "what": what,
             **{key: getattr(self, key) for key in EVIDENCE_COLUMNS},
         }
