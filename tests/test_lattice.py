@@ -33,7 +33,7 @@ from worlds import (
     walls_around,
 )
 
-from decoy_cli.csgo import JUMP_HEIGHT_M, MAP_NAMES
+from decoy_cli.csgo import HAMMER_TO_M, JUMP_HEIGHT_M, MAP_NAMES
 from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.build import build_graph, builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind, WaypointGraph
@@ -240,6 +240,60 @@ def test_box_is_jumped_onto_and_dropped_off() -> None:
     for e in np.flatnonzero(from_wall):
         parent = (dst == src[e]) & lattice_top[src] & (direction == direction[e])
         assert parent.sum() == 1
+
+
+def crate_room(height_u: float) -> LatticeResult:
+    """The jump-box room with the box `height_u` Hammer units high."""
+    world = make_world(
+        [
+            floor(0.0, 0.0, 8.0, 8.0),
+            walls_around(0.0, 0.0, 8.0, 8.0),
+            box(*BOX, 0.0, height_u * HAMMER_TO_M),
+        ],
+        "crate",
+        (0.5, 0.5, 0.0),
+    )
+    with PhysicsWorld(world) as physics:
+        return build_lattice(physics, seeds_of(world))
+
+
+@pytest.mark.parametrize(("height_u", "climbed"), [(64.0, True), (65.0, True), (67.0, False)])
+def test_a_crouch_jump_gets_onto_a_64_unit_crate_and_no_higher_than_65(
+    height_u: float, climbed: bool
+) -> None:
+    """CS:GO maps build crates 64 u high because a crouch-jump gets onto them (65 u at most)."""
+    result = crate_room(height_u)
+    top = np.abs(result.positions[:, 2] - height_u * HAMMER_TO_M) < 0.02
+    onto = ~top[result.edge_source] & top[result.edge_target]
+    assert bool(onto.any()) is climbed
+    assert np.all(result.edge_kind[onto] == EdgeKind.JUMP)
+
+
+BY_THE_LEDGE = (5.0, 1.2, LEDGE_X, 2.9)
+"""A box against the ledge face of `ledge_world` (x0, y0, x1, y1), BOX_Z high: the platform is
+out of a jump's reach from the floor but not from the box."""
+
+
+def test_a_box_by_a_ledge_is_the_way_up() -> None:
+    parts = [ledge_world().triangles, box(*BY_THE_LEDGE, 0.0, BOX_Z)]
+    world = make_world(parts, "box by the ledge", (1.0, 1.0, 0.0))
+    graph, _ = build_graph(world, seeds=seeds_of(world))  # verified by the capsule like all
+    pos, kind = graph.positions, graph.edge_kind
+    x0, y0, x1, y1 = BY_THE_LEDGE
+    on_box = (np.abs(pos[:, 2] - BOX_Z) < 0.02) & (pos[:, 0] > x0) & (pos[:, 1] > y0)
+    on_box &= (pos[:, 0] < x1) & (pos[:, 1] < y1)
+    platform = np.abs(pos[:, 2] - LEDGE_Z) < 0.02
+    floor_ = pos[:, 2] < 0.02
+    src, dst = graph.edge_source, graph.edge_target
+    box_up = on_box[src] & platform[dst]
+    assert box_up.any() and np.all(kind[box_up] == EdgeKind.JUMP)
+    assert not (floor_[src] & platform[dst]).any()  # 1.5 m: no jump from the floor
+    # from the floor in front of the box to the platform behind it: over the box, not round
+    # by the ramp lane
+    start, end = graph.nearest(np.array([[4.5, 2.4, 0.0], [6.6, 2.4, LEDGE_Z]]))[0]
+    path = graph.shortest_path(int(start), int(end))
+    assert on_box[path].any()
+    assert len(path) <= 5
 
 
 def test_wall_node_stands_at_a_box_face_and_the_jump_leaves_from_it() -> None:
