@@ -92,16 +92,15 @@ def main() -> None:
         f"targets reached more than 0.5 s late: {over:.2%} of {int(players['targets'].sum()):,}"
     )
     causes = {
-        "the lattice's zig-zag (the straight line would be in time)": "late_zigzag",
-        "a way round something (the straight line would be in time)": "late_detour",
-        "faster than the weapon's maximum even straight": "late_speed",
+        "the lattice's zig-zag (the straight line was within the cap)": "late_zigzag",
+        "a way round something (the straight line was within the cap)": "late_detour",
+        "over the speed cap even straight": "late_speed",
         "a gap of the graph (relocated)": "late_gap",
-        "the target before was already late": "late_carried",
-        "the replay's own delay": "late_replay",
+        "within the cap: the replay's own delay": "late_replay",
     }
     total = max(int(players["late_over_frame"].sum()), 1)
     print(
-        "why those targets are late: "
+        "why the late stretches those targets belong to began: "
         + "; ".join(f"{what} {players[c].sum() / total:.0%}" for what, c in causes.items())
     )
     print(

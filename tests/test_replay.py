@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -25,7 +25,14 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import RoundClock
 from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK, player_metrics
-from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
+from decoy_cli.replay.plans import PlayerPlan
+from decoy_cli.replay.replayer import (
+    LATE_CAUSES,
+    ReplayOptions,
+    ReplayResult,
+    replay_round,
+    stretch_causes,
+)
 from decoy_cli.replay.snapping import SnapStatus
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import BOMB_TARGET_BOXES, RulesConfig, SiteZones
@@ -65,7 +72,6 @@ PLAYER_COLUMNS = (
     "late_detour",
     "late_speed",
     "late_gap",
-    "late_carried",
     "late_replay",
     "late_p95_s",
     "stuck",
@@ -260,18 +266,44 @@ def test_a_plan_twice_too_fast_runs_late_then_catches_up(timed: Timed) -> None:
     assert row["late_max_s"] == pytest.approx(late.max())
     assert row["late_over_frame"] == int(np.sum(late > 0.5 + 1e-9))
     assert row["late_share"] == pytest.approx(3 / TIMING_FRAMES)
-    # why: the first run asked for more than the player's speed, only by the graph's way round
-    # the wall (the straight line would be in time); every late target after a late one
-    # inherits its lateness
+    # why: the stretch of late targets began where the plan asked for more than the cap, only
+    # by the graph's way round the wall (the straight line would be in time); every late
+    # target of the stretch is put down to that
+    cause = stretch_causes(plan, result.plan.caps[DETOURER], late)
     over = late > 0.5 + 1e-9
-    carried = np.r_[False, over[:-1]]
+    assert set(cause[over].tolist()) == {LATE_CAUSES.index("detour")}
     assert plan.interval_detour[:2].all() and not plan.interval_detour[2:].any()
-    assert row["late_detour"] == int(np.sum(over[1:3] & ~carried[1:3])) >= 1
-    assert row["late_speed"] == row["late_gap"] == row["late_zigzag"] == 0
-    assert row["late_carried"] == int(np.sum(over & carried))
-    assert row["late_replay"] == 0
-    causes = ("late_zigzag", "late_detour", "late_speed", "late_gap", "late_carried", "late_replay")
-    assert sum(row[c] for c in causes) == row["late_over_frame"]
+    assert row["late_detour"] == row["late_over_frame"] >= 1
+    assert row["late_speed"] == row["late_gap"] == row["late_zigzag"] == row["late_replay"] == 0
+
+
+def test_a_late_stretch_is_put_down_to_how_its_first_interval_compares_with_the_cap(
+    timed: Timed,
+) -> None:
+    _, result = timed
+    plan = result.plan.plans[DETOURER]
+    late = result.logs[DETOURER].lateness_s
+    caps = result.plan.caps[DETOURER]
+    stretch = late > 1 / 60 + 1e-9
+    first = int(np.flatnonzero(stretch)[0])  # the stretch's first target
+
+    def cause_of(plan_: PlayerPlan, caps_: np.ndarray) -> set[str]:
+        return {LATE_CAUSES[c] for c in stretch_causes(plan_, caps_, late)[stretch]}
+
+    assert cause_of(plan, caps) == {"detour"}
+    assert np.all(stretch_causes(plan, caps, late)[~stretch] == -1)
+    assert cause_of(plan, caps * 100) == {"replay"}  # the cap allowed it: the replay's delay
+    tiny = caps.copy()
+    tiny[first - 1] = 1e-3  # not even the straight line fits
+    assert cause_of(plan, tiny) == {"speed"}
+    zigzag = replace(
+        plan,
+        interval_length_m=plan.interval_straight_m * 1.05,
+        interval_required_speed_m_s=caps * 2,
+    )
+    assert cause_of(zigzag, caps) == {"zigzag"}
+    gap = replace(plan, interval_unreachable=np.ones_like(plan.interval_unreachable))
+    assert cause_of(gap, caps) == {"gap"}
 
 
 def test_survivors_survive_and_the_round_is_undecided(timed: Timed) -> None:

@@ -26,7 +26,6 @@ REPLAY_COLUMNS = (
     "late_detour",
     "late_speed",
     "late_gap",
-    "late_carried",
     "late_replay",
     "late_p95_s",
     "stuck",
@@ -47,11 +46,12 @@ class ReplayTrace:
     data shows a death (`died_original`), whether the replay removed the player at its data
     death time rather than by combat (`scripted_death`), the share of plan targets reached late
     and the 95th percentile lateness in seconds (NaN when none was reached), the targets reached
-    and how many of them more than one data frame late, split by cause (the plan asked for more
-    than the player's speed on the way to it: `late_zigzag` only by the lattice's zig-zag and
-    `late_detour` by a longer way round something, the straight line would do; `late_speed`
-    even straight; `late_gap` across a gap of the graph, relocated; `late_carried`: the target
-    before was already that late; `late_replay`: none of these, the replay's own delay), stuck
+    and how many of them more than one data frame late, split by why the stretch of late
+    targets each belongs to began (the interval to its first target, against the speed the
+    replay may run there: `late_zigzag` asked more only by the lattice's zig-zag, `late_detour`
+    only by a way round something, the straight line would do; `late_speed` more even
+    straight; `late_gap` across a gap of the graph, relocated; `late_replay` nothing beyond the
+    cap, the replay's own delay), stuck
     episodes, recoveries (teleports) and relocations.
     """
 
@@ -67,7 +67,6 @@ class ReplayTrace:
     late_detour: np.ndarray
     late_speed: np.ndarray
     late_gap: np.ndarray
-    late_carried: np.ndarray
     late_replay: np.ndarray
     stuck: np.ndarray
     recoveries: np.ndarray
@@ -107,7 +106,6 @@ def player_metrics(round_: Round, trace: ReplayTrace, *, fastdtw: bool = False) 
                 "late_detour": int(trace.late_detour[p]),
                 "late_speed": int(trace.late_speed[p]),
                 "late_gap": int(trace.late_gap[p]),
-                "late_carried": int(trace.late_carried[p]),
                 "late_replay": int(trace.late_replay[p]),
                 "late_p95_s": float(trace.late_p95_s[p]),
                 "stuck": int(trace.stuck[p]),

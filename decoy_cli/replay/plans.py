@@ -138,6 +138,8 @@ class PlayerPlan:
     interval_zigzag: np.ndarray
     """(T-1,) bool a detour no longer than the lattice's zig-zag allows (`ZIGZAG_MAX`); the other
     detours go round something (a missing edge, a wall the player got past)."""
+    interval_straight_m: np.ndarray
+    """(T-1,) float64 straight-line distance between the interval's two waypoints."""
 
     path_node: np.ndarray
     """(K,) int64 every waypoint in order; a repeated node is a wait or a relocation target."""
@@ -344,6 +346,7 @@ def build_plan(
         interval_unreachable=unreachable,
         interval_detour=detour,
         interval_zigzag=detour & (length <= ZIGZAG_MAX * straight),
+        interval_straight_m=straight,
         path_node=np.concatenate([target_node[:1], step_nodes]).astype(np.int64),
         path_interval=path_interval,
         path_deadline_s=target_seconds[path_interval + 1],

@@ -33,6 +33,7 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
+from decoy_cli.replay.plans import RATIO_TOLERANCE, ZIGZAG_MAX, PlayerPlan, running_seconds
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
@@ -86,7 +87,6 @@ class ReplayResult:
             late_detour=lateness["late_detour"].to_numpy(dtype=np.int64),
             late_speed=lateness["late_speed"].to_numpy(dtype=np.int64),
             late_gap=lateness["late_gap"].to_numpy(dtype=np.int64),
-            late_carried=lateness["late_carried"].to_numpy(dtype=np.int64),
             late_replay=lateness["late_replay"].to_numpy(dtype=np.int64),
             late_p95_s=lateness["late_p95_s"].to_numpy(dtype=float),
             stuck=self.stuck if self.stuck is not None else np.zeros(count, np.int64),
@@ -99,27 +99,15 @@ class ReplayResult:
     def lateness_table(self) -> pd.DataFrame:
         """Per player: targets, those reached, the share reached late (after their tick), how
         many more than one data frame late (`DATA_FRAME_S`) and why (`late_zigzag`,
-        `late_detour`, `late_speed`, `late_gap`, `late_carried`, `late_replay`: see
-        `ReplayTrace`), p95 and max lateness (s), relocations."""
+        `late_detour`, `late_speed`, `late_gap`, `late_replay`: see `ReplayTrace`), p95 and
+        max lateness (s), relocations."""
         rows = []
         for p, log in enumerate(self.logs):
             late = log.lateness_s
             reached = late[np.isfinite(late)]
-            plan = self.plan.plans[p]
             with np.errstate(invalid="ignore"):
                 over = late > DATA_FRAME_S + 1e-9  # unreached (NaN): not
-            # why it became late: the target before was already late (carried), else the
-            # interval to it asked too much (by the lattice's zig-zag, by a way round, even
-            # straight, or across a gap), else the replay's own delay
-            zigzag, detour, speed, gap = (np.zeros(len(late), dtype=bool) for _ in range(4))
-            zigzag[1:] = plan.interval_zigzag
-            detour[1:] = plan.interval_detour & ~plan.interval_zigzag
-            speed[1:] = plan.interval_infeasible & ~plan.interval_detour
-            gap[1:] = plan.interval_unreachable
-            asked_too_much = zigzag | detour | speed | gap
-            carried = np.zeros(len(late), dtype=bool)
-            carried[1:] = over[:-1]
-            zigzag, detour, speed, gap = (c & ~carried for c in (zigzag, detour, speed, gap))
+            cause = stretch_causes(self.plan.plans[p], self.plan.caps[p], late)
             rows.append(
                 {
                     "player": self.plan.players[p].name,
@@ -129,18 +117,59 @@ class ReplayResult:
                     if len(reached)
                     else np.nan,
                     "late_over_frame": int(over.sum()),
-                    "late_zigzag": int(np.sum(over & zigzag)),
-                    "late_detour": int(np.sum(over & detour)),
-                    "late_speed": int(np.sum(over & speed)),
-                    "late_gap": int(np.sum(over & gap)),
-                    "late_carried": int(np.sum(over & carried)),
-                    "late_replay": int(np.sum(over & ~asked_too_much & ~carried)),
+                    **{
+                        f"late_{name}": int(np.sum(over & (cause == k)))
+                        for k, name in enumerate(LATE_CAUSES)
+                    },
                     "late_p95_s": float(np.percentile(reached, 95)) if len(reached) else np.nan,
                     "late_max_s": float(reached.max()) if len(reached) else np.nan,
                     "relocations": log.relocations,
                 }
             )
         return pd.DataFrame(rows)
+
+
+LATE_CAUSES = ("zigzag", "detour", "speed", "gap", "replay")
+"""Why a late stretch began, as `stretch_causes` numbers them (`ReplayTrace` says each)."""
+
+
+def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.ndarray:
+    """(T,) for every target, why the stretch of late targets it belongs to began (an index into
+    `LATE_CAUSES`; -1 for a target on time or unreached).
+
+    A stretch is a run of targets reached late (after their tick); it began at the interval to
+    its first target, judged against the speed the replay may run there (`caps`): unreachable
+    (`gap`); asking more than the cap only by the graph's way round something, the straight
+    line between the two waypoints would be in time (`detour`) or only by the lattice's
+    zig-zag (`zigzag`); asking more even straight (`speed`: the waypoints lie farther apart
+    than the player ran, or the player outran the cap); within the cap (`replay`: the
+    replay's own delay, a wait or a stop).
+    """
+    count = len(late)
+    interval = np.full(count, LATE_CAUSES.index("replay"), dtype=np.int64)
+    if count > 1:
+        running = running_seconds(plan.interval_seconds, plan.interval_air_s)
+        straight = plan.interval_straight_m
+        with np.errstate(invalid="ignore"):
+            over_cap = plan.interval_required_speed_m_s > caps * (1.0 + RATIO_TOLERANCE)
+            straight_fits = straight / running <= caps * (1.0 + RATIO_TOLERANCE)
+        zigzag = plan.interval_length_m <= ZIGZAG_MAX * straight
+        kind = np.select(
+            [
+                plan.interval_unreachable,
+                over_cap & straight_fits & zigzag,
+                over_cap & straight_fits,
+                over_cap,
+            ],
+            [LATE_CAUSES.index(c) for c in ("gap", "zigzag", "detour", "speed")],
+            LATE_CAUSES.index("replay"),
+        )
+        interval[1:] = kind
+    with np.errstate(invalid="ignore"):
+        is_late = late > 1 / TICK_RATE + 1e-9
+    first = is_late & ~np.r_[False, is_late[:-1]]
+    start = np.maximum.accumulate(np.where(first, np.arange(count), 0))
+    return np.where(is_late, interval[start], -1)
 
 
 @dataclass(frozen=True, kw_only=True)
