@@ -84,6 +84,25 @@ def test_a_plant_with_bomb_events_begins_at_plant_begin_and_takes_the_rules_time
     assert row["bomb_anomalies"] == ""
 
 
+def test_the_planter_is_on_time_at_every_target_it_stands_at_while_planting(
+    tmp_path: Path,
+) -> None:
+    """Planting holds the carrier still where the real one stood planting: the targets of those
+    seconds are reached as they come, not all at once when the plant completes."""
+    scenario, t1 = carrier_round()
+    scenario.plant_tick = tick_of(PLANT_S)
+    scenario.event(tick_of(PLANT_BEGIN_S), "plant_begin", t1)
+    scenario.event(tick_of(PLANT_S), "plant", t1)
+    result = replayed(scenario, tmp_path)
+    plan = result.plan.plans[0]
+    during = (plan.target_seconds > PLANT_BEGIN_S) & (plan.target_seconds < PLANT_S)
+    assert during.sum() >= 4  # frames every 0.5 s through the 3 s plant
+    late = result.logs[0].lateness_s
+    assert np.all(late[during] <= 1 / TICK_RATE + 1e-9)
+    assert np.all(np.isfinite(late))
+    assert result.lateness_table().iloc[0]["late_over_frame"] == 0
+
+
 def test_a_plant_known_only_from_the_frames_is_the_first_planted_frame(tmp_path: Path) -> None:
     """The T-side files: no bomb events, `bombPlantTick` is the first frame showing the bomb
     planted (docs/metrics.md), known to the frame interval before it."""

@@ -107,12 +107,15 @@ class PlanPolicy:
         if plant and bomb.planter == agent:
             # planting, as the real player did: hold still until the plant completes, then
             # the plan resumes and catches up
-            left = config.plant_ticks - bomb.plant_ticks
-            return Decision(STOP_ACTION, hold_ticks=max(1, left), plant=True)
+            left = max(1, config.plant_ticks - bomb.plant_ticks)
+            self._stand_through(sim, agent, now + left)
+            return Decision(STOP_ACTION, hold_ticks=left, plant=True)
         if defuse and bomb.defuser == agent:  # likewise while defusing
             kit = bool(sim.agents.has_defuser[agent])
             left = (config.defuse_kit_ticks if kit else config.defuse_ticks) - bomb.defuse_ticks
-            return Decision(STOP_ACTION, hold_ticks=max(1, min(left, last - now + 1)), defuse=True)
+            hold = max(1, min(left, last - now + 1))
+            self._stand_through(sim, agent, now + hold)
+            return Decision(STOP_ACTION, hold_ticks=hold, defuse=True)
         decision = self._follow_plan(sim, agent, plan, now, plant, defuse)
         if decision.action == STOP_ACTION:
             # wake when the data's plant or this agent's defuse starts or ends, so the wish to
@@ -123,6 +126,24 @@ class PlanPolicy:
             if wakes:
                 decision = replace(decision, hold_ticks=min(wakes) - now)
         return decision
+
+    def _stand_through(self, sim: Simulator, agent: int, until: int) -> None:
+        """An agent held still (planting, defusing) until tick `until` reaches, now, the plan's
+        targets it stands at whose stand ends by then: the real player stood there too. Without
+        this their arrivals would wait for the hold's end and count as late."""
+        plan, a = self.plans[agent], int(self.next_action[agent])
+        node = int(sim.agents.node[agent])
+        if a > 0 and self._last_move[agent][a - 1] and int(plan.action_node[a - 1]) == node:
+            self._arrive(agent, int(plan.action_interval[a - 1]), sim.tick)  # the move's end
+        while (
+            a < len(plan.action)
+            and int(plan.action[a]) == STOP_ACTION
+            and int(plan.action_node[a]) == node
+            and self.tick_of(plan.action_deadline_s[a]) <= until
+        ):
+            self._arrive(agent, int(plan.action_interval[a]), sim.tick)
+            a += 1
+        self.next_action[agent] = a
 
     def _plants_here(self, sim: Simulator, agent: int, interval: int) -> bool:
         """Whether the carrier, about to leave its plan's plant spot by a move of `interval`,
