@@ -203,6 +203,11 @@ def test_a_defuse_follows_the_data_with_or_without_a_kit(
     assert row is not None and row["defuse_data"] and row["defuse_replay"]
     assert row["defuse_time_error_s"] == pytest.approx(rules_s - defuse_s, abs=ONE_TICK_S)
     assert result.outcome is not None and result.outcome.reason == "BombDefused"
+    # held still while defusing, the defuser reaches the targets it stands at as they come
+    plan, late = result.plan.plans[1], result.logs[1].lateness_s
+    during = (plan.target_seconds > 18.0) & (plan.target_seconds < done.tick / TICK_RATE)
+    assert during.sum() >= 8
+    assert np.all(late[during] <= 1 / TICK_RATE + 1e-9)
 
 
 def test_anomalies_in_the_bomb_data_are_replayed_and_named(tmp_path: Path) -> None:

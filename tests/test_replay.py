@@ -306,6 +306,21 @@ def test_a_late_stretch_is_put_down_to_how_its_first_interval_compares_with_the_
     assert cause_of(gap, caps) == {"gap"}
 
 
+def test_a_late_target_is_put_down_to_the_interval_that_added_most_lateness_in_its_stretch(
+    timed: Timed,
+) -> None:
+    _, result = timed
+    plan = result.plan.plans[DETOURER]
+    caps = result.plan.caps[DETOURER].copy()
+    assert plan.interval_detour[1] and len(plan.target_node) >= 7
+    caps[0] = 1e3  # the first interval within the cap: lateness there is the replay's own
+    late = np.zeros(len(plan.target_node))
+    late[1:4] = [0.05, 1.0, 0.8]  # a small delay, then the detour adds most, then catch-up
+    late[5] = 0.6  # a second stretch, on a standing interval within the cap
+    names = [LATE_CAUSES[c] if c >= 0 else "" for c in stretch_causes(plan, caps, late)]
+    assert names[:7] == ["", "replay", "detour", "detour", "", "replay", ""]
+
+
 def test_survivors_survive_and_the_round_is_undecided(timed: Timed) -> None:
     _, result = timed
     assert result.recording.alive[-1].all()

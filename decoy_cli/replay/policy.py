@@ -65,6 +65,7 @@ class PlanPolicy:
         self._remaining = []
         self._remaining_air = []  # seconds of those moves spent rising or falling
         self._last_move = []
+        self._stood: list[list[tuple[int, int]]] = [[] for _ in plans]  # (interval, tick)
         for plan in plans:
             n_targets = len(plan.target_node)
             arrival = np.full(n_targets, -1, dtype=np.int64)
@@ -100,6 +101,9 @@ class PlanPolicy:
     def decide(self, sim: Simulator, agent: int) -> Decision:
         plan = self.plans[agent]
         now = sim.tick
+        for interval, tick in self._stood[agent]:  # it lived through the hold: it stood there
+            self._arrive(agent, interval, tick)
+        self._stood[agent].clear()
         plant = self.plant is not None and now >= self.plant.start_tick
         first, last = self.defuse_window.get(agent, (FOREVER, FOREVER))
         defuse = first <= now <= last
@@ -128,20 +132,21 @@ class PlanPolicy:
         return decision
 
     def _stand_through(self, sim: Simulator, agent: int, until: int) -> None:
-        """An agent held still (planting, defusing) until tick `until` reaches, now, the plan's
-        targets it stands at whose stand ends by then: the real player stood there too. Without
-        this their arrivals would wait for the hold's end and count as late."""
+        """An agent held still (planting, defusing) until tick `until` reaches the plan's
+        targets it stands at whose stand ends by then as they come: the real player stood there
+        too. They are logged, from now, at its next decision (one it is killed before never
+        reaches them); without this they would wait for the hold's end and count as late."""
         plan, a = self.plans[agent], int(self.next_action[agent])
-        node = int(sim.agents.node[agent])
+        node, stood = int(sim.agents.node[agent]), self._stood[agent]
         if a > 0 and self._last_move[agent][a - 1] and int(plan.action_node[a - 1]) == node:
-            self._arrive(agent, int(plan.action_interval[a - 1]), sim.tick)  # the move's end
+            stood.append((int(plan.action_interval[a - 1]), sim.tick))  # the move's end
         while (
             a < len(plan.action)
             and int(plan.action[a]) == STOP_ACTION
             and int(plan.action_node[a]) == node
             and self.tick_of(plan.action_deadline_s[a]) <= until
         ):
-            self._arrive(agent, int(plan.action_interval[a]), sim.tick)
+            stood.append((int(plan.action_interval[a]), sim.tick))
             a += 1
         self.next_action[agent] = a
 

@@ -33,7 +33,7 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
-from decoy_cli.replay.plans import RATIO_TOLERANCE, ZIGZAG_MAX, PlayerPlan, running_seconds
+from decoy_cli.replay.plans import RATIO_TOLERANCE, ZIGZAG_MAX, PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
@@ -134,27 +134,26 @@ LATE_CAUSES = ("zigzag", "detour", "speed", "gap", "replay")
 
 
 def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.ndarray:
-    """(T,) for every target, why the stretch of late targets it belongs to began (an index into
-    `LATE_CAUSES`; -1 for a target on time or unreached).
+    """(T,) for every target reached late (after its tick), why: an index into `LATE_CAUSES`
+    (-1 for a target on time or unreached).
 
-    A stretch is a run of targets reached late (after their tick); it began at the interval to
-    its first target, judged against the speed the replay may run there (`caps`): unreachable
-    (`gap`); asking more than the cap only by the graph's way round something, the straight
-    line between the two waypoints would be in time (`detour`) or only by the lattice's
-    zig-zag (`zigzag`); asking more even straight (`speed`: the waypoints lie farther apart
-    than the player ran, or the player outran the cap); within the cap (`replay`: the
-    replay's own delay, a wait or a stop).
+    A late target is put down to the interval that added the most lateness in its stretch of
+    late targets so far (the run of late targets it ends), judged against the speed the replay
+    may run there (`caps`): unreachable (`gap`); asking more than the cap only by the graph's
+    way round something, the straight line between the two waypoints would be in time
+    (`detour`) or only by the lattice's zig-zag (`zigzag`); asking more even straight
+    (`speed`: the waypoints lie farther apart than the player ran, or the player outran the
+    cap); within the cap (`replay`: the replay's own delay, a wait or a stop).
     """
     count = len(late)
     interval = np.full(count, LATE_CAUSES.index("replay"), dtype=np.int64)
     if count > 1:
-        running = running_seconds(plan.interval_seconds, plan.interval_air_s)
         straight = plan.interval_straight_m
         with np.errstate(invalid="ignore"):
             over_cap = plan.interval_required_speed_m_s > caps * (1.0 + RATIO_TOLERANCE)
-            straight_fits = straight / running <= caps * (1.0 + RATIO_TOLERANCE)
+            straight_fits = straight / plan.interval_running_s <= caps * (1.0 + RATIO_TOLERANCE)
         zigzag = plan.interval_length_m <= ZIGZAG_MAX * straight
-        kind = np.select(
+        interval[1:] = np.select(
             [
                 plan.interval_unreachable,
                 over_cap & straight_fits & zigzag,
@@ -164,12 +163,18 @@ def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.n
             [LATE_CAUSES.index(c) for c in ("gap", "zigzag", "detour", "speed")],
             LATE_CAUSES.index("replay"),
         )
-        interval[1:] = kind
     with np.errstate(invalid="ignore"):
         is_late = late > 1 / TICK_RATE + 1e-9
-    first = is_late & ~np.r_[False, is_late[:-1]]
-    start = np.maximum.accumulate(np.where(first, np.arange(count), 0))
-    return np.where(is_late, interval[start], -1)
+    added = np.diff(np.where(is_late, late, 0.0), prepend=0.0)  # lateness each interval added
+    cause = np.full(count, -1, dtype=np.int64)
+    worst, most = -1, -np.inf
+    for target in np.flatnonzero(is_late).tolist():
+        if target == 0 or not is_late[target - 1]:
+            worst, most = target, -np.inf  # a new stretch
+        if added[target] > most:
+            worst, most = target, float(added[target])
+        cause[target] = interval[worst]
+    return cause
 
 
 @dataclass(frozen=True, kw_only=True)
