@@ -60,9 +60,8 @@ approximate)."""
 
 JUMP_HEIGHT_M = 65 * HAMMER_TO_M
 """Highest block a player gets onto with a crouch-jump: 65 u (Valve Developer Community, CS:GO
-Mapper's Reference, "Reachable Heights": crouch then jump 65, a plain jump 54). Maps use 64 u
-crates because a crouch-jump clears them; real T players climb them (`decoy build-waypoints`
-had no edge onto a 64 u ledge while this was 64 u, the rise being a rounding above it)."""
+Mapper's Reference, "Reachable Heights": crouch then jump 65, a plain jump 54). Maps build 64 u
+crates because a crouch-jump clears them."""
 
 GRAVITY_U_S2 = 800.0
 """sv_gravity: downward acceleration in Hammer units per second squared."""

@@ -257,7 +257,9 @@ def crate_room(height_u: float) -> LatticeResult:
         return build_lattice(physics, seeds_of(world))
 
 
-@pytest.mark.parametrize(("height_u", "climbed"), [(64.0, True), (65.0, True), (67.0, False)])
+@pytest.mark.parametrize(
+    ("height_u", "climbed"), [(64.0, True), (65.0, True), (66.0, False), (67.0, False)]
+)
 def test_a_crouch_jump_gets_onto_a_64_unit_crate_and_no_higher_than_65(
     height_u: float, climbed: bool
 ) -> None:

@@ -11,6 +11,7 @@ import pytest
 from worlds import box, floor, make_world, seeds_of, wall
 
 from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.waypoints import patch_check
 from decoy_cli.waypoints.build import build_graph
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.patch_check import (
@@ -69,7 +70,11 @@ BOXES = [patch_box(DOOR_BOX, 0), patch_box(STAND, 1)]
 
 THROUGH_THE_DOOR = [(3.5, 1.7, 0.0), (5.2, 1.7, 0.0), (6.8, 1.7, 0.0), (8.5, 1.7, 0.0)]
 """A walk from the west room to the east one through the doorway, a frame each 1.7 m."""
+IN_THE_DOOR = [(4.4, 1.7, 0.0), (6.0, 1.7, 0.0), (7.6, 1.7, 0.0)]
+"""The same walk with a frame in the doorway itself, where the door box stands."""
 ON_THE_STAND = [(9.2, 4.0, 0.9), (9.9, 4.7, 0.9), (9.5, 4.3, 0.9)]
+BESIDE_THE_STAND = [(8.2, 4.3, 0.0), (11.0, 4.3, 0.0)]
+"""On the floor either side of the stand: near a waypoint on both graphs, so nothing gained."""
 
 
 def tracks(*walks: tuple[int, list[tuple[float, float, float]]]) -> Tracks:
@@ -82,12 +87,14 @@ def tracks(*walks: tuple[int, list[tuple[float, float, float]]]) -> Tracks:
 
 def test_the_door_box_sends_paths_round_and_the_stand_gives_positions() -> None:
     bare, patched = graphs()
-    check = check_patches(bare, patched, BOXES, tracks((0, THROUGH_THE_DOOR), (1, ON_THE_STAND)))
+    walks = tracks((0, THROUGH_THE_DOOR), (1, ON_THE_STAND), (1, BESIDE_THE_STAND))
+    check = check_patches(bare, patched, BOXES, walks)
     door, stand = check.verdicts
     assert (door.lengthened, door.lengthened_matches, door.gained) == (1, 1, 0)
     assert (stand.lengthened, stand.gained) == (0, len(ON_THE_STAND))
     assert check.lengthened_pairs == 1
-    assert check.pairs == len(THROUGH_THE_DOOR) - 1  # the stand's positions: no bare waypoint
+    # the stand's positions have no bare waypoint; the walk beside the stand is not lengthened
+    assert check.pairs == len(THROUGH_THE_DOOR) - 1 + len(BESIDE_THE_STAND) - 1
 
 
 def test_a_box_that_lengthens_paths_in_two_matches_is_left_out() -> None:
@@ -98,6 +105,26 @@ def test_a_box_that_lengthens_paths_in_two_matches_is_left_out() -> None:
     kept = check.kept_boxes(BOXES)
     assert [b.patch for b in kept] == [1]
     assert (kept[0].paths_lengthened, kept[0].positions_gained) == (0, len(ON_THE_STAND))
+
+
+def test_a_frame_where_the_box_now_stands_counts_against_it() -> None:
+    """A player stood in the doorway: the patched graph has no waypoint there, so the pairs
+    into and out of that frame are lengthened (the box took the way)."""
+    bare, patched = graphs()
+    check = check_patches(bare, patched, BOXES, tracks((0, IN_THE_DOOR), (1, IN_THE_DOOR)))
+    door = check.verdicts[0]
+    assert (door.lengthened, door.lengthened_matches) == (4, 2)
+    assert not door.kept
+
+
+def test_the_path_searches_give_the_same_costs_in_any_batch_size(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    bare, patched = graphs()
+    walks = tracks((0, THROUGH_THE_DOOR), (1, THROUGH_THE_DOOR[::-1]), (2, IN_THE_DOOR))
+    whole = check_patches(bare, patched, BOXES, walks)
+    monkeypatch.setattr(patch_check, "_SOURCES_PER_SEARCH", 1)
+    assert check_patches(bare, patched, BOXES, walks) == whole
 
 
 def test_one_matchs_detour_leaves_the_box_in() -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -25,6 +26,7 @@ from decoy_cli.world.patch_boxes import SLAB_U
 from decoy_cli.world.patch_learning import (
     PatchBox,
     StandingPositions,
+    _match_tracks,
     learn_patches,
     patches_csv,
     read_positions,
@@ -289,3 +291,16 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
     assert result.exit_code == 0, result.output
     summary = json.loads((evaluated / "summary.json").read_text())
     assert summary["options"]["graph"] == str(out.resolve())
+
+
+def test_tracks_run_player_by_player_and_break_at_a_death_and_a_round() -> None:
+    """`follows` joins only a player's consecutive alive frames of one round."""
+    alive = np.array([[True, True, False, True], [True, True, True, True]])
+    position = np.arange(2 * 4 * 3, dtype=float).reshape(2, 4, 3)
+    position[1, 3] = np.nan  # a frame without a position: not a track position
+    one = SimpleNamespace(alive=alive, position=position)
+    two = SimpleNamespace(alive=np.array([[True, True]]), position=np.ones((1, 2, 3)))
+    points, follows = _match_tracks(SimpleNamespace(rounds=[one, two]))  # type: ignore[arg-type]
+    expected = [position[0, 0], position[0, 1], position[0, 3], *position[1, :3], [1, 1, 1]]
+    np.testing.assert_array_equal(points, np.array([*expected, [1, 1, 1]]))
+    assert follows.tolist() == [False, True, False, False, True, True, False, True]

@@ -129,6 +129,8 @@ def build_waypoints(
         world, built = nav_world(map_id, tuple(b.box for b in learned.kept)), learned.built
 
     started = time.perf_counter()
+    if built is not None:
+        console.print("the graph is the one the patch check built", highlight=False)
     with Progress(
         TextColumn("{task.description:<14}"),
         BarColumn(),
@@ -151,8 +153,8 @@ def build_waypoints(
         for task in tasks.values():
             progress.update(task, total=progress.tasks[task].completed or 1)
     graph.save(out)
-    elapsed = time.perf_counter() - started
     stats = result.stats
+    elapsed = time.perf_counter() - started + (sum(stats.seconds.values()) if built else 0.0)
 
     table = Table(title=f"waypoints of {world.source}")
     table.add_column("stage")
@@ -220,7 +222,7 @@ def build_waypoints(
         check_aligned(quality, min_aligned)
 
 
-def _count(boxes: list[patch_learning.PatchBox]) -> str:
+def _count(boxes: tuple[patch_learning.PatchBox, ...]) -> str:
     return f"{len({b.patch for b in boxes})} patches ({len(boxes)} boxes)"
 
 

@@ -9,17 +9,18 @@ stay.
 
 Method, on the graph built without any learned patch (bare) and with every candidate (patched):
 
-1. **What a patch costs.** For each pair of consecutive frames of a real player with a waypoint
-   within `ALIGNED_WITHIN_M` on both graphs, the shortest-path cost (`edge_cost`) on each. The
-   patched path is *lengthened* when it costs more than `LENGTHENED_RATIO` times the bare one
-   plus `LENGTHENED_EXTRA_M`. Each lengthened pair is blamed on the patches whose box, grown by
-   one lattice spacing sideways and `BLAME_REACH_M` up and down, holds a waypoint of the bare
-   path: the box took that way.
+1. **What a patch costs.** Each pair of consecutive frames of a real player at two different
+   bare waypoints (each within `ALIGNED_WITHIN_M`, the bare path at most `BARE_LIMIT_M`) is
+   compared with the patched graph. The pair is *lengthened* when the patched path costs
+   (`edge_cost`) more than `LENGTHENED_RATIO` times the bare one plus `LENGTHENED_EXTRA_M`, or
+   when an end has no patched waypoint within `ALIGNED_WITHIN_M` (a box filling the way the
+   player stood in). Each lengthened pair is blamed on the patches whose box holds a waypoint of
+   the bare path, the box grown by one lattice spacing sideways, `BLAME_BELOW_M` down and a
+   step up: the box took that way.
 2. **What a patch gives.** Real positions within `ALIGNED_WITHIN_M` of a patched waypoint on the
    patch's top (within a step of it) that have no bare waypoint that near.
 3. **Verdict.** A patch is left out when the pairs blamed on it come from at least
-   `MIN_MATCHES` matches (one match's detour can be one player's habit) and outnumber the
-   positions it gives.
+   `MIN_LENGTHENED_MATCHES` matches and outnumber the positions it gives.
 """
 
 from __future__ import annotations
@@ -43,8 +44,8 @@ from decoy_cli.world.patch_learning import MIN_MATCHES, PatchBox, Tracks
 from decoy_cli.world.physics import PhysicsWorld
 
 LENGTHENED_RATIO = 1.5
-"""A patched path longer than this many times the bare one is a detour, not the lattice's
-zig-zag (which differs between two builds by a few tenths of a metre)."""
+"""A patched path longer than this many times the bare one is a detour, not a difference of
+the lattice's zig-zag between two builds."""
 
 LENGTHENED_EXTRA_M = 3.0
 """...plus this much: more than a data frame's run at the fastest speed (250 u/s for 0.5 s,
@@ -54,9 +55,14 @@ BARE_LIMIT_M = 20.0
 """Longest bare path between consecutive frames that is compared; longer ones (a teleport, a
 position glitch) say nothing about a patch."""
 
-BLAME_REACH_M = PLAYER_HEIGHT_M + JUMP_HEIGHT_M
-"""How far above and below a box its bare-path waypoints are blamed: a standing player's height
-plus a crouch-jump's rise (game rules) is the most headroom a box can take from a path."""
+BLAME_BELOW_M = PLAYER_HEIGHT_M + JUMP_HEIGHT_M
+"""How far below a box its bare-path waypoints are blamed: a standing player's height plus a
+crouch-jump's rise (game rules) is the most headroom a box can take from a path under it.
+Above, a step: a box takes nothing from a path over its top."""
+
+MIN_LENGTHENED_MATCHES = 2
+"""Fewest matches the paths blamed on a patch must come from to leave it out: one match's
+detour can be one player's habit."""
 
 _SOURCES_PER_SEARCH = 256
 """Dijkstra sources searched together (each a row of the graph's size)."""
@@ -68,7 +74,8 @@ class PatchVerdict:
 
     patch: int
     lengthened: int
-    """Consecutive-frame pairs of real players whose path the patch lengthens."""
+    """Lengthened consecutive-frame pairs of real players blamed on the patch (a pair next to
+    several patches is blamed on each)."""
     lengthened_matches: int
     """Matches those pairs come from."""
     gained: int
@@ -76,7 +83,9 @@ class PatchVerdict:
 
     @property
     def kept(self) -> bool:
-        return not (self.lengthened_matches >= MIN_MATCHES and self.lengthened > self.gained)
+        return not (
+            self.lengthened_matches >= MIN_LENGTHENED_MATCHES and self.lengthened > self.gained
+        )
 
 
 @dataclass(frozen=True)
@@ -101,13 +110,13 @@ class PatchCheck:
 class LearnedPatches:
     """The patches learned from a set of matches, the check that weighed them, those kept."""
 
-    candidates: list[PatchBox]
+    candidates: tuple[PatchBox, ...]
     check: PatchCheck | None
     """None when nothing was learned."""
-    kept: list[PatchBox]
+    kept: tuple[PatchBox, ...]
     standing_positions: int
     built: tuple[WaypointGraph, LatticeResult] | None
-    """The graph on the kept patches when the check already built it (all were kept)."""
+    """The graph on the kept patches when the check already built it (all or none kept)."""
 
 
 def learn_checked_patches(
@@ -127,18 +136,19 @@ def learn_checked_patches(
     with PhysicsWorld(bare_world) as physics:
         candidates = patch_learning.learn_patches(standing, physics, nav, min_matches=min_matches)
     if not candidates:
-        return LearnedPatches([], None, [], len(standing.position), None)
-    bare, _ = build_graph(bare_world, map_id, seeds, params, manual)
+        return LearnedPatches((), None, (), len(standing.position), None)
+    bare = build_graph(bare_world, map_id, seeds, params, manual)
     patched_world = nav_world(map_id, tuple(b.box for b in candidates))
-    built = build_graph(patched_world, map_id, seeds, params, manual)
-    check = check_patches(bare, built[0], candidates, tracks, params)
-    kept = check.kept_boxes(candidates)
+    patched = build_graph(patched_world, map_id, seeds, params, manual)
+    check = check_patches(bare[0], patched[0], candidates, tracks, params)
+    kept = tuple(check.kept_boxes(candidates))
+    built = patched if len(kept) == len(candidates) else bare if not kept else None
     return LearnedPatches(
-        candidates=candidates,
+        candidates=tuple(candidates),
         check=check,
         kept=kept,
         standing_positions=len(standing.position),
-        built=built if len(kept) == len(candidates) else None,
+        built=built,
     )
 
 
@@ -154,8 +164,11 @@ def check_patches(
     box_m = np.array([_box_m(b) for b in boxes]).reshape(-1, 6)
     patch_of_box = np.array([b.patch for b in boxes], dtype=np.int64)
     patches = sorted(set(patch_of_box.tolist()))
-    blamed, pairs, lengthened = _lengthened(bare, patched, box_m, patch_of_box, tracks, params)
-    gained = _gained(bare, patched, box_m, patch_of_box, tracks)
+    on_bare, on_patched = _snapped(bare, tracks), _snapped(patched, tracks)
+    blamed, pairs, lengthened = _lengthened(
+        bare, patched, (on_bare, on_patched), box_m, patch_of_box, tracks, params
+    )
+    gained = _gained(patched, (on_bare, on_patched), box_m, patch_of_box)
     verdicts = tuple(
         PatchVerdict(
             patch=p,
@@ -175,51 +188,53 @@ def _box_m(box: PatchBox) -> tuple[float, ...]:
     )
 
 
-def _snapped(graph: WaypointGraph, position: np.ndarray) -> np.ndarray:
-    index, _ = graph.nearest(position, max_distance=ALIGNED_WITHIN_M)
+def _snapped(graph: WaypointGraph, tracks: Tracks) -> np.ndarray:
+    """The waypoint within `ALIGNED_WITHIN_M` of every track position (-1: none)."""
+    if len(tracks.position) == 0:
+        return np.zeros(0, dtype=np.int64)
+    index, _ = graph.nearest(tracks.position, max_distance=ALIGNED_WITHIN_M)
     return index
 
 
 def _lengthened(
     bare: WaypointGraph,
     patched: WaypointGraph,
+    snapped: tuple[np.ndarray, np.ndarray],
     box_m: np.ndarray,
     patch_of_box: np.ndarray,
     tracks: Tracks,
     params: LatticeParams,
 ) -> tuple[dict[int, list[int]], int, int]:
     """({patch: match of each pair blamed on it}, pairs compared, pairs lengthened)."""
-    if len(tracks.position) == 0:
-        return {}, 0, 0
-    on_bare, on_patched = _snapped(bare, tracks.position), _snapped(patched, tracks.position)
+    on_bare, on_patched = snapped
     end = np.flatnonzero(tracks.follows)
     start = end - 1
     a0, b0, a1, b1 = on_bare[start], on_bare[end], on_patched[start], on_patched[end]
-    use = (np.minimum.reduce([a0, b0, a1, b1]) >= 0) & (a0 != b0)
+    use = (a0 >= 0) & (b0 >= 0) & (a0 != b0)
     a0, b0, a1, b1, end = a0[use], b0[use], a1[use], b1[use], end[use]
     bare_cost = _path_costs(bare, a0, b0, BARE_LIMIT_M)
     compared = np.isfinite(bare_cost)
+    a0, b0, a1, b1, end, bare_cost = (v[compared] for v in (a0, b0, a1, b1, end, bare_cost))
+    on_both = (a1 >= 0) & (b1 >= 0)  # an end with no patched waypoint: lengthened
+    patched_cost = np.full(len(a1), np.inf)
     patched_limit = LENGTHENED_RATIO * BARE_LIMIT_M + LENGTHENED_EXTRA_M
-    patched_cost = _path_costs(patched, a1[compared], b1[compared], patched_limit)
-    worse = patched_cost > LENGTHENED_RATIO * bare_cost[compared] + LENGTHENED_EXTRA_M
+    patched_cost[on_both] = _path_costs(patched, a1[on_both], b1[on_both], patched_limit)
+    worse = patched_cost > LENGTHENED_RATIO * bare_cost + LENGTHENED_EXTRA_M
     blamed: dict[int, list[int]] = {}
-    grow = np.array([-params.spacing, -params.spacing, params.spacing, params.spacing])
-    low = box_m[:, :4] + grow
-    for source, target, row in zip(
-        a0[compared][worse], b0[compared][worse], end[compared][worse], strict=True
-    ):
+    grow = params.spacing
+    for source, target, row in zip(a0[worse], b0[worse], end[worse], strict=True):
         nodes = bare.positions[bare.shortest_path(int(source), int(target))]
         hit = (
-            (nodes[:, None, 0] >= low[:, 0])
-            & (nodes[:, None, 1] >= low[:, 1])
-            & (nodes[:, None, 0] <= low[:, 2])
-            & (nodes[:, None, 1] <= low[:, 3])
-            & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_REACH_M)
-            & (nodes[:, None, 2] <= box_m[:, 5] + BLAME_REACH_M)
+            (nodes[:, None, 0] >= box_m[:, 0] - grow)
+            & (nodes[:, None, 1] >= box_m[:, 1] - grow)
+            & (nodes[:, None, 0] <= box_m[:, 2] + grow)
+            & (nodes[:, None, 1] <= box_m[:, 3] + grow)
+            & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_BELOW_M)
+            & (nodes[:, None, 2] <= box_m[:, 5] + STEP_HEIGHT_M)
         ).any(axis=0)
         for patch in set(patch_of_box[hit].tolist()):
             blamed.setdefault(patch, []).append(int(tracks.match[row]))
-    return blamed, int(compared.sum()), int(worse.sum())
+    return blamed, len(a0), int(worse.sum())
 
 
 def _path_costs(
@@ -237,15 +252,13 @@ def _path_costs(
 
 
 def _gained(
-    bare: WaypointGraph,
     patched: WaypointGraph,
+    snapped: tuple[np.ndarray, np.ndarray],
     box_m: np.ndarray,
     patch_of_box: np.ndarray,
-    tracks: Tracks,
 ) -> dict[int, int]:
     """{patch: real positions near a patched waypoint on its top and far from every bare one}."""
-    if len(tracks.position) == 0:
-        return {}
+    on_bare, on_patched = snapped
     node = patched.positions
     node_patch = np.full(patched.num_nodes, -1, dtype=np.int64)
     for box, patch in zip(box_m, patch_of_box, strict=True):
@@ -257,8 +270,6 @@ def _gained(
             & (np.abs(node[:, 2] - box[5]) <= STEP_HEIGHT_M)
         )
         node_patch[on_top] = patch
-    near_patched = _snapped(patched, tracks.position)
-    only_patched = (near_patched >= 0) & (_snapped(bare, tracks.position) < 0)
-    owner = node_patch[near_patched[only_patched]]
+    owner = node_patch[on_patched[(on_patched >= 0) & (on_bare < 0)]]
     patches, counts = np.unique(owner[owner >= 0], return_counts=True)
     return dict(zip(patches.tolist(), counts.tolist(), strict=True))
