@@ -18,6 +18,7 @@ from decoy_cli.waypoints.patch_check import (
     LENGTHENED_EXTRA_M,
     LENGTHENED_RATIO,
     PatchVerdict,
+    _deep_inside,
     check_patches,
 )
 from decoy_cli.world.patch_learning import PatchBox, Tracks
@@ -162,3 +163,27 @@ def test_no_tracks_keep_every_patch() -> None:
     empty = Tracks(np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0, bool))
     check = check_patches(bare, patched, BOXES, empty)
     assert check.pairs == 0 and all(v.kept for v in check.verdicts)
+
+
+def test_a_pair_the_patched_graph_joins_much_shorter_is_credited_to_the_patch_beside_it() -> None:
+    """The graphs swapped: the door box is in the 'bare' graph and the 'patched' one goes
+    through the doorway, so the walk is much shorter there, beside the door box."""
+    bare, patched = graphs()
+    walks = tracks((0, THROUGH_THE_DOOR), (1, THROUGH_THE_DOOR))
+    check = check_patches(patched, bare, BOXES, walks)
+    door, stand = check.verdicts
+    assert (door.shortened, door.lengthened) == (2, 0)
+    assert stand.shortened == 0 and check.lengthened_pairs == 0
+
+
+def test_only_a_spot_deep_inside_a_box_is_filled_by_it() -> None:
+    x0, y0, x1, y1, top = DOOR_BOX
+    box_m = np.array([[x0, y0, x1, y1, 0.0, top]])
+    points = np.array(
+        [
+            [(x0 + x1) / 2, (y0 + y1) / 2, 0.0],  # in the middle of the doorway
+            [x0 + 0.1, (y0 + y1) / 2, 0.0],  # at the box's edge: grown over the feet
+            [(x0 + x1) / 2, (y0 + y1) / 2, top + 1.0],  # above it
+        ]
+    )
+    assert _deep_inside(points, box_m, np.array([0])).tolist() == [True, False, False]

@@ -65,7 +65,11 @@ def test_until_is_asked_whenever_more_than_motion_may_have_happened(physics) -> 
     def deaths(count: int) -> Callable[[Simulator], bool]:
         return lambda sim: int((~sim.agents.alive).sum()) >= count
 
-    cases = [(seed, decisions(5 + 49 * seed)) for seed in range(8)]
+    # a count of decisions part way through each round (the whole round's count, stepped)
+    totals = [
+        int(_play(physics, "kinematic", seed, every_tick).decisions.sum()) for seed in range(8)
+    ]
+    cases = [(seed, decisions(max(5, totals[seed] * (seed + 1) // 9))) for seed in range(8)]
     for seed, until in [*cases, (5, deaths(2)), (6, deaths(1))]:
 
         def step_until(sim: Simulator, until=until) -> None:

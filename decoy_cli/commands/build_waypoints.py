@@ -243,17 +243,19 @@ def _show_learned(console: Console, learned: patch_check.LearnedPatches, files: 
     )
     if not left_out:
         return
-    table = Table(title="left out: they lengthen more real paths than they give positions")
+    table = Table(title="left out: they lengthen more real paths than they give")
     table.add_column("patch", justify="right")
     table.add_column("paths lengthened", justify="right")
     table.add_column("in matches", justify="right")
     table.add_column("positions gained", justify="right")
+    table.add_column("paths shortened", justify="right")
     for verdict in left_out:
         table.add_row(
             str(verdict.patch),
             f"{verdict.lengthened:,}",
             str(verdict.lengthened_matches),
             f"{verdict.gained:,}",
+            f"{verdict.shortened:,}",
         )
     console.print(table)
 

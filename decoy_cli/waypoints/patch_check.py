@@ -11,16 +11,20 @@ Method, on the graph built without any learned patch (bare) and with every candi
 
 1. **What a patch costs.** Each pair of consecutive frames of a real player at two different
    bare waypoints (each within `ALIGNED_WITHIN_M`, the bare path at most `BARE_LIMIT_M`) is
-   compared with the patched graph. The pair is *lengthened* when the patched path costs
+   compared with the patched graph (each path searched up to the longest a lengthened pair
+   needs). The pair is *lengthened* when the patched path costs
    (`edge_cost`) more than `LENGTHENED_RATIO` times the bare one plus `LENGTHENED_EXTRA_M`, or
-   when an end has no patched waypoint within `ALIGNED_WITHIN_M` (a box filling the way the
-   player stood in). Each lengthened pair is blamed on the patches whose box holds a waypoint of
+   when an end has no patched waypoint within `ALIGNED_WITHIN_M` because a box fills the spot
+   the player stood in (deeper inside it than the learning grows a box; an end at a box's edge
+   leaves the pair out). Each lengthened pair is blamed on the patches whose box holds a waypoint of
    the bare path, the box grown by one lattice spacing sideways, `BLAME_BELOW_M` down and a
    step up: the box took that way.
 2. **What a patch gives.** Real positions within `ALIGNED_WITHIN_M` of a patched waypoint on the
-   patch's top (within a step of it) that have no bare waypoint that near.
+   patch's top (within a step of it) that have no bare waypoint that near; and pairs the
+   patched graph joins by a much shorter path (the same rule the other way: a way up the
+   patch opens), credited to the patches beside the patched path in the same way.
 3. **Verdict.** A patch is left out when the pairs blamed on it come from at least
-   `MIN_LENGTHENED_MATCHES` matches and outnumber the positions it gives.
+   `MIN_LENGTHENED_MATCHES` matches and outnumber what it gives.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from decoy_cli.waypoints.lattice_params import LatticeParams
 from decoy_cli.waypoints.quality import ALIGNED_WITHIN_M
 from decoy_cli.world import patch_learning
 from decoy_cli.world.navmesh import load_navmesh, nav_world
+from decoy_cli.world.patch_boxes import CELL_U
 from decoy_cli.world.patch_learning import MIN_MATCHES, PatchBox, Tracks
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -80,11 +85,15 @@ class PatchVerdict:
     """Matches those pairs come from."""
     gained: int
     """Real positions on the patch's top that only the patched graph has a waypoint near."""
+    shortened: int = 0
+    """Consecutive-frame pairs of real players the patched graph joins by a much shorter path
+    (the same rule as lengthened, the other way) that runs beside the patch."""
 
     @property
     def kept(self) -> bool:
         return not (
-            self.lengthened_matches >= MIN_LENGTHENED_MATCHES and self.lengthened > self.gained
+            self.lengthened_matches >= MIN_LENGTHENED_MATCHES
+            and self.lengthened > self.gained + self.shortened
         )
 
 
@@ -100,7 +109,9 @@ class PatchCheck:
         """The boxes of the patches that stay, each with its verdict's counts as evidence."""
         verdict = {v.patch: v for v in self.verdicts}
         return [
-            b.with_check(verdict[b.patch].lengthened, verdict[b.patch].gained)
+            b.with_check(
+                verdict[b.patch].lengthened, verdict[b.patch].gained, verdict[b.patch].shortened
+            )
             for b in boxes
             if verdict[b.patch].kept
         ]
@@ -165,7 +176,7 @@ def check_patches(
     patch_of_box = np.array([b.patch for b in boxes], dtype=np.int64)
     patches = sorted(set(patch_of_box.tolist()))
     on_bare, on_patched = _snapped(bare, tracks), _snapped(patched, tracks)
-    blamed, pairs, lengthened = _lengthened(
+    blamed, credited, pairs, lengthened = _path_changes(
         bare, patched, (on_bare, on_patched), box_m, patch_of_box, tracks, params
     )
     gained = _gained(patched, (on_bare, on_patched), box_m, patch_of_box)
@@ -175,6 +186,7 @@ def check_patches(
             lengthened=len(blamed.get(p, ())),
             lengthened_matches=len(set(blamed.get(p, ()))),
             gained=int(gained.get(p, 0)),
+            shortened=int(credited.get(p, 0)),
         )
         for p in patches
     )
@@ -196,7 +208,7 @@ def _snapped(graph: WaypointGraph, tracks: Tracks) -> np.ndarray:
     return index
 
 
-def _lengthened(
+def _path_changes(
     bare: WaypointGraph,
     patched: WaypointGraph,
     snapped: tuple[np.ndarray, np.ndarray],
@@ -204,37 +216,83 @@ def _lengthened(
     patch_of_box: np.ndarray,
     tracks: Tracks,
     params: LatticeParams,
-) -> tuple[dict[int, list[int]], int, int]:
-    """({patch: match of each pair blamed on it}, pairs compared, pairs lengthened)."""
+) -> tuple[dict[int, list[int]], dict[int, int], int, int]:
+    """({patch: match of each lengthened pair blamed on it}, {patch: shortened pairs credited
+    to it}, pairs compared, pairs lengthened)."""
     on_bare, on_patched = snapped
     end = np.flatnonzero(tracks.follows)
     start = end - 1
     a0, b0, a1, b1 = on_bare[start], on_bare[end], on_patched[start], on_patched[end]
     use = (a0 >= 0) & (b0 >= 0) & (a0 != b0)
     a0, b0, a1, b1, end = a0[use], b0[use], a1[use], b1[use], end[use]
-    bare_cost = _path_costs(bare, a0, b0, BARE_LIMIT_M)
-    compared = np.isfinite(bare_cost)
-    a0, b0, a1, b1, end, bare_cost = (v[compared] for v in (a0, b0, a1, b1, end, bare_cost))
-    on_both = (a1 >= 0) & (b1 >= 0)  # an end with no patched waypoint: lengthened
+    limit = LENGTHENED_RATIO * BARE_LIMIT_M + LENGTHENED_EXTRA_M
+    bare_cost = _path_costs(bare, a0, b0, limit)
+    on_both = (a1 >= 0) & (b1 >= 0)
     patched_cost = np.full(len(a1), np.inf)
-    patched_limit = LENGTHENED_RATIO * BARE_LIMIT_M + LENGTHENED_EXTRA_M
-    patched_cost[on_both] = _path_costs(patched, a1[on_both], b1[on_both], patched_limit)
-    worse = patched_cost > LENGTHENED_RATIO * bare_cost + LENGTHENED_EXTRA_M
+    patched_cost[on_both] = _path_costs(patched, a1[on_both], b1[on_both], limit)
+    # an end with no patched waypoint is lengthened when a box fills the spot (it stands deep
+    # inside one), else not compared (the box's edge grew over the player's feet)
+    position = tracks.position
+    filled = (a1 >= 0) | _deep_inside(position[end - 1], box_m, patch_of_box)
+    filled &= (b1 >= 0) | _deep_inside(position[end], box_m, patch_of_box)
+    compared = ((bare_cost <= BARE_LIMIT_M) | (patched_cost <= BARE_LIMIT_M)) & filled
+    with np.errstate(invalid="ignore"):
+        worse = compared & (patched_cost > LENGTHENED_RATIO * bare_cost + LENGTHENED_EXTRA_M)
+        better = compared & (bare_cost > LENGTHENED_RATIO * patched_cost + LENGTHENED_EXTRA_M)
     blamed: dict[int, list[int]] = {}
+    for row in np.flatnonzero(worse).tolist():
+        for patch in _patches_beside(bare, int(a0[row]), int(b0[row]), box_m, patch_of_box, params):
+            blamed.setdefault(patch, []).append(int(tracks.match[end[row]]))
+    credited: dict[int, int] = {}
+    for row in np.flatnonzero(better).tolist():
+        near = _patches_beside(patched, int(a1[row]), int(b1[row]), box_m, patch_of_box, params)
+        for patch in near:
+            credited[patch] = credited.get(patch, 0) + 1
+    return blamed, credited, int(compared.sum()), int(worse.sum())
+
+
+def _deep_inside(position: np.ndarray, box_m: np.ndarray, patch_of_box: np.ndarray) -> np.ndarray:
+    """(N,) whether each position stands in a patch's boxes (between a box's bottom and a step
+    above its top) more than one learned column (`CELL_U`) from the patch's edge: where the
+    box fills a spot, not where its edge was grown over a player's feet."""
+    reach = CELL_U * HAMMER_TO_M
+    probes = np.array([[0.0, 0.0], [reach, 0.0], [-reach, 0.0], [0.0, reach], [0.0, -reach]])
+    deep = np.zeros(len(position), dtype=bool)
+    for patch in np.unique(patch_of_box).tolist():
+        mine = box_m[patch_of_box == patch]
+        height = (position[:, None, 2] >= mine[:, 4]) & (
+            position[:, None, 2] <= mine[:, 5] + STEP_HEIGHT_M
+        )
+        everywhere = np.ones(len(position), dtype=bool)
+        for dx, dy in probes:
+            x, y = position[:, None, 0] + dx, position[:, None, 1] + dy
+            inside = (x >= mine[:, 0]) & (x <= mine[:, 2]) & (y >= mine[:, 1]) & (y <= mine[:, 3])
+            everywhere &= (inside & height).any(axis=1)
+        deep |= everywhere
+    return deep
+
+
+def _patches_beside(
+    graph: WaypointGraph,
+    source: int,
+    target: int,
+    box_m: np.ndarray,
+    patch_of_box: np.ndarray,
+    params: LatticeParams,
+) -> set[int]:
+    """The patches whose box holds a waypoint of the graph's shortest path from `source` to
+    `target`: grown by one lattice spacing sideways, `BLAME_BELOW_M` down and a step up."""
+    nodes = graph.positions[graph.shortest_path(source, target)]
     grow = params.spacing
-    for source, target, row in zip(a0[worse], b0[worse], end[worse], strict=True):
-        nodes = bare.positions[bare.shortest_path(int(source), int(target))]
-        hit = (
-            (nodes[:, None, 0] >= box_m[:, 0] - grow)
-            & (nodes[:, None, 1] >= box_m[:, 1] - grow)
-            & (nodes[:, None, 0] <= box_m[:, 2] + grow)
-            & (nodes[:, None, 1] <= box_m[:, 3] + grow)
-            & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_BELOW_M)
-            & (nodes[:, None, 2] <= box_m[:, 5] + STEP_HEIGHT_M)
-        ).any(axis=0)
-        for patch in set(patch_of_box[hit].tolist()):
-            blamed.setdefault(patch, []).append(int(tracks.match[row]))
-    return blamed, len(a0), int(worse.sum())
+    hit = (
+        (nodes[:, None, 0] >= box_m[:, 0] - grow)
+        & (nodes[:, None, 1] >= box_m[:, 1] - grow)
+        & (nodes[:, None, 0] <= box_m[:, 2] + grow)
+        & (nodes[:, None, 1] <= box_m[:, 3] + grow)
+        & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_BELOW_M)
+        & (nodes[:, None, 2] <= box_m[:, 5] + STEP_HEIGHT_M)
+    ).any(axis=0)
+    return set(patch_of_box[hit].tolist())
 
 
 def _path_costs(

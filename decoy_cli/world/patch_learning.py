@@ -92,6 +92,7 @@ EVIDENCE_COLUMNS = (
     "place",
     "paths_lengthened",
     "positions_gained",
+    "paths_shortened",
 )
 
 
@@ -134,10 +135,17 @@ class PatchBox:
     """Real consecutive-frame paths the patch lengthens (None: not checked)."""
     positions_gained: int | None = None
     """Real positions only the patch puts near a waypoint (None: not checked)."""
+    paths_shortened: int | None = None
+    """Real consecutive-frame paths the patch shortens (None: not checked)."""
 
-    def with_check(self, lengthened: int, gained: int) -> PatchBox:
+    def with_check(self, lengthened: int, gained: int, shortened: int) -> PatchBox:
         """The same box with the counts of its patch's check as evidence."""
-        return replace(self, paths_lengthened=lengthened, positions_gained=gained)
+        return replace(
+            self,
+            paths_lengthened=lengthened,
+            positions_gained=gained,
+            paths_shortened=shortened,
+        )
 
     @property
     def box(self) -> tuple[float, ...]:
