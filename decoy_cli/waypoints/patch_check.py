@@ -10,15 +10,14 @@ stay.
 Method, on the graph built without any learned patch (bare) and with every candidate (patched):
 
 1. **What a patch costs.** Each pair of consecutive frames of a real player at two different
-   bare waypoints (each within `ALIGNED_WITHIN_M`, the bare path at most `BARE_LIMIT_M`) is
-   compared with the patched graph (each path searched up to the longest a lengthened pair
-   needs). The pair is *lengthened* when the patched path costs
-   (`edge_cost`) more than `LENGTHENED_RATIO` times the bare one plus `LENGTHENED_EXTRA_M`, or
-   when an end has no patched waypoint within `ALIGNED_WITHIN_M` because a box fills the spot
-   the player stood in (deeper inside it than the learning grows a box; an end at a box's edge
-   leaves the pair out). Each lengthened pair is blamed on the patches whose box holds a waypoint of
-   the bare path, the box grown by one lattice spacing sideways, `BLAME_BELOW_M` down and a
-   step up: the box took that way.
+   bare waypoints (each within `ALIGNED_WITHIN_M`; the path on one of the graphs at most
+   `BARE_LIMIT_M`) is compared with the patched graph. The pair is *lengthened* when the
+   patched path costs (`edge_cost`) more than `LENGTHENED_RATIO` times the bare one plus
+   `LENGTHENED_EXTRA_M`, or when an end has no patched waypoint within `ALIGNED_WITHIN_M`
+   because a box fills the spot the player stood in (deeper inside it than the learning grows
+   a box; an end at a box's edge leaves the pair out). Each lengthened pair is blamed on the
+   patches whose box holds a waypoint of the bare path, the box grown by one lattice spacing
+   sideways, `BLAME_BELOW_M` down and a step up: the box took that way.
 2. **What a patch gives.** Real positions within `ALIGNED_WITHIN_M` of a patched waypoint on the
    patch's top (within a step of it) that have no bare waypoint that near; and pairs the
    patched graph joins by a much shorter path (the same rule the other way: a way up the
@@ -57,8 +56,8 @@ LENGTHENED_EXTRA_M = 3.0
 2.4 m), so a lengthened pair makes a replay at least a frame late."""
 
 BARE_LIMIT_M = 20.0
-"""Longest bare path between consecutive frames that is compared; longer ones (a teleport, a
-position glitch) say nothing about a patch."""
+"""Longest path between consecutive frames, on either graph, for the pair to be compared;
+longer ones on both (a teleport, a position glitch) say nothing about a patch."""
 
 BLAME_BELOW_M = PLAYER_HEIGHT_M + JUMP_HEIGHT_M
 """How far below a box its bare-path waypoints are blamed: a standing player's height plus a
