@@ -103,6 +103,24 @@ def test_the_planter_is_on_time_at_every_target_it_stands_at_while_planting(
     assert result.lateness_table().iloc[0]["late_over_frame"] == 0
 
 
+def test_a_planter_held_still_does_not_reach_a_target_elsewhere(tmp_path: Path) -> None:
+    """The data has the planter a waypoint away during one frame of the plant (jitter): the
+    replay's planter, held still, reaches that target only after the plant, late."""
+    scenario, t1 = carrier_round()
+    scenario.plant_tick = tick_of(PLANT_S)
+    scenario.event(tick_of(PLANT_BEGIN_S), "plant_begin", t1)
+    scenario.event(tick_of(PLANT_S), "plant", t1)
+    walk, _ = site_a_walk()
+    away = next(j for j in range(scenario.frames) if frame_tick(j) > tick_of(PLANT_BEGIN_S + 1.0))
+    t1.nodes = [*t1.nodes[:away], walk[-2], *t1.nodes[away + 1 :]]
+    result = replayed(scenario, tmp_path)
+    plan, late = result.plan.plans[0], result.logs[0].lateness_s
+    elsewhere = np.flatnonzero(plan.target_node != plan.target_node[-1])
+    during = elsewhere[(plan.target_seconds[elsewhere] > PLANT_BEGIN_S)]
+    assert len(during) == 1
+    assert late[during[0]] > 1.0  # reached after the plant ended, not while held elsewhere
+
+
 def test_a_plant_known_only_from_the_frames_is_the_first_planted_frame(tmp_path: Path) -> None:
     """The T-side files: no bomb events, `bombPlantTick` is the first frame showing the bomb
     planted (docs/metrics.md), known to the frame interval before it."""
