@@ -178,7 +178,7 @@ def test_a_pair_the_patched_graph_joins_much_shorter_is_credited_to_the_patch_be
 
 def test_only_a_spot_deep_inside_a_box_is_filled_by_it() -> None:
     x0, y0, x1, y1, top = DOOR_BOX
-    box_m = np.array([[x0, y0, x1, y1, 0.0, top]])
+    box_m = np.array([[x0, y0, x1, y1, top, 0.0]])  # the patches file's column order
     points = np.array(
         [
             [(x0 + x1) / 2, (y0 + y1) / 2, 0.0],  # in the middle of the doorway

@@ -46,9 +46,9 @@ class ReplayTrace:
     data shows a death (`died_original`), whether the replay removed the player at its data
     death time rather than by combat (`scripted_death`), the share of plan targets reached late
     and the 95th percentile lateness in seconds (NaN when none was reached), the targets reached
-    and how many of them more than one data frame late, split by why the stretch of late
-    targets each belongs to began (the interval to its first target, against the speed the
-    replay may run there: `late_zigzag` asked more only by the lattice's zig-zag, `late_detour`
+    and how many of them more than one data frame late, split by why (the interval that added
+    most lateness in its stretch of late targets up to it, against the speed the replay may
+    run there: `late_zigzag` asked more only by the lattice's zig-zag, `late_detour`
     only by a way round something, the straight line would do; `late_speed` more even
     straight; `late_gap` across a gap of the graph, relocated; `late_replay` nothing beyond the
     cap, the replay's own delay), stuck

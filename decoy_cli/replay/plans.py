@@ -324,9 +324,7 @@ def build_plan(
     straight = np.linalg.norm(
         graph.positions[target_node[1:]] - graph.positions[target_node[:-1]], axis=1
     )
-    straight_ratio = straight / running / max_speed  # the same air time as the path's
-    infeasible = ratio > 1.0 + RATIO_TOLERANCE
-    detour = infeasible & (straight_ratio <= 1.0 + RATIO_TOLERANCE)
+    infeasible, detour, zigzag = asks_more(required, straight, running, length, max_speed)
     path_interval = np.concatenate([np.full(len(target_node[:1]), -1), action_interval])
     target_path_index = np.concatenate([[0], np.cumsum(steps)])[: len(target_node)]
     last_alive_frame, death_frame = _fate(alive, present)
@@ -345,7 +343,7 @@ def build_plan(
         interval_infeasible=infeasible,
         interval_unreachable=unreachable,
         interval_detour=detour,
-        interval_zigzag=detour & (length <= ZIGZAG_MAX * straight),
+        interval_zigzag=zigzag,
         interval_straight_m=straight,
         path_node=np.concatenate([target_node[:1], step_nodes]).astype(np.int64),
         path_interval=path_interval,
@@ -360,6 +358,25 @@ def build_plan(
         death_frame=death_frame,
         death_seconds=float(seconds[death_frame]) if death_frame >= 0 else float("nan"),
     )
+
+
+def asks_more(
+    required: np.ndarray,
+    straight: np.ndarray,
+    running: np.ndarray,
+    length: np.ndarray,
+    limit: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Which intervals ask for more than a speed `limit` (m/s, per interval): (over the limit;
+    only by the graph's way, the straight line between the two waypoints would be within it;
+    of those, only by the lattice's zig-zag, `ZIGZAG_MAX`). `required` is the path's speed over
+    the `running` time, `straight` the waypoints' distance, `length` the path's (NaN:
+    unreachable, never a zig-zag)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        over = required / limit > 1.0 + RATIO_TOLERANCE
+        straight_fits = straight / running / limit <= 1.0 + RATIO_TOLERANCE
+    detour = over & straight_fits
+    return over, detour, detour & (length <= ZIGZAG_MAX * straight)
 
 
 def running_seconds(seconds: np.ndarray, air: np.ndarray) -> np.ndarray:

@@ -33,7 +33,7 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
-from decoy_cli.replay.plans import RATIO_TOLERANCE, ZIGZAG_MAX, PlayerPlan
+from decoy_cli.replay.plans import PlayerPlan, asks_more
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
@@ -130,7 +130,7 @@ class ReplayResult:
 
 
 LATE_CAUSES = ("zigzag", "detour", "speed", "gap", "replay")
-"""Why a late stretch began, as `stretch_causes` numbers them (`ReplayTrace` says each)."""
+"""Why a target is late, as `stretch_causes` numbers them (`ReplayTrace` says each)."""
 
 
 def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.ndarray:
@@ -138,9 +138,10 @@ def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.n
     (-1 for a target on time or unreached).
 
     A late target is put down to the interval that added the most lateness in its stretch of
-    late targets so far (the run of late targets it ends), judged against the speed the replay
-    may run there (`caps`): unreachable (`gap`); asking more than the cap only by the graph's
-    way round something, the straight line between the two waypoints would be in time
+    late targets (consecutive targets reached late) up to it, judged against the speed the
+    replay may run there (`caps`, as `asks_more` judges): unreachable (`gap`); asking more
+    than the cap only by the graph's way round something, the straight line between the two
+    waypoints would be in time
     (`detour`) or only by the lattice's zig-zag (`zigzag`); asking more even straight
     (`speed`: the waypoints lie farther apart than the player ran, or the player outran the
     cap); within the cap (`replay`: the replay's own delay, a wait or a stop).
@@ -148,18 +149,15 @@ def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.n
     count = len(late)
     interval = np.full(count, LATE_CAUSES.index("replay"), dtype=np.int64)
     if count > 1:
-        straight = plan.interval_straight_m
-        with np.errstate(invalid="ignore"):
-            over_cap = plan.interval_required_speed_m_s > caps * (1.0 + RATIO_TOLERANCE)
-            straight_fits = straight / plan.interval_running_s <= caps * (1.0 + RATIO_TOLERANCE)
-        zigzag = plan.interval_length_m <= ZIGZAG_MAX * straight
+        over, detour, zigzag = asks_more(
+            plan.interval_required_speed_m_s,
+            plan.interval_straight_m,
+            plan.interval_running_s,
+            plan.interval_length_m,
+            caps,
+        )
         interval[1:] = np.select(
-            [
-                plan.interval_unreachable,
-                over_cap & straight_fits & zigzag,
-                over_cap & straight_fits,
-                over_cap,
-            ],
+            [plan.interval_unreachable, zigzag, detour, over],
             [LATE_CAUSES.index(c) for c in ("gap", "zigzag", "detour", "speed")],
             LATE_CAUSES.index("replay"),
         )

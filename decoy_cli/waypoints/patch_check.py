@@ -42,6 +42,7 @@ from decoy_cli.waypoints.lattice import LatticeResult
 from decoy_cli.waypoints.lattice_params import LatticeParams
 from decoy_cli.waypoints.quality import ALIGNED_WITHIN_M
 from decoy_cli.world import patch_learning
+from decoy_cli.world.nav_data import PATCH_COLUMNS
 from decoy_cli.world.navmesh import load_navmesh, nav_world
 from decoy_cli.world.patch_boxes import CELL_U
 from decoy_cli.world.patch_learning import MIN_MATCHES, PatchBox, Tracks
@@ -67,6 +68,9 @@ Above, a step: a box takes nothing from a path over its top."""
 MIN_LENGTHENED_MATCHES = 2
 """Fewest matches the paths blamed on a patch must come from to leave it out: one match's
 detour can be one player's habit."""
+
+TOP, BOTTOM = PATCH_COLUMNS.index("z_top"), PATCH_COLUMNS.index("z_bottom")
+"""Columns of a box row (`PatchBox.box`, the patches file's order)."""
 
 _SOURCES_PER_SEARCH = 256
 """Dijkstra sources searched together (each a row of the graph's size)."""
@@ -171,7 +175,7 @@ def check_patches(
 ) -> PatchCheck:
     """Weigh every learned patch of `boxes` (built into `patched`, absent from `bare`) on the
     real players' `tracks` (see the module docstring)."""
-    box_m = np.array([_box_m(b) for b in boxes]).reshape(-1, 6)
+    box_m = np.array([b.box for b in boxes]).reshape(-1, 6) * HAMMER_TO_M  # as the world has them
     patch_of_box = np.array([b.patch for b in boxes], dtype=np.int64)
     patches = sorted(set(patch_of_box.tolist()))
     on_bare, on_patched = _snapped(bare, tracks), _snapped(patched, tracks)
@@ -190,13 +194,6 @@ def check_patches(
         for p in patches
     )
     return PatchCheck(verdicts=verdicts, pairs=pairs, lengthened_pairs=lengthened)
-
-
-def _box_m(box: PatchBox) -> tuple[float, ...]:
-    return tuple(
-        v * HAMMER_TO_M
-        for v in (box.x_min, box.y_min, box.x_max, box.y_max, box.z_bottom, box.z_top)
-    )
 
 
 def _snapped(graph: WaypointGraph, tracks: Tracks) -> np.ndarray:
@@ -259,8 +256,8 @@ def _deep_inside(position: np.ndarray, box_m: np.ndarray, patch_of_box: np.ndarr
     deep = np.zeros(len(position), dtype=bool)
     for patch in np.unique(patch_of_box).tolist():
         mine = box_m[patch_of_box == patch]
-        height = (position[:, None, 2] >= mine[:, 4]) & (
-            position[:, None, 2] <= mine[:, 5] + STEP_HEIGHT_M
+        height = (position[:, None, 2] >= mine[:, BOTTOM]) & (
+            position[:, None, 2] <= mine[:, TOP] + STEP_HEIGHT_M
         )
         everywhere = np.ones(len(position), dtype=bool)
         for dx, dy in probes:
@@ -288,8 +285,8 @@ def _patches_beside(
         & (nodes[:, None, 1] >= box_m[:, 1] - grow)
         & (nodes[:, None, 0] <= box_m[:, 2] + grow)
         & (nodes[:, None, 1] <= box_m[:, 3] + grow)
-        & (nodes[:, None, 2] >= box_m[:, 4] - BLAME_BELOW_M)
-        & (nodes[:, None, 2] <= box_m[:, 5] + STEP_HEIGHT_M)
+        & (nodes[:, None, 2] >= box_m[:, BOTTOM] - BLAME_BELOW_M)
+        & (nodes[:, None, 2] <= box_m[:, TOP] + STEP_HEIGHT_M)
     ).any(axis=0)
     return set(patch_of_box[hit].tolist())
 
@@ -324,7 +321,7 @@ def _gained(
             & (node[:, 0] <= box[2])
             & (node[:, 1] >= box[1])
             & (node[:, 1] <= box[3])
-            & (np.abs(node[:, 2] - box[5]) <= STEP_HEIGHT_M)
+            & (np.abs(node[:, 2] - box[TOP]) <= STEP_HEIGHT_M)
         )
         node_patch[on_top] = patch
     owner = node_patch[on_patched[(on_patched >= 0) & (on_bare < 0)]]
