@@ -100,7 +100,7 @@ def main() -> None:
     }
     total = max(int(players["late_over_frame"].sum()), 1)
     print(
-        "why the late stretches those targets belong to began: "
+        "why those targets are late (the interval that added most lateness in their stretch): "
         + "; ".join(f"{what} {players[c].sum() / total:.0%}" for what, c in causes.items())
     )
     print(
