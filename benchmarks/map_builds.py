@@ -67,7 +67,8 @@ def main() -> None:
         "Made by `python benchmarks/map_builds.py` (build times are of this machine: "
         f"{machine}). Coverage: share of the nav mesh's floor area within 0.5 m of a waypoint "
         "(the graph is its largest strongly connected component); SCC share: lattice nodes in "
-        "that component before pruning. Pictures: `docs/maps/<map>.png`.",
+        "that component before pruning; ladder edges join the two ends of the map's ladders "
+        "(`nav_ladders.csv`), one each way. Pictures: `docs/maps/<map>.png`.",
         "",
         "| map | nav areas | build (s) | nodes | edges | SCC share | region waypoints "
         "| coverage | least covered places | shipped graph reproduced |",

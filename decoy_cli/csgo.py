@@ -96,6 +96,10 @@ GRAVITY_M_S2 = GRAVITY_U_S2 * HAMMER_TO_M
 JUMP_SPEED_M_S = 301.99 * HAMMER_TO_M
 """Upward speed a jump starts with (sqrt(2 * 800 * 57) u/s): a plain jump rises about 57 u."""
 
+LADDER_SPEED_M_S = 200 * 0.78 * HAMMER_TO_M
+"""Climbing speed on a ladder: the Source engine's MAX_CLIMB_SPEED (200 u/s) scaled by CS:GO's
+sv_ladder_scale_speed (0.78 by default), 156 u/s, up or down."""
+
 
 def seconds_to_ticks(seconds: float, tick_rate: int = TICK_RATE) -> int:
     """A duration as a whole number of ticks, rounded up so that no rule runs shorter than in the

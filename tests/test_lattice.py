@@ -450,16 +450,18 @@ def test_builds_are_deterministic(tmp_path) -> None:
 def test_shipped_graph_invariants(map_name: str) -> None:
     """The same invariants on every shipped graph (rebuilding them is the CLI test's job). Nudged
     nodes bend some edges: a few dozen lie up to ~31 degrees off their compass direction, none
-    by half a sector or more. Each region holds waypoints of its nav places only."""
+    by half a sector or more (ladders aside). Each region holds waypoints of its nav places only."""
     graph = builtin_graph(map_name)
     count, _ = connected_components(graph.adjacency, directed=True, connection="strong")
     assert count == 1
     assert graph.num_nodes > 4000 and graph.num_edges > 25_000
     slots = Counter(zip(graph.edge_source.tolist(), graph.edge_direction.tolist(), strict=True))
     assert max(slots.values()) == 1
+    # a ladder takes the free direction nearest its climb's, which may be farther off
+    along = graph.edge_kind != EdgeKind.LADDER
     delta = graph.positions[graph.edge_target] - graph.positions[graph.edge_source]
     heading = np.degrees(np.arctan2(delta[:, 0], delta[:, 1])) % 360
-    deviation = np.abs((heading - 45.0 * graph.edge_direction + 180) % 360 - 180)
+    deviation = np.abs((heading - 45.0 * graph.edge_direction + 180) % 360 - 180)[along]
     assert deviation.max() < 45.0
     assert np.mean(deviation < 22.5) > 0.998
     for region in ("t_spawn", "ct_spawn", "bombsite_a", "bombsite_b"):

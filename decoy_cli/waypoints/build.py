@@ -88,7 +88,7 @@ def build_graph(
     nav = load_navmesh(map_name)
     seed_points = default_seeds(nav) if seeds is None else np.asarray(seeds, dtype=np.float64)
     with PhysicsWorld(world) as physics:
-        result = build_lattice(physics, seed_points, params, manual, progress)
+        result = build_lattice(physics, seed_points, params, manual, progress, nav.ladders)
     places = nav.places
     place_index = {name: k for k, name in enumerate(places)}
     area = nav.area_of(result.positions)

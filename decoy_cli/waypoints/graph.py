@@ -30,7 +30,13 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from decoy_cli.csgo import GRAVITY_M_S2, HAMMER_TO_M, JUMP_SPEED_M_S, SAFE_DROP_M
+from decoy_cli.csgo import (
+    GRAVITY_M_S2,
+    HAMMER_TO_M,
+    JUMP_SPEED_M_S,
+    LADDER_SPEED_M_S,
+    SAFE_DROP_M,
+)
 from decoy_cli.errors import GraphError
 from decoy_cli.files import write_atomic
 from decoy_cli.weapons import KNIFE_SPEED
@@ -53,6 +59,7 @@ class EdgeKind(IntEnum):
     STEP = 1  # a ledge up to the step height, walked without jumping
     JUMP = 2  # a ledge above the step height, reached with a (crouch-)jump
     DROP = 3  # a one-way drop to a lower floor
+    LADDER = 4  # up or down a ladder of the nav mesh, at the climbing speed
 
 
 # Vertical band for the floor-aware lookup: how far a waypoint may lie above or below the query.
@@ -147,8 +154,13 @@ class WaypointGraph:
     @cached_property
     def edge_cost(self) -> np.ndarray:
         """(E,) what an edge costs a running agent, in metres: its length plus the distance it
-        would have run (at knife speed) in the time it spends rising or falling."""
-        return self.edge_length + RUN_SPEED_M_S * self.edge_air_s
+        would have run (at knife speed) in the time it spends rising or falling; a ladder, the
+        distance it would have run in the time the climb takes."""
+        climb = self.edge_kind == EdgeKind.LADDER
+        length = np.where(
+            climb, self.edge_length * RUN_SPEED_M_S / LADDER_SPEED_M_S, self.edge_length
+        )
+        return length + RUN_SPEED_M_S * self.edge_air_s
 
     @cached_property
     def adjacency(self) -> csr_matrix:

@@ -29,6 +29,9 @@
    capsule tolerates that approximation (with the full radius, measurably fewer nodes end up in the
    largest strongly connected component).
 
+**Ladders** (`ladders.py`): the map's ladders seed the flood beside their ends, and after the
+verification the nodes at a ladder's two ends are joined by a LADDER edge each way.
+
 Then the graph is pruned to its largest strongly connected component (so an agent can always get
 back), manual waypoints are merged in, each node gets its nav place, and nodes are numbered in a
 fixed order so the same inputs give the same file.
@@ -46,6 +49,7 @@ import numpy as np
 from decoy_cli.errors import GraphError
 from decoy_cli.waypoints.flood import Lattice, flood
 from decoy_cli.waypoints.graph import DIRECTION_VECTORS, EdgeKind
+from decoy_cli.waypoints.ladders import add_ladder_edges, ladder_seeds
 from decoy_cli.waypoints.lattice_params import BuildStats, LatticeParams, LatticeResult, Progress
 from decoy_cli.waypoints.pruning import canonical_order, merge_manual, prune
 from decoy_cli.waypoints.verification import nudge_nodes, verify_edges
@@ -59,18 +63,39 @@ def _kind_counts(kinds: np.ndarray) -> dict[str, int]:
     return {k.name.lower(): int(np.sum(kinds == k)) for k in EdgeKind}
 
 
+def _cell_on_floor(
+    physics: PhysicsWorld, lattice: Lattice, point: np.ndarray, params: LatticeParams
+) -> tuple[tuple[int, int], float] | None:
+    """The lattice cell at or next to `point` whose floor is the point's own floor (within
+    `same_floor_dz`; a cell's centre can lie off a ledge the point stands on), with that floor's
+    height; None when no such cell is found."""
+    ci, cj = lattice.cell(point[:2])
+    cells = [(ci, cj)] + [(ci + int(di), cj + int(dj)) for di, dj in DIRECTION_VECTORS]
+    probes = np.array([[*lattice.xy(c), point[2] + params.jump_height] for c in cells])
+    z, nz = physics.first_floor_below(probes, params.jump_height + params.same_floor_dz)
+    ok = np.isfinite(z) & (nz >= params.min_floor_normal_z)
+    ok &= np.abs(z - point[2]) <= params.same_floor_dz
+    if not ok.any():
+        return None
+    k = int(np.argmax(ok))
+    return cells[k], float(z[k])
+
+
 def build_lattice(
     physics: PhysicsWorld,
     seeds: np.ndarray,
     params: LatticeParams = LatticeParams(),
     manual: np.ndarray | None = None,
     progress: Progress = lambda stage, done, total: None,
+    ladders_u: np.ndarray | None = None,
 ) -> LatticeResult:
-    """Run the three stages, prune, merge manual waypoints; see the module docstring."""
+    """Run the three stages, prune, merge manual waypoints; see the module docstring. `ladders_u`:
+    the map's ladders, (L, 6) top and bottom x y z in Hammer units (`NavMesh.ladders`)."""
     stats = BuildStats()
     seeds = np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
     if len(seeds) == 0:
         raise GraphError("no seed points: give at least one position on a floor")
+    ladders = np.zeros((0, 6)) if ladders_u is None else np.asarray(ladders_u).reshape(-1, 6)
     lattice = Lattice(seeds[0], params)
 
     # stage 1: lattice flood from the seeds
@@ -83,6 +108,15 @@ def build_lattice(
         if not np.isfinite(z[0]) or nz[0] < params.min_floor_normal_z:
             raise GraphError(f"seed {k} at {np.round(seed, 2).tolist()} m is not above a floor")
         node, new = lattice.find_or_add(cell, float(z[0]))
+        if new:
+            frontier.append(node)
+    stats.ladders = len(ladders)
+    for seed in ladder_seeds(physics, ladders, params):
+        found = _cell_on_floor(physics, lattice, seed, params)
+        if found is None:
+            continue
+        stats.ladder_seeds += 1
+        node, new = lattice.find_or_add(*found)
         if new:
             frontier.append(node)
     stats.seeds = len(seeds)
@@ -128,6 +162,7 @@ def build_lattice(
     stats.verified_removed = _kind_counts(removed[:, 2])
     edge_arr = edge_arr[keep]
     stats.seconds["verification"] = nudge_seconds + time.perf_counter() - clock
+    edge_arr, stats.ladders_joined = add_ladder_edges(positions, edge_arr, ladders)
 
     # manual waypoints, then the largest strongly connected component
     clock = time.perf_counter()

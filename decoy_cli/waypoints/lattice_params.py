@@ -47,6 +47,9 @@ class BuildStats:
     """What the build did, stage by stage (the CLI prints it, the graph file stores it)."""
 
     seeds: int = 0
+    ladders: int = 0
+    ladder_seeds: int = 0
+    ladders_joined: int = 0
     lattice_nodes: int = 0
     lattice_edges: dict[str, int] = field(default_factory=dict)
     drop_edges: int = 0

@@ -57,6 +57,10 @@ def plot_graph(
     ax.add_collection(
         LineCollection(segments[kind == EdgeKind.JUMP], colors="#ffbf00", lw=1.0, label="jump")
     )
+    ladder = kind == EdgeKind.LADDER  # nearly vertical: a marker at each end, not a line
+    if ladder.any():
+        ends = pos[graph.edge_source[ladder]]
+        ax.scatter(ends[:, 0], ends[:, 1], marker="^", s=36, c="#1f77b4", label="ladder", zorder=3)
     if removed_segments is not None and len(removed_segments):
         ax.add_collection(
             LineCollection(

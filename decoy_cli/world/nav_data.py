@@ -1,12 +1,13 @@
-"""The nav mesh of a built-in map as data: the areas, their places and links, the radar
-transform, and the boxes the nav mesh lacks (`world_patches.csv`), read from the map's assets.
+"""The nav mesh of a built-in map as data: the areas, their places and links, the ladders, the
+radar transform, and the boxes the nav mesh lacks (`world_patches.csv`), read from the map's
+assets.
 """
 
 from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
@@ -36,6 +37,8 @@ class NavMesh:
     connections: np.ndarray  # (C, 2) area indices (not ids), directed
     radar: dict[str, float]
     regions: dict[str, tuple[str, ...]]  # region -> the nav places that make it
+    ladders: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    """(L, 6) each ladder's top and bottom centre, x y z, Hammer units (`nav_ladders.csv`)."""
 
     @property
     def num_areas(self) -> int:
@@ -95,6 +98,9 @@ def load_navmesh(map_name: str = BUILTIN_MAP) -> NavMesh:
 
 
 NAV_COLUMNS = ("x_min", "y_min", "z_at_min", "x_max", "y_max", "z_at_max")
+NAV_LADDERS_FILE = "nav_ladders.csv"
+"""A map's ladders (`scripts/extract_nav_ladders.py`); maps without ladders have no such file."""
+LADDER_ENDS = ("top_x", "top_y", "top_z", "bottom_x", "bottom_y", "bottom_z")
 
 
 def read_navmesh(folder: Path) -> NavMesh:
@@ -130,6 +136,9 @@ def read_navmesh(folder: Path) -> NavMesh:
     except (KeyError, TypeError, ValueError):
         raise WorldError(f"{folder / 'nav_connections.csv'}: a link names no known area") from None
     col = dict(zip(NAV_COLUMNS, values.T, strict=True))
+    ladders = np.zeros((0, len(LADDER_ENDS)))
+    if (folder / NAV_LADDERS_FILE).is_file():
+        ladders = read_ladders(folder / NAV_LADDERS_FILE)
     return NavMesh(
         area_id=area_id,
         place=np.array([r.get("place") or "" for r in rows]),
@@ -142,7 +151,31 @@ def read_navmesh(folder: Path) -> NavMesh:
         connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
         radar=radar,
         regions=regions,
+        ladders=ladders,
     )
+
+
+def read_ladders(path: Path) -> np.ndarray:
+    """The ladders of a `nav_ladders.csv` (`LADDER_ENDS`, Hammer units); a WorldError naming the
+    file and line for a malformed row or a ladder whose top is not above its bottom."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise WorldError(f"{path}: not a readable ladders file ({error})") from None
+    ladders = np.zeros((len(rows), len(LADDER_ENDS)))
+    for line, row in enumerate(rows, start=2):
+        try:
+            ladders[line - 2] = [float(row[key]) for key in LADDER_ENDS]
+        except (KeyError, TypeError, ValueError):
+            ladders[line - 2] = np.nan
+        if not np.all(np.isfinite(ladders[line - 2])):
+            raise WorldError(
+                f"{path}, line {line}: a ladder needs numbers in {', '.join(LADDER_ENDS)}"
+            )
+        if not ladders[line - 2, 2] > ladders[line - 2, 5]:
+            raise WorldError(f"{path}, line {line}: the ladder's top is not above its bottom")
+    return ladders
 
 
 def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:

@@ -11,7 +11,9 @@ edge's kind and a speed, and calls `step()` once per tick. Two movers share one 
   crouch-jump, modelled as a stronger start, where the top is above a plain jump), then moves
   horizontally. A drop moves horizontally at the upper height to above the target, then falls
   with gravity. These are the paths the waypoint builder verified a capsule along
-  (`decoy_cli.waypoints.lattice`), so an agent on its edge never enters a wall.
+  (`decoy_cli.waypoints.lattice`), so an agent on its edge never enters a wall. A ladder edge
+  is a straight 3-D line too, climbed up or down at no more than the climbing speed
+  (`LADDER_SPEED_M_S`); it passes over the ladder's lip, the one path not verified.
 * `PhysicsMover`: the same motion for capsule bodies in pybullet that block each other, as
   players do in CS:GO; see its docstring for the collision rules and stuck recovery.
 

@@ -12,6 +12,7 @@ import math
 
 from numba import njit
 
+from decoy_cli.csgo import LADDER_SPEED_M_S
 from decoy_cli.sim.movement.layout import (
     EPS,
     F_CARRY,
@@ -41,6 +42,8 @@ JUMP_EDGE = 2
 """`EdgeKind.JUMP` (numba reads module ints as constants; `tests/test_sim_movement.py` checks)."""
 DROP_EDGE = 3
 """`EdgeKind.DROP`."""
+LADDER_EDGE = 4
+"""`EdgeKind.LADDER`: climbed along its line at no more than `LADDER_SPEED_M_S`."""
 
 
 @njit(cache=True)
@@ -58,11 +61,11 @@ def line_z(x, y, sx, sy, sz, tx, ty, tz):
 def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, lookahead, on_line):
     """Move one agent for `t` seconds along its edge from node (sx, sy, sz) to (tx, ty, tz).
 
-    Phases: RISE (jump: vertical, gravity, until the target height), LINE (walk/step: along the
-    3-D line at `speed`), GLIDE (jump/drop: horizontal at constant height at `speed`), FALL
-    (gravity, until the target height). An agent off its line (pushed aside by another) steers
-    back to it, `lookahead` ahead of its projection. Returns (x, y, z, phase, vz, seconds left,
-    arrived); the seconds left are those after arriving.
+    Phases: RISE (jump: vertical, gravity, until the target height), LINE (walk/step/ladder:
+    along the 3-D line at `speed`), GLIDE (jump/drop: horizontal at constant height at
+    `speed`), FALL (gravity, until the target height). An agent off its line (pushed aside by
+    another) steers back to it, `lookahead` ahead of its projection. Returns (x, y, z, phase,
+    vz, seconds left, arrived); the seconds left are those after arriving.
     """
     for _ in range(4):  # at most RISE -> GLIDE -> FALL -> landed in one call
         if phase == RISE:
@@ -179,14 +182,17 @@ def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
 @njit(cache=True)
 def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target, fv, iv):
     """Start agent i on the edge to (tx, ty, tz) of `kind` (EdgeKind) at `speed` (capped by
-    its max speed, first set to `cap` unless that is negative): its phase, vertical speed and
-    heading. Returns False, changing nothing, if the agent is in the air (it lands first)."""
+    its max speed, first set to `cap` unless that is negative, and on a ladder by the climbing
+    speed): its phase, vertical speed and heading. Returns False, changing nothing, if the
+    agent is in the air (it lands first)."""
     if iv[i, I_PHASE] in (RISE, GLIDE, FALL):
         return False
     if cap >= 0.0:
         fv[i, F_MAX_SPEED] = cap
     target[i, 0], target[i, 1], target[i, 2] = tx, ty, tz
     fv[i, F_SPEED] = min(speed, fv[i, F_MAX_SPEED])
+    if kind == LADDER_EDGE:
+        fv[i, F_SPEED] = min(fv[i, F_SPEED], LADDER_SPEED_M_S)
     fv[i, F_VZ] = 0.0
     z = pos[i, 2]
     if kind == JUMP_EDGE and tz > z + EPS:

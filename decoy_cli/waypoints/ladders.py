@@ -1,0 +1,125 @@
+"""Ladders in the lattice: seeds beside each ladder's ends, and a LADDER edge each way.
+
+The lattice flood walks, steps, jumps and drops, so floors players reach only by climbing (de_nuke's
+Heaven and roofs, de_train's sniper's nest) were never flooded, or were cut off when the
+builder kept the largest strongly connected component. The map's ladders (`NavMesh.ladders`,
+from the game's `.nav` file) close that gap in two steps of `build_lattice`:
+
+1. `ladder_seeds`: a floor point beside each end of each ladder seeds the flood, so the floors
+   at the top get nodes. An end's floor is the nearest one found by probes on rings around it,
+   in a height band: a ladder's top lies up to a crouch-jump above the floor players step off
+   onto (the ladder brush rises past the lip), its bottom a little above the floor.
+2. `add_ladder_edges`: after the capsule verification, the nodes nearest the two ends (within
+   `LADDER_REACH_M`, in the same band) are joined by a LADDER edge each way, in the compass
+   direction of the climb (the nearest free one: a node has one edge per direction). An agent
+   climbs the straight line between them at the climbing speed; the capsule is not moved along
+   it, since a climb passes over the lip, where a standing capsule does not fit.
+
+A ladder whose ends find no floor (its top leads to a spot the nav mesh has no area for) gets
+no edge; the build statistics count the ladders joined.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.waypoints.graph import EdgeKind
+from decoy_cli.waypoints.lattice_params import LatticeParams
+from decoy_cli.world.physics import PhysicsWorld
+
+LADDER_REACH_M = 1.5
+"""How far from a ladder's end (horizontally) its floor node may lie: the top's floor starts
+beyond the lip, up to two lattice spacings away."""
+TOP_BAND_M = (-1.2, 0.4)
+"""Heights of a top's floor relative to the ladder's top (below: the brush rising past the lip
+by up to a crouch-jump; above: a step)."""
+BOTTOM_BAND_M = (-0.9, 0.4)
+"""Heights of a bottom's floor relative to the ladder's bottom."""
+_RINGS_M = (0.0, 0.35, 0.7, 1.05, 1.4)
+_ANGLES = np.arange(8) * (math.pi / 4)
+
+
+def ladder_ends(ladders_u: np.ndarray) -> list[tuple[np.ndarray, tuple[float, float]]]:
+    """Each ladder's top then bottom (metres) with its height band, in ladder order."""
+    ends = []
+    for ladder in np.asarray(ladders_u, dtype=np.float64).reshape(-1, 6) * HAMMER_TO_M:
+        ends.append((ladder[:3], TOP_BAND_M))
+        ends.append((ladder[3:], BOTTOM_BAND_M))
+    return ends
+
+
+def ladder_seeds(physics: PhysicsWorld, ladders_u: np.ndarray, params: LatticeParams) -> np.ndarray:
+    """(S, 3) floor points (metres) beside the ends of the ladders (Hammer units, (L, 6) tops and
+    bottoms), one per end that has a floor in its band; see the module docstring."""
+    seeds = []
+    for end, (below, above) in ladder_ends(ladders_u):
+        for radius in _RINGS_M:
+            angles = _ANGLES[:1] if radius == 0.0 else _ANGLES
+            probes = np.column_stack(
+                [
+                    end[0] + radius * np.cos(angles),
+                    end[1] + radius * np.sin(angles),
+                    np.full(len(angles), end[2] + above + params.jump_height),
+                ]
+            )
+            z, normal_z = physics.first_floor_below(probes, params.jump_height + above - below)
+            ok = np.isfinite(z) & (normal_z >= params.min_floor_normal_z)
+            ok &= (z >= end[2] + below) & (z <= end[2] + above)
+            if ok.any():
+                k = int(np.argmax(ok))
+                seeds.append([probes[k, 0], probes[k, 1], z[k]])
+                break
+    return np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
+
+
+def add_ladder_edges(
+    positions: np.ndarray, edges: np.ndarray, ladders_u: np.ndarray
+) -> tuple[np.ndarray, int]:
+    """`edges` (E, 4: source, target, kind, direction) with a LADDER edge each way for every
+    ladder whose two ends have a node; returns (edges, ladders joined)."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 4)
+    used = {(int(s), int(d)) for s, d in edges[:, [0, 3]]}
+    ends = ladder_ends(ladders_u)
+    added: list[tuple[int, int, int, int]] = []
+    joined = 0
+    for top_end, bottom_end in zip(ends[0::2], ends[1::2], strict=True):
+        top, bottom = _end_node(positions, *top_end), _end_node(positions, *bottom_end)
+        if top < 0 or bottom < 0 or top == bottom:
+            continue
+        up = _free_direction(used, bottom, positions[top] - positions[bottom])
+        down = _free_direction(used, top, positions[bottom] - positions[top])
+        if up < 0 or down < 0:
+            continue
+        for source, target, direction in ((bottom, top, up), (top, bottom, down)):
+            used.add((source, direction))
+            added.append((source, target, int(EdgeKind.LADDER), direction))
+        joined += 1
+    if added:
+        edges = np.concatenate([edges, np.asarray(added, dtype=np.int64)])
+    return edges, joined
+
+
+def _end_node(positions: np.ndarray, end: np.ndarray, band: tuple[float, float]) -> int:
+    """The node nearest a ladder's end within reach and its height band, -1 if none."""
+    horizontal = np.hypot(positions[:, 0] - end[0], positions[:, 1] - end[1])
+    dz = positions[:, 2] - end[2]
+    ok = (horizontal <= LADDER_REACH_M) & (dz >= band[0]) & (dz <= band[1])
+    if not ok.any():
+        return -1
+    distance = np.where(ok, np.hypot(horizontal, dz), np.inf)
+    return int(np.argmin(distance))
+
+
+def _free_direction(used: set[tuple[int, int]], node: int, delta: np.ndarray) -> int:
+    """The compass direction (0 = N = +y, clockwise) nearest `delta`'s that `node` has no edge
+    in, -1 if it has all eight."""
+    heading = math.degrees(math.atan2(delta[0], delta[1])) % 360.0
+    preferred = round(heading / 45.0) % 8
+    for offset in (0, 1, -1, 2, -2, 3, -3, 4):
+        direction = (preferred + offset) % 8
+        if (node, direction) not in used:
+            return direction
+    return -1
