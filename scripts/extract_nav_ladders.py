@@ -8,7 +8,8 @@ awpy 1.3.1's nav data has no ladders; the game's `.nav` file has them (`decoy_cl
 Give the map's official file (`csgo/maps/<map>.nav` of a CS:GO install) or, as the shipped
 assets did, several independent copies: only the ladders every file agrees on (same id, ends
 within 1 u) are written, so a ladder one editor added is left out. The files shipped were made
-from two published copies (see each map's ATTRIBUTION.md); a map without ladders gets no file.
+from two published copies (see each map's ATTRIBUTION.md); a map without ladders gets no file
+(an old one is removed).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from decoy_cli.world.nav_data import NAV_LADDERS_FILE, asset_dir
 from decoy_cli.world.nav_file import LADDER_COLUMNS, read_nav_ladders
 
 AGREE_U = 1.0
+"""How close (Hammer units) two files' ends of the same ladder must be to count as agreeing."""
 
 
 def agreed(sets: list[np.ndarray]) -> np.ndarray:
@@ -50,7 +52,8 @@ def main() -> None:
         print(f"{path}: {len(found)} ladders")
     out = asset_dir(map_name) / NAV_LADDERS_FILE
     if not len(ladders):
-        print(f"{map_name}: no ladders all files agree on; nothing written")
+        out.unlink(missing_ok=True)
+        print(f"{map_name}: no ladders all files agree on; no {NAV_LADDERS_FILE}")
         return
     with open(out, "w", newline="") as f:
         writer = csv.writer(f, lineterminator="\n")

@@ -6,6 +6,7 @@ layout; the world is a hand-made tower whose platform only a ladder reaches."""
 from __future__ import annotations
 
 import math
+import os
 import struct
 from functools import cache
 from pathlib import Path
@@ -14,12 +15,14 @@ import numpy as np
 import pytest
 from worlds import floor, make_world, seeds_of, wall, walls_around
 
-from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, TICK_RATE
+from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, SAFE_DROP_M, TICK_RATE
 from decoy_cli.errors import WorldError
 from decoy_cli.sim.movement import KinematicMover, PhysicsMover, kernels
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import RUN_SPEED_M_S, EdgeKind, WaypointGraph
-from decoy_cli.waypoints.lattice import build_lattice
+from decoy_cli.waypoints.ladders import add_ladder_edges
+from decoy_cli.waypoints.lattice import LatticeParams, build_lattice
+from decoy_cli.world import nav_file
 from decoy_cli.world.nav_data import load_navmesh, read_ladders
 from decoy_cli.world.nav_file import read_nav_ladders
 from decoy_cli.world.physics import PhysicsWorld
@@ -92,6 +95,36 @@ def test_a_bad_nav_file_is_one_error(tmp_path: Path, data: bytes, message: str) 
         read_nav_ladders(path)
 
 
+def test_a_nav_file_of_another_sub_version_or_with_a_bad_ladder_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "map.nav"
+    path.write_bytes(nav_bytes(sub_version=2))
+    with pytest.raises(WorldError, match="sub-version 2"):
+        read_nav_ladders(path)
+    for top_z, message in ((-200.0, "top is not above its bottom"), (math.nan, "NaN")):
+        bad = [(4, 23.0, (10.0, 20.0, top_z), (10.0, 20.0, 0.0))]
+        path.write_bytes(nav_bytes(ladders=bad))
+        with pytest.raises(WorldError, match=message):
+            read_nav_ladders(path)
+
+
+def test_a_nav_path_that_is_no_regular_file_or_too_large_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    with pytest.raises(WorldError, match="not a regular file"):
+        read_nav_ladders(tmp_path)
+    if hasattr(os, "mkfifo"):  # a FIFO would block a reader forever
+        os.mkfifo(tmp_path / "fifo.nav")
+        with pytest.raises(WorldError, match="not a regular file"):
+            read_nav_ladders(tmp_path / "fifo.nav")
+    with pytest.raises(WorldError, match="cannot read"):
+        read_nav_ladders(tmp_path / "missing.nav")
+    path = tmp_path / "map.nav"
+    path.write_bytes(nav_bytes())
+    monkeypatch.setattr(nav_file, "MAX_NAV_BYTES", 100)
+    with pytest.raises(WorldError, match="too large"):
+        read_nav_ladders(path)
+
+
 def test_a_huge_count_in_a_nav_area_is_refused_before_reading(tmp_path: Path) -> None:
     data = bytearray(nav_bytes())
     # the first area's first link count (after the header, one place, the unnamed byte, the
@@ -114,6 +147,8 @@ def test_a_huge_count_in_a_nav_area_is_refused_before_reading(tmp_path: Path) ->
         ("1,23,0,0,100,0,0", "needs numbers"),
         ("1,23,0,0,abc,0,0,0", "needs numbers"),
         ("1,23,0,0,0,0,0,100", "top is not above its bottom"),
+        ("1,23,0,0,1e308,0,0,0", "off the map's nav mesh"),
+        ("1,23,90000,0,100,90000,0,0", "off the map's nav mesh"),
     ],
 )
 def test_a_bad_ladder_row_is_one_error_naming_file_and_line(
@@ -124,7 +159,7 @@ def test_a_bad_ladder_row_is_one_error_naming_file_and_line(
         f"ladder_id,width,top_x,top_y,top_z,bottom_x,bottom_y,bottom_z\n1,23,0,0,9,0,0,1\n{row}\n"
     )
     with pytest.raises(WorldError, match=rf"line 3: .*{message}"):
-        read_ladders(path)
+        read_ladders(path, load_navmesh("de_nuke"))
 
 
 def test_the_shipped_ladders_are_the_maps_nav_files_and_nuke_has_its_five() -> None:
@@ -135,34 +170,48 @@ def test_the_shipped_ladders_are_the_maps_nav_files_and_nuke_has_its_five() -> N
 
 # ---- the lattice: a tower only a ladder climbs --------------------------------------------------
 
-PLATFORM_Z = 3.0
-"""The platform's height: far above a crouch-jump, below a fatal fall."""
+PLATFORM_Z = 4.5
+"""The platform's height: far above a crouch-jump, and a drop from it does damage (deeper than
+`SAFE_DROP_M`), so a player climbs down."""
 FACE_X = 4.85
-"""The platform's west face; the lower floor lies west of it (x 0..FACE_X), the platform east
-(x FACE_X..8), both y 0..4. Walls close the lower room and the platform."""
-LADDER_U = np.array([[FACE_X - 0.1, 2.0, PLATFORM_Z + 0.05, FACE_X - 0.1, 2.0, 0.05]]) / HAMMER_TO_M
-"""A ladder on the face: its top just above the platform's lip, its bottom on the floor."""
+"""The platform's face; the lower floor lies on one side of it (x 0..FACE_X), the platform on the
+other (x FACE_X..8), both y 0..4. Walls close the lower room and the platform."""
 
 
-def tower() -> World:
+def tower(mirrored: bool = False) -> World:
+    """The tower; `mirrored`: the same, flipped east-west (the platform lies west of the face)."""
     parts = [
         floor(0.0, 0.0, FACE_X, 4.0),
-        walls_around(0.0, 0.0, FACE_X, 4.0),
+        walls_around(0.0, 0.0, FACE_X, 4.0, PLATFORM_Z),
         floor(FACE_X, 0.0, 8.0, 4.0, PLATFORM_Z),
         wall(8.0, 0.0, 8.0, 4.0, PLATFORM_Z, PLATFORM_Z + 3.0),
         wall(FACE_X, 0.0, 8.0, 0.0, PLATFORM_Z, PLATFORM_Z + 3.0),
         wall(FACE_X, 4.0, 8.0, 4.0, PLATFORM_Z, PLATFORM_Z + 3.0),
     ]
-    return make_world(parts, "tower", (1.0, 1.0, 0.0))
+    triangles = np.concatenate(parts)
+    if mirrored:
+        triangles = (triangles * np.array([-1.0, 1.0, 1.0]))[:, ::-1]  # keep the winding
+    seed = (-1.0 if mirrored else 1.0, 1.0, 0.0)
+    return make_world([triangles], "tower", seed)
 
 
-@cache
-def tower_graph(with_ladder: bool = True) -> WaypointGraph:
-    world = tower()
+def ladder_u(
+    top_above: float = 0.05,
+    bottom_above: float = 0.05,
+    off_face: float = 0.1,
+    mirrored: bool = False,
+) -> np.ndarray:
+    """A ladder on the face (Hammer units): its top `top_above` the platform, its bottom
+    `bottom_above` the floor, `off_face` metres in front of the face on the floor's side."""
+    x = (FACE_X - off_face) * (-1.0 if mirrored else 1.0)
+    ends = [x, 2.0, PLATFORM_Z + top_above, x, 2.0, bottom_above]
+    return np.array([ends]) / HAMMER_TO_M
+
+
+def build(ladders: np.ndarray | None, mirrored: bool = False) -> WaypointGraph:
+    world = tower(mirrored)
     with PhysicsWorld(world) as physics:
-        result = build_lattice(
-            physics, seeds_of(world), ladders_u=LADDER_U if with_ladder else None
-        )
+        result = build_lattice(physics, seeds_of(world), ladders_u=ladders)
     return WaypointGraph(
         positions=result.positions,
         edge_source=result.edge_source,
@@ -176,37 +225,53 @@ def tower_graph(with_ladder: bool = True) -> WaypointGraph:
     )
 
 
+@cache
+def tower_graph(mirrored: bool = False) -> WaypointGraph:
+    return build(ladder_u(mirrored=mirrored), mirrored)
+
+
 def on_platform(graph: WaypointGraph) -> np.ndarray:
     return np.abs(graph.positions[:, 2] - PLATFORM_Z) < 0.05
 
 
+def ladder_edges(graph: WaypointGraph) -> tuple[int, int]:
+    """The (up, down) ladder edges of a graph with one ladder."""
+    ladder = np.flatnonzero(graph.edge_kind == EdgeKind.LADDER)
+    assert len(ladder) == 2
+    up, down = sorted(ladder.tolist(), key=lambda e: graph.positions[graph.edge_target[e], 2])[::-1]
+    return up, down
+
+
 def test_without_the_ladder_the_platform_has_no_waypoint() -> None:
-    graph = tower_graph(with_ladder=False)
+    graph = build(None)
     assert not on_platform(graph).any()
     assert not (graph.edge_kind == EdgeKind.LADDER).any()
 
 
-def test_the_ladder_joins_the_platform_both_ways() -> None:
-    graph = tower_graph()
+@pytest.mark.parametrize("mirrored", [False, True], ids=["platform east", "platform west"])
+def test_the_ladder_joins_the_platform_both_ways(mirrored: bool) -> None:
+    graph = tower_graph(mirrored)
     top = on_platform(graph)
     assert top.sum() >= 15  # the platform is flooded from the ladder's seed
-    ladder = np.flatnonzero(graph.edge_kind == EdgeKind.LADDER)
-    assert len(ladder) == 2
-    up, down = sorted(ladder, key=lambda e: graph.positions[graph.edge_target[e], 2])[::-1]
+    up, down = ladder_edges(graph)
     assert top[graph.edge_target[up]] and not top[graph.edge_source[up]]
     assert graph.edge_source[down] == graph.edge_target[up]
     assert graph.edge_target[down] == graph.edge_source[up]
+    # the climb's compass direction: towards the platform (E = 2, W = 6), down the other way
+    assert graph.edge_direction[up] == (6 if mirrored else 2)
+    assert graph.edge_direction[down] in ((1, 2, 3) if mirrored else (5, 6, 7))
     # each end within reach of the ladder, on its floor
-    bottom, top_end = LADDER_U[0, 3:] * HAMMER_TO_M, LADDER_U[0, :3] * HAMMER_TO_M
-    assert np.hypot(*(graph.positions[graph.edge_source[up], :2] - bottom[:2])) <= 1.5
-    assert np.hypot(*(graph.positions[graph.edge_target[up], :2] - top_end[:2])) <= 1.5
-    # one edge per direction still, and the platform is in the strongly connected graph
+    ladder = ladder_u(mirrored=mirrored)[0] * HAMMER_TO_M
+    assert np.hypot(*(graph.positions[graph.edge_source[up], :2] - ladder[3:5])) <= 1.4
+    assert np.hypot(*(graph.positions[graph.edge_target[up], :2] - ladder[:2])) <= 1.4
+    # one edge per direction and per pair still, and the platform is strongly connected
     pairs = set(zip(graph.edge_source.tolist(), graph.edge_direction.tolist(), strict=True))
     assert len(pairs) == graph.num_edges
+    joined = set(zip(graph.edge_source.tolist(), graph.edge_target.tolist(), strict=True))
+    assert len(joined) == graph.num_edges
     stats = graph.meta["stats"]
     assert (stats["ladders"], stats["ladders_joined"], stats["edges"]["ladder"]) == (1, 1, 2)
-    lengths = graph.path_lengths(int(graph.edge_source[up]))
-    assert np.all(np.isfinite(lengths))
+    assert np.all(np.isfinite(graph.path_lengths(int(graph.edge_source[up]))))
 
 
 def test_a_climb_costs_the_run_it_could_have_made_in_its_time() -> None:
@@ -218,14 +283,67 @@ def test_a_climb_costs_the_run_it_could_have_made_in_its_time() -> None:
     assert graph.edge_cost[e] > 1.5 * graph.edge_length[e]
 
 
-def test_a_ladder_whose_top_has_no_floor_gets_no_edge() -> None:
-    world = tower()
-    in_the_air = LADDER_U.copy()
-    in_the_air[0, 2] += 2.5 / HAMMER_TO_M  # its top 2.5 m above the platform
-    with PhysicsWorld(world) as physics:
-        result = build_lattice(physics, seeds_of(world), ladders_u=in_the_air)
-    assert not (result.edge_kind == EdgeKind.LADDER).any()
-    assert (result.stats.ladders, result.stats.ladders_joined) == (1, 0)
+@pytest.mark.parametrize(
+    ("ladder", "joined"),
+    [
+        (ladder_u(top_above=1.0), True),  # the brush rises a metre past the lip
+        (ladder_u(top_above=1.5), False),  # more than a crouch-jump: no floor at its top
+        (ladder_u(top_above=-0.5), False),  # its top half a metre under the lip
+        (ladder_u(bottom_above=0.8), True),
+        (ladder_u(bottom_above=1.0), False),
+        (ladder_u(off_face=2.0), False),  # two metres from the face: it leads nowhere
+    ],
+    ids=["top 1 m up", "top 1.5 m up", "top under the lip", "foot 0.8 m up", "foot 1 m up", "far"],
+)
+def test_a_ladder_joins_the_floors_within_its_bands_and_reach(
+    ladder: np.ndarray, joined: bool
+) -> None:
+    graph = build(ladder)
+    assert graph.meta["stats"]["ladders_joined"] == int(joined)
+    assert (graph.edge_kind == EdgeKind.LADDER).any() == joined
+
+
+# ---- joining nodes: one edge per direction and per pair -----------------------------------------
+
+FOOT, TOP_A, TOP_B = 0, 1, 2
+POSITIONS = np.array([[0.0, 0.0, 0.0], [0.6, 0.0, 3.0], [0.6, 0.1, 3.0], [-0.7, 0.0, 0.0]])
+"""A foot, two tops east of it (for a ladder each, both climbs heading east), and a floor node
+west of the foot."""
+
+
+def joined_edges(ladders_m: list[list[float]], edges: list[tuple[int, int, int, int]]):
+    ladders_u = np.asarray(ladders_m) / HAMMER_TO_M
+    return add_ladder_edges(POSITIONS, np.array(edges).reshape(-1, 4), ladders_u, LatticeParams())
+
+
+def test_two_ladders_from_one_foot_take_two_directions() -> None:
+    edges, joined = joined_edges(
+        [[0.6, 0.0, 3.0, 0.0, 0.0, 0.0], [0.6, 0.1, 3.0, 0.0, 0.0, 0.0]], [(FOOT, 3, 0, 6)]
+    )
+    assert joined == 2
+    up = edges[(edges[:, 0] == FOOT) & (edges[:, 2] == EdgeKind.LADDER)]
+    assert sorted(up[:, 1].tolist()) == [TOP_A, TOP_B]
+    assert sorted(up[:, 3].tolist()) == [2, 3]  # east, then the next free one (south-east)
+
+
+def test_a_second_ladder_between_the_same_nodes_adds_nothing() -> None:
+    edges, joined = joined_edges(
+        [[0.6, 0.0, 3.0, 0.0, 0.0, 0.0], [0.6, 0.02, 3.0, 0.0, 0.02, 0.0]], []
+    )
+    assert joined == 2 and len(edges) == 2
+
+
+@pytest.mark.parametrize(("depth", "kind"), [(3.0, EdgeKind.DROP), (5.0, EdgeKind.LADDER)])
+def test_a_drop_beside_the_ladder_stays_unless_it_hurts(depth: float, kind: EdgeKind) -> None:
+    assert 3.0 < SAFE_DROP_M < 5.0
+    positions = POSITIONS.copy()
+    positions[TOP_A, 2] = depth
+    ladders_u = np.array([[0.6, 0.0, depth, 0.0, 0.0, 0.0]]) / HAMMER_TO_M
+    drop = np.array([[TOP_A, FOOT, int(EdgeKind.DROP), 6]])
+    edges, joined = add_ladder_edges(positions, drop, ladders_u, LatticeParams())
+    assert joined == 1
+    down = edges[(edges[:, 0] == TOP_A) & (edges[:, 1] == FOOT)]
+    assert len(down) == 1 and down[0, 2] == kind and down[0, 3] == 6
 
 
 # ---- the movers climb at the climbing speed ----------------------------------------------------

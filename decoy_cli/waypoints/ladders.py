@@ -6,14 +6,18 @@ builder kept the largest strongly connected component. The map's ladders (`NavMe
 from the game's `.nav` file) close that gap in two steps of `build_lattice`:
 
 1. `ladder_seeds`: a floor point beside each end of each ladder seeds the flood, so the floors
-   at the top get nodes. An end's floor is the nearest one found by probes on rings around it,
-   in a height band: a ladder's top lies up to a crouch-jump above the floor players step off
-   onto (the ladder brush rises past the lip), its bottom a little above the floor.
-2. `add_ladder_edges`: after the capsule verification, the nodes nearest the two ends (within
-   `LADDER_REACH_M`, in the same band) are joined by a LADDER edge each way, in the compass
-   direction of the climb (the nearest free one: a node has one edge per direction). An agent
-   climbs the straight line between them at the climbing speed; the capsule is not moved along
-   it, since a climb passes over the lip, where a standing capsule does not fit.
+   at the top get nodes. An end's floor is the nearest one found by probes on rings around it
+   (half a lattice spacing apart, out to `LADDER_REACH`), in a height band: a ladder's top lies
+   up to a crouch-jump above the floor players step off onto (the ladder brush rises past the
+   lip), its bottom a little above the floor.
+2. `add_ladder_edges`: after the capsule verification and the manual waypoints, the nodes
+   nearest the two ends (within `LADDER_REACH` spacings, in the same band) are joined by a
+   LADDER edge each way, in the compass direction of the climb (the nearest free one: a node
+   has one edge per direction). Where the two nodes are already joined, one edge per pair
+   stays: a drop deeper than the safe fall becomes the ladder (a player climbs down rather than
+   take the damage); any other edge is kept (it is the quicker way). An agent climbs the
+   straight line between the nodes at the climbing speed; the capsule is not moved along it,
+   since a climb passes over the lip, where a standing capsule does not fit.
 
 A ladder whose ends find no floor (its top leads to a spot the nav mesh has no area for) gets
 no edge; the build statistics count the ladders joined.
@@ -25,20 +29,20 @@ import math
 
 import numpy as np
 
-from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M, JUMP_HEIGHT_M, SAFE_DROP_M, STEP_HEIGHT_M
 from decoy_cli.waypoints.graph import EdgeKind
 from decoy_cli.waypoints.lattice_params import LatticeParams
 from decoy_cli.world.physics import PhysicsWorld
 
-LADDER_REACH_M = 1.5
-"""How far from a ladder's end (horizontally) its floor node may lie: the top's floor starts
-beyond the lip, up to two lattice spacings away."""
-TOP_BAND_M = (-1.2, 0.4)
-"""Heights of a top's floor relative to the ladder's top (below: the brush rising past the lip
-by up to a crouch-jump; above: a step)."""
-BOTTOM_BAND_M = (-0.9, 0.4)
-"""Heights of a bottom's floor relative to the ladder's bottom."""
-_RINGS_M = (0.0, 0.35, 0.7, 1.05, 1.4)
+LADDER_REACH = 2
+"""How far from a ladder's end (horizontally, in lattice spacings) its floor node may lie: the
+top's floor starts beyond the lip (on the five maps with ladders, up to 1.4 m away)."""
+TOP_BAND_M = (-JUMP_HEIGHT_M, STEP_HEIGHT_M)
+"""Heights of a top's floor relative to the ladder's top: down to a crouch-jump below (the brush
+rising past the lip), up to a step above."""
+BOTTOM_BAND_M = (-0.9, STEP_HEIGHT_M)
+"""Heights of a bottom's floor relative to the ladder's bottom: chosen by hand above the ladder
+bottoms of the five maps, which lie 0.04-0.79 m above their floors."""
 _ANGLES = np.arange(8) * (math.pi / 4)
 
 
@@ -55,8 +59,9 @@ def ladder_seeds(physics: PhysicsWorld, ladders_u: np.ndarray, params: LatticePa
     """(S, 3) floor points (metres) beside the ends of the ladders (Hammer units, (L, 6) tops and
     bottoms), one per end that has a floor in its band; see the module docstring."""
     seeds = []
+    rings = np.arange(2 * LADDER_REACH + 1) * (params.spacing / 2)
     for end, (below, above) in ladder_ends(ladders_u):
-        for radius in _RINGS_M:
+        for radius in rings:
             angles = _ANGLES[:1] if radius == 0.0 else _ANGLES
             probes = np.column_stack(
                 [
@@ -76,25 +81,40 @@ def ladder_seeds(physics: PhysicsWorld, ladders_u: np.ndarray, params: LatticePa
 
 
 def add_ladder_edges(
-    positions: np.ndarray, edges: np.ndarray, ladders_u: np.ndarray
+    positions: np.ndarray, edges: np.ndarray, ladders_u: np.ndarray, params: LatticeParams
 ) -> tuple[np.ndarray, int]:
     """`edges` (E, 4: source, target, kind, direction) with a LADDER edge each way for every
-    ladder whose two ends have a node; returns (edges, ladders joined)."""
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 4)
+    ladder whose two ends have a node (see the module docstring for nodes already joined);
+    returns (edges, ladders joined)."""
+    edges = np.array(edges, dtype=np.int64).reshape(-1, 4)
     used = {(int(s), int(d)) for s, d in edges[:, [0, 3]]}
+    joining = {(int(s), int(t)): k for k, (s, t) in enumerate(edges[:, :2].tolist())}
+    reach = LADDER_REACH * params.spacing
     ends = ladder_ends(ladders_u)
     added: list[tuple[int, int, int, int]] = []
     joined = 0
     for top_end, bottom_end in zip(ends[0::2], ends[1::2], strict=True):
-        top, bottom = _end_node(positions, *top_end), _end_node(positions, *bottom_end)
+        top = _end_node(positions, *top_end, reach)
+        bottom = _end_node(positions, *bottom_end, reach)
         if top < 0 or bottom < 0 or top == bottom:
             continue
-        up = _free_direction(used, bottom, positions[top] - positions[bottom])
-        down = _free_direction(used, top, positions[bottom] - positions[top])
-        if up < 0 or down < 0:
+        ways = []  # (source, target, direction, the edge already joining them or -1)
+        for source, target in ((bottom, top), (top, bottom)):
+            known = joining.get((source, target), -1)
+            direction = _free_direction(used, source, positions[target] - positions[source])
+            ways.append((source, target, direction, known))
+        if any(direction < 0 and known < 0 for _, _, direction, known in ways):
             continue
-        for source, target, direction in ((bottom, top, up), (top, bottom, down)):
+        for source, target, direction, known in ways:
+            if known >= len(edges):
+                continue  # a ladder added for another ladder between the same two nodes
+            if known >= 0:
+                depth = positions[source, 2] - positions[target, 2]
+                if edges[known, 2] == EdgeKind.DROP and depth > SAFE_DROP_M:
+                    edges[known, 2] = int(EdgeKind.LADDER)
+                continue
             used.add((source, direction))
+            joining[source, target] = len(edges) + len(added)
             added.append((source, target, int(EdgeKind.LADDER), direction))
         joined += 1
     if added:
@@ -102,11 +122,13 @@ def add_ladder_edges(
     return edges, joined
 
 
-def _end_node(positions: np.ndarray, end: np.ndarray, band: tuple[float, float]) -> int:
-    """The node nearest a ladder's end within reach and its height band, -1 if none."""
+def _end_node(
+    positions: np.ndarray, end: np.ndarray, band: tuple[float, float], reach: float
+) -> int:
+    """The node nearest a ladder's end within `reach` and its height band, -1 if none."""
     horizontal = np.hypot(positions[:, 0] - end[0], positions[:, 1] - end[1])
     dz = positions[:, 2] - end[2]
-    ok = (horizontal <= LADDER_REACH_M) & (dz >= band[0]) & (dz <= band[1])
+    ok = (horizontal <= reach) & (dz >= band[0]) & (dz <= band[1])
     if not ok.any():
         return -1
     distance = np.where(ok, np.hypot(horizontal, dz), np.inf)

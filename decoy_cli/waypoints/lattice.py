@@ -30,7 +30,8 @@
    largest strongly connected component).
 
 **Ladders** (`ladders.py`): the map's ladders seed the flood beside their ends, and after the
-verification the nodes at a ladder's two ends are joined by a LADDER edge each way.
+verification and the manual waypoints the nodes at a ladder's two ends are joined by a LADDER
+edge each way.
 
 Then the graph is pruned to its largest strongly connected component (so an agent can always get
 back), manual waypoints are merged in, each node gets its nav place, and nodes are numbered in a
@@ -162,12 +163,12 @@ def build_lattice(
     stats.verified_removed = _kind_counts(removed[:, 2])
     edge_arr = edge_arr[keep]
     stats.seconds["verification"] = nudge_seconds + time.perf_counter() - clock
-    edge_arr, stats.ladders_joined = add_ladder_edges(positions, edge_arr, ladders)
 
-    # manual waypoints, then the largest strongly connected component
+    # manual waypoints, the ladders, then the largest strongly connected component
     clock = time.perf_counter()
     if manual is not None and len(manual):
         positions, edge_arr = merge_manual(physics, positions, edge_arr, manual, params, stats)
+    edge_arr, stats.ladders_joined = add_ladder_edges(positions, edge_arr, ladders, params)
     positions, edge_arr, pruned = prune(positions, edge_arr, stats)
     positions, edge_arr = canonical_order(positions, edge_arr)
     stats.seconds["pruning"] = time.perf_counter() - clock

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from pathlib import Path
 
@@ -136,10 +136,7 @@ def read_navmesh(folder: Path) -> NavMesh:
     except (KeyError, TypeError, ValueError):
         raise WorldError(f"{folder / 'nav_connections.csv'}: a link names no known area") from None
     col = dict(zip(NAV_COLUMNS, values.T, strict=True))
-    ladders = np.zeros((0, len(LADDER_ENDS)))
-    if (folder / NAV_LADDERS_FILE).is_file():
-        ladders = read_ladders(folder / NAV_LADDERS_FILE)
-    return NavMesh(
+    nav = NavMesh(
         area_id=area_id,
         place=np.array([r.get("place") or "" for r in rows]),
         x_min=col["x_min"],
@@ -151,31 +148,46 @@ def read_navmesh(folder: Path) -> NavMesh:
         connections=np.array(pairs, dtype=np.int64).reshape(-1, 2),
         radar=radar,
         regions=regions,
-        ladders=ladders,
     )
+    if (folder / NAV_LADDERS_FILE).is_file():
+        nav = replace(nav, ladders=read_ladders(folder / NAV_LADDERS_FILE, nav))
+    return nav
 
 
-def read_ladders(path: Path) -> np.ndarray:
+def read_ladders(path: Path, nav: NavMesh) -> np.ndarray:
     """The ladders of a `nav_ladders.csv` (`LADDER_ENDS`, Hammer units); a WorldError naming the
-    file and line for a malformed row or a ladder whose top is not above its bottom."""
+    file and line for a malformed row, a ladder whose top is not above its bottom or one off
+    the map's nav mesh."""
     try:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise WorldError(f"{path}: not a readable ladders file ({error})") from None
+    low, high = _reach(nav)
     ladders = np.zeros((len(rows), len(LADDER_ENDS)))
     for line, row in enumerate(rows, start=2):
         try:
-            ladders[line - 2] = [float(row[key]) for key in LADDER_ENDS]
+            ladder = np.array([float(row[key]) for key in LADDER_ENDS])
         except (KeyError, TypeError, ValueError):
-            ladders[line - 2] = np.nan
-        if not np.all(np.isfinite(ladders[line - 2])):
-            raise WorldError(
-                f"{path}, line {line}: a ladder needs numbers in {', '.join(LADDER_ENDS)}"
-            )
-        if not ladders[line - 2, 2] > ladders[line - 2, 5]:
-            raise WorldError(f"{path}, line {line}: the ladder's top is not above its bottom")
+            ladder = np.full(len(LADDER_ENDS), np.nan)
+        where = f"{path}, line {line}"
+        if not np.all(np.isfinite(ladder)):
+            raise WorldError(f"{where}: a ladder needs numbers in {', '.join(LADDER_ENDS)}")
+        if not ladder[2] > ladder[5]:
+            raise WorldError(f"{where}: the ladder's top is not above its bottom")
+        ends = ladder.reshape(2, 3)
+        if np.any(ends < low) or np.any(ends > high):
+            raise WorldError(f"{where}: the ladder lies off the map's nav mesh")
+        ladders[line - 2] = ladder
     return ladders
+
+
+def _reach(nav: NavMesh) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) x y z corners of the box, the nav mesh's bounds grown by `PATCH_REACH_U`, in
+    which the boxes and ladders of its map must lie."""
+    low = np.array([nav.x_min.min(), nav.y_min.min(), nav.z_at_min.min()]) - PATCH_REACH_U
+    high = np.array([nav.x_max.max(), nav.y_max.max(), nav.z_at_max.max()]) + PATCH_REACH_U
+    return low, high
 
 
 def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
@@ -190,7 +202,7 @@ def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
 PATCH_COLUMNS = ("x_min", "y_min", "x_max", "y_max", "z_top", "z_bottom")
 
 PATCH_REACH_U = 512.0
-"""How far beyond the nav mesh's bounding box a patch may reach (Hammer units)."""
+"""How far beyond the nav mesh's bounding box a patch or a ladder may reach (Hammer units)."""
 
 
 def read_patches(path: Path, nav: NavMesh) -> np.ndarray:
@@ -201,8 +213,7 @@ def read_patches(path: Path, nav: NavMesh) -> np.ndarray:
             rows = list(csv.DictReader(f))
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise WorldError(f"{path}: not a readable patches file ({error})") from None
-    low = np.array([nav.x_min.min(), nav.y_min.min(), nav.z_at_min.min()]) - PATCH_REACH_U
-    high = np.array([nav.x_max.max(), nav.y_max.max(), nav.z_at_max.max()]) + PATCH_REACH_U
+    low, high = _reach(nav)
     boxes = np.zeros((len(rows), len(PATCH_COLUMNS)))
     for line, row in enumerate(rows, start=2):
         try:

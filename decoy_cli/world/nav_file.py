@@ -29,6 +29,10 @@ NAV_VERSION = 16
 """The version CS:GO writes; older and newer layouts differ and are refused."""
 MAX_NAV_BYTES = 64 * 1024 * 1024
 """A CS:GO nav file is a few hundred kilobytes; anything this large is not one."""
+SUB_VERSIONS = (0, 1)
+"""CS:GO's sub-versions: 1 adds approach spots to every area; others are refused."""
+LADDER_RECORD = "If3f3ffI5I"
+"""One ladder in the file: id, width, top, bottom, length, facing direction, five area ids."""
 LADDER_COLUMNS = (
     "ladder_id",
     "width",
@@ -71,11 +75,16 @@ def read_nav_ladders(path: str | Path) -> np.ndarray:
     WorldError for a file that is not a version-16 nav file or is cut short."""
     path = Path(path)
     try:
-        if path.stat().st_size > MAX_NAV_BYTES:
-            raise WorldError(f"{path}: too large for a nav file ({path.stat().st_size} bytes)")
-        data = path.read_bytes()
+        if not path.exists():
+            raise WorldError(f"cannot read nav file {path}: no such file")
+        if not path.is_file():
+            raise WorldError(f"{path}: not a nav file (not a regular file)")
+        with open(path, "rb") as f:
+            data = f.read(MAX_NAV_BYTES + 1)
     except OSError as error:
         raise WorldError(f"cannot read nav file {path}: {error.strerror}") from None
+    if len(data) > MAX_NAV_BYTES:
+        raise WorldError(f"{path}: larger than {MAX_NAV_BYTES} bytes, too large for a nav file")
     r = _Reader(data, str(path))
     magic, version = r.read("II")
     if magic != NAV_MAGIC:
@@ -83,6 +92,8 @@ def read_nav_ladders(path: str | Path) -> np.ndarray:
     if version != NAV_VERSION:
         raise WorldError(f"{path}: nav version {version}; only CS:GO's {NAV_VERSION} is read")
     sub_version = r.one("I")
+    if sub_version not in SUB_VERSIONS:
+        raise WorldError(f"{path}: nav sub-version {sub_version}; CS:GO's are 0 and 1")
     r.read("IB")  # BSP size, analyzed
     for _ in range(int(r.one("H"))):  # place names
         r.skip(int(r.one("H")), 1)
@@ -90,16 +101,18 @@ def read_nav_ladders(path: str | Path) -> np.ndarray:
     for _ in range(int(r.one("I"))):
         _skip_area(r, int(sub_version))
     count = int(r.one("I"))
-    r_left = len(data) - r.offset
-    if count * 60 > r_left:
-        raise WorldError(f"{path}: {count} ladders do not fit in the file's last {r_left} bytes")
+    left = len(data) - r.offset
+    if count * struct.calcsize("<" + LADDER_RECORD) > left:
+        raise WorldError(f"{path}: {count} ladders do not fit in the file's last {left} bytes")
     ladders = np.zeros((count, len(LADDER_COLUMNS)))
     for k in range(count):
-        ladder_id, width, tx, ty, tz, bx, by, bz, _length, _facing = r.read("If3f3ffI")
-        r.read("5I")  # the areas at its top (forward, left, right, behind) and bottom
+        # the five area ids (at its top: forward, left, right, behind; at its bottom) are unused
+        ladder_id, width, tx, ty, tz, bx, by, bz = r.read(LADDER_RECORD)[:8]
         ladders[k] = (ladder_id, width, tx, ty, tz, bx, by, bz)
     if not np.all(np.isfinite(ladders)):
         raise WorldError(f"{path}: a ladder has a NaN or infinite coordinate")
+    if np.any(ladders[:, 4] <= ladders[:, 7]):
+        raise WorldError(f"{path}: a ladder's top is not above its bottom")
     return ladders
 
 
