@@ -391,3 +391,33 @@ def test_the_shipped_nuke_graph_climbs_to_heaven_and_the_roof() -> None:
     places = graph.place_names
     reached = {places[p] for p in graph.node_place[graph.edge_target[ladder]] if p >= 0}
     assert {"Heaven", "Roof"} <= reached
+
+
+def test_a_replay_over_a_ladder_climbs_at_the_climbing_speed_and_arrives_on_time() -> None:
+    """The plan gives the climb its time at the climbing speed and the walk the rest: 3.5 m and
+    a 2.12 m ladder in 1.5 s. Timed as running (before), the walk went at 3.75 m/s and the
+    climb, capped, made the agent 9 ticks late."""
+    from test_plans import at, plan_for, with_ladder
+
+    from decoy_cli.csgo import tick_at
+    from decoy_cli.replay.policy import PlanPolicy
+    from decoy_cli.sim.engine import Simulator
+    from decoy_cli.sim.rules import BombRules, RulesConfig
+    from decoy_cli.sim.sites import SiteZones
+    from decoy_cli.sim.state import Agents
+
+    graph = with_ladder()
+    plans = [
+        plan_for(graph, at(0, 6, 6, graph=graph), seconds=[0.0, 1.5, 3.0]),
+        plan_for(graph, at(11, 11, 11, graph=graph), seconds=[0.0, 1.5, 3.0]),  # a CT stands
+    ]
+    nodes = np.array([0, 11])
+    agents = Agents.create(["t", "ct"], ["T", "CT"], graph.positions[nodes], nodes)
+    policy = PlanPolicy(plans, tick_at, graph)
+    zones = SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]})  # nobody can plant
+    rules = BombRules(zones, RulesConfig())
+    sim = Simulator(graph, agents, KinematicMover(), policy, rules, seed=0)
+    sim.run(to_tick=tick_at(2.0))
+    log = policy.logs[0]
+    assert log.arrival_tick[1] >= 0
+    assert abs(log.arrival_tick[1] - log.deadline_tick[1]) <= 1

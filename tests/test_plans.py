@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from decoy_cli.csgo import GRAVITY_M_S2
+from decoy_cli.csgo import GRAVITY_M_S2, LADDER_SPEED_M_S
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.replay import (
     RELOCATE_ACTION,
@@ -582,3 +582,30 @@ def test_interval_sums_round_exactly_as_numpy_sums_each_run(runs: list[int], see
     sums = _interval_sums(values, starts, steps)
     expected = np.array([values[a : a + n].sum() for a, n in zip(starts, steps, strict=True)])
     assert sums.tobytes() == expected.tobytes()
+
+
+# ---- ladders ------------------------------------------------------------------------------------
+
+
+def with_ladder() -> WaypointGraph:
+    """A low walkway (nodes 0..5, z = 0, x 0 .. 3.5) and a high one beyond it (6..11, z = 2,
+    x 4.2 .. 7.7), joined by a ladder from 5 up to 6 and back (2.12 m long)."""
+    low, low_edges = lattice(6, 1, z=0.0)
+    high, high_edges = lattice(6, 1, z=2.0, x0=6 * SPACING, first=6)
+    ladders = [(5, 6, EdgeKind.LADDER, 2), (6, 5, EdgeKind.LADDER, 6)]
+    return make_graph(low + high, [*low_edges, *high_edges, *ladders])
+
+
+def test_a_ladder_is_planned_as_its_climb_and_the_rest_as_a_run() -> None:
+    graph = with_ladder()
+    climb = math.hypot(SPACING, 2.0) / LADDER_SPEED_M_S
+    plan = plan_for(graph, at(0, 6, graph=graph), seconds=[0.0, 1.5])
+    assert plan.interval_length_m[0] == pytest.approx(5 * SPACING)  # the climb is not run
+    assert plan.interval_air_s[0] == pytest.approx(climb)
+    assert plan.interval_required_speed_m_s[0] == pytest.approx(5 * SPACING / (1.5 - climb))
+    assert not plan.interval_infeasible[0]  # 4.45 m/s: a knife runs it
+    assert plan.action_duration_s[-1] == pytest.approx(climb)  # the ladder, last
+    assert plan.action_duration_s.sum() == pytest.approx(1.5)
+    alone = plan_for(graph, at(5, 6, graph=graph), seconds=[0.0, 2.0])
+    assert alone.interval_required_speed_m_s[0] == 0.0
+    assert alone.action_duration_s.tolist() == [pytest.approx(2.0)]  # no NaN: all by the climb

@@ -117,9 +117,11 @@ class PlayerPlan:
     interval_skipped_frames: np.ndarray
     """(T-1,) int64 frames between the two targets without a target (absent, unsnappable)."""
     interval_length_m: np.ndarray
-    """(T-1,) float64 shortest-path length, 0 when standing still, NaN when unreachable."""
+    """(T-1,) float64 shortest-path length run at the player's own speed (`graph.edge_run_m`:
+    a ladder's climb is counted in time instead), 0 when standing still, NaN when unreachable."""
     interval_air_s: np.ndarray
-    """(T-1,) float64 seconds of the path spent rising or falling (`graph.edge_air_s`)."""
+    """(T-1,) float64 seconds of the path spent rising, falling or climbing a ladder
+    (`graph.edge_fixed_s`)."""
     interval_required_speed_m_s: np.ndarray
     """(T-1,) float64 length / running time (the time less the air time, at least a tick): the
     speed needed to arrive on time."""
@@ -298,8 +300,8 @@ def build_plan(
     action_interval = np.repeat(np.arange(count, dtype=np.int64), steps)
     on_edge = action_edge >= 0
     edge = np.where(on_edge, action_edge, 0)
-    edge_length = np.where(on_edge, graph.edge_length[edge], 0.0)
-    edge_air = np.where(on_edge, graph.edge_air_s[edge], 0.0)  # without headway
+    edge_length = np.where(on_edge, graph.edge_run_m[edge], 0.0)  # run at the agent's speed
+    edge_air = np.where(on_edge, graph.edge_fixed_s[edge], 0.0)  # rising, falling, climbing
     starts = np.cumsum(steps) - steps
     length, air = (
         _interval_sums(edge_length, starts, steps),
@@ -381,7 +383,7 @@ def asks_more(
 
 def running_seconds(seconds: np.ndarray, air: np.ndarray) -> np.ndarray:
     """The time an interval leaves for running: its `seconds` less the `air` time its path
-    spends rising or falling without headway, at least `MIN_RUN_S`."""
+    spends rising, falling or climbing (not at the player's own speed), at least `MIN_RUN_S`."""
     return np.maximum(seconds - air, MIN_RUN_S)
 
 
@@ -433,10 +435,11 @@ def _edge_durations(
     on_edge: np.ndarray,
 ) -> np.ndarray:
     """Each action's share of its interval's `seconds` (all arrays per action, the totals those
-    of its interval): an edge gets its time in the air, and the rest of the interval by length,
-    run at one speed (all of it by air time when the air time alone exceeds it); a STOP or a
-    RELOCATE gets the whole interval."""
-    by_air = (total_air > 0) & (seconds <= total_air)
+    of its interval): an edge gets its time in the air (rising, falling, climbing), and the rest
+    of the interval by length, run at one speed (all of it by air time when the air time alone
+    exceeds it, or when nothing of the path is run: a ladder alone); a STOP or a RELOCATE gets
+    the whole interval."""
+    by_air = (total_air > 0) & ((seconds <= total_air) | (total_length <= 0))
     with np.errstate(divide="ignore", invalid="ignore"):
         shared = np.where(
             by_air,

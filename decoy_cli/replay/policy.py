@@ -19,7 +19,7 @@ from decoy_cli.replay.bomb import FOREVER, DataPlant
 from decoy_cli.replay.plans import RELOCATE_ACTION, PlayerPlan
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.state import BombStatus
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import STOP_ACTION, EdgeKind, WaypointGraph
 
 
 @dataclass
@@ -63,7 +63,7 @@ class PlanPolicy:
         # per plan and action: path length of this and the later moves of its interval, and
         # whether it is the last move of its interval
         self._remaining = []
-        self._remaining_air = []  # seconds of those moves spent rising or falling
+        self._remaining_air = []  # seconds of those moves spent rising, falling, climbing
         self._last_move = []
         self._stood: list[list[tuple[int, int]]] = [[] for _ in plans]  # (interval, tick)
         for plan in plans:
@@ -76,8 +76,8 @@ class PlanPolicy:
             )
             moves = plan.action_edge >= 0
             edge = np.maximum(plan.action_edge, 0)
-            lengths = np.where(moves, graph.edge_length[edge], 0.0)
-            airs = np.where(moves, graph.edge_air_s[edge], 0.0)
+            lengths = np.where(moves, graph.edge_run_m[edge], 0.0)
+            airs = np.where(moves, graph.edge_fixed_s[edge], 0.0)
             remaining = np.zeros(len(plan.action))
             remaining_air = np.zeros(len(plan.action))
             last_move = np.zeros(len(plan.action), dtype=bool)
@@ -204,6 +204,8 @@ class PlanPolicy:
                 return Decision(STOP_ACTION, hold_ticks=1, plant=True)
             seconds_left = (deadline - now) / TICK_RATE - self._remaining_air[agent][a - 1]
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
+            if sim.graph.edge_kind[plan.action_edge[a - 1]] == EdgeKind.LADDER:
+                speed = None  # climbed at the climbing speed: the time the plan gave it
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
         return Decision(STOP_ACTION, hold_ticks=FOREVER, plant=plant, defuse=defuse)

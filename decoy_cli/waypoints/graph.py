@@ -152,15 +152,29 @@ class WaypointGraph:
         return np.where(up, rise_s, np.where(down, fall_s, 0.0))
 
     @cached_property
-    def edge_cost(self) -> np.ndarray:
-        """(E,) what an edge costs a running agent, in metres: its length plus the distance it
-        would have run (at knife speed) in the time it spends rising or falling; a ladder, the
-        distance it would have run in the time the climb takes."""
+    def edge_climb_s(self) -> np.ndarray:
+        """(E,) seconds each ladder edge takes at the climbing speed, 0 for every other edge."""
         climb = self.edge_kind == EdgeKind.LADDER
-        length = np.where(
-            climb, self.edge_length * RUN_SPEED_M_S / LADDER_SPEED_M_S, self.edge_length
-        )
-        return length + RUN_SPEED_M_S * self.edge_air_s
+        return np.where(climb, self.edge_length / LADDER_SPEED_M_S, 0.0)
+
+    @cached_property
+    def edge_run_m(self) -> np.ndarray:
+        """(E,) metres of each edge an agent runs at its own speed: its length, none of a
+        ladder (climbed at the climbing speed, `edge_climb_s`)."""
+        return np.where(self.edge_kind == EdgeKind.LADDER, 0.0, self.edge_length)
+
+    @cached_property
+    def edge_fixed_s(self) -> np.ndarray:
+        """(E,) seconds of each edge whatever the agent's speed: rising, falling, climbing. The
+        replay plans an edge as these plus `edge_run_m` run at one speed."""
+        return self.edge_air_s + self.edge_climb_s
+
+    @cached_property
+    def edge_cost(self) -> np.ndarray:
+        """(E,) what an edge costs a running agent, in metres: what it runs of it plus the
+        distance it would have run (at knife speed) in the time it spends rising, falling or
+        climbing."""
+        return self.edge_run_m + RUN_SPEED_M_S * self.edge_fixed_s
 
     @cached_property
     def adjacency(self) -> csr_matrix:
