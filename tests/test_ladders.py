@@ -421,3 +421,41 @@ def test_a_replay_over_a_ladder_climbs_at_the_climbing_speed_and_arrives_on_time
     log = policy.logs[0]
     assert log.arrival_tick[1] >= 0
     assert abs(log.arrival_tick[1] - log.deadline_tick[1]) <= 1
+
+
+def test_random_play_over_a_ladder_is_the_same_compiled_and_stepped() -> None:
+    """The compiled quiet stretches (`quiet_play`) climb as stepping every tick does."""
+    from decoy_cli.sim.engine import Simulator
+    from decoy_cli.sim.random_play import RandomPolicy
+    from decoy_cli.sim.rules import BombRules, RulesConfig
+    from decoy_cli.sim.sites import SiteZones
+    from decoy_cli.sim.state import Agents
+
+    graph = tower_graph()
+    up, _ = ladder_edges(graph)
+    foot = graph.positions[graph.edge_source[up]]
+    near = np.argsort(np.linalg.norm(graph.positions - foot, axis=1))[:8]
+
+    def play(seed: int, compiled: bool) -> Simulator:
+        sides = ["T"] * 4 + ["CT"] * 4
+        agents = Agents.create([f"p{k}" for k in range(8)], sides, graph.positions[near], near)
+        policy = RandomPolicy(np.random.default_rng(seed), hold_ticks=5)
+        chosen = policy if compiled else type("OneAtATime", (), {"decide": policy.decide})()
+        rules = BombRules(SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]}), RulesConfig())
+        sim = Simulator(graph, agents, KinematicMover(), chosen, rules, seed=0,
+                        record_ticks=range(0, 2000, 7))  # fmt: skip
+        if compiled:
+            sim.run(to_tick=2000)
+        else:
+            while sim.tick < 2000 and not sim.done:
+                sim.step()
+        return sim
+
+    climbed = 0
+    for seed in range(3):
+        stepped, compiled = play(seed, compiled=False), play(seed, compiled=True)
+        assert compiled.events == stepped.events, seed
+        np.testing.assert_array_equal(compiled.recording.position, stepped.recording.position)
+        heights = stepped.recording.position[:, :, 2]
+        climbed += int(((heights > 1.0) & (heights < PLATFORM_Z - 1.0)).any(axis=0).sum())
+    assert climbed >= 3  # agents were seen on the ladder

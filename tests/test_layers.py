@@ -11,6 +11,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "decoy_cli"
 LAYERS = {
     # shared facts and helpers
     "csgo": 0,
+    "compiled": 0,
     "errors": 0,
     "files": 0,
     "weapons": 0,

@@ -42,7 +42,8 @@ import operator
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+
+from decoy_cli.compiled import njit_cached
 
 TIE_RTOL = 1e-12
 """Accumulated DTW costs within this relative difference count as a tie (rounding of the sums)."""
@@ -67,7 +68,7 @@ class CurveDistances(NamedTuple):
     frechet: float
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def _squared(
     a_t: np.ndarray, i: int, b_rev_t: np.ndarray, r: int, frechet_dims: int
 ) -> tuple[float, float]:
@@ -82,7 +83,7 @@ def _squared(
     return (sq1 if frechet_dims == 1 else (sq2 if frechet_dims == 2 else sq3)), sq3
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def _upper_bounds(a_t: np.ndarray, b_rev_t: np.ndarray, frechet_dims: int) -> tuple[float, float]:
     """(DTW total, squared Fréchet value), each the smaller over two warping paths (the two
     may come from different paths; each is the value of a real path): the staircase along the
@@ -128,7 +129,7 @@ def _upper_bounds(a_t: np.ndarray, b_rev_t: np.ndarray, frechet_dims: int) -> tu
     return min(stair_total, greedy_total), min(stair_worst, greedy_worst)
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def _sweep(
     a_t: np.ndarray,
     b_rev_t: np.ndarray,
@@ -260,7 +261,7 @@ def _as_curves(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def curve_kernel(
     a: np.ndarray, b: np.ndarray, frechet_dims: int, prune: bool = True
 ) -> tuple[float, int, float]:

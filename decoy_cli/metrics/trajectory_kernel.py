@@ -19,7 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from decoy_cli.compiled import njit_cached
 
 OK = 0
 FEW_ORIGINAL = 1
@@ -32,7 +33,7 @@ _PAIRWISE_BLOCK = 128
 """numpy's PW_BLOCKSIZE: below it a sum is eight interleaved partial sums, above it halves."""
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def pairwise_sum(values: np.ndarray) -> float:
     """Sum of a contiguous 1-D float64 array in numpy's pairwise order (equals `np.sum`)."""
     n = values.shape[0]
@@ -56,7 +57,7 @@ def pairwise_sum(values: np.ndarray) -> float:
     return pairwise_sum(values[:half]) + pairwise_sum(values[half:])
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def resample_points(points: np.ndarray, length: int) -> np.ndarray:
     """Linear resampling of an (n, d) polyline, n >= 2, to `length` points over normalised
     index, at the positions `np.linspace(0, n - 1, length)` gives."""
@@ -72,7 +73,7 @@ def resample_points(points: np.ndarray, length: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit_cached(nogil=True)
 def metric_values(
     original: np.ndarray,
     original_alive: np.ndarray,

@@ -22,8 +22,8 @@ from numbers import Integral
 from typing import TypeGuard, cast
 
 import numpy as np
-from numba import njit
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import BUILTIN_MAP, seconds_to_ticks
 from decoy_cli.errors import GraphError
 from decoy_cli.sim.combat import DamageModel
@@ -315,7 +315,7 @@ class DecoyArrayEnv:
         self._sim = None
 
 
-@njit(cache=True)
+@njit_cached
 def _hand_in(chosen, due, given):
     """Put the actions of the due agents into `given` (-1 for the others); the first due agent
     whose action is not 0..8, or -1."""
@@ -328,7 +328,7 @@ def _hand_in(chosen, due, given):
     return -1
 
 
-@njit(cache=True)
+@njit_cached
 def _settle(given, was_active, alive, is_t, winner):
     """After a step: rewards (float32; +1/-1 by side to the agents active before it, once the
     round is won: `winner` 1 T, 0 CT, -1 not yet), terminated, still active, and an agent whose

@@ -11,8 +11,8 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from numba import njit
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.schedule import is_due
@@ -157,7 +157,7 @@ _BOMB = (
 """The round's entries, the same for every agent, in the order of `_encode`'s `bomb_starts`."""
 
 
-@njit(cache=True)
+@njit_cached
 def _encode(
     size, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates, enemies,
     centre, half, bomb_pos, bomb_state, carrier, scalars, done, tick, waiting, hold_until, node,

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-from numba import njit
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
@@ -126,7 +126,7 @@ def play_stretch(
     return status
 
 
-@njit(cache=True)
+@njit_cached
 def _play(
     tick, horizon, given, draws, next_draw, first, actions, hold_ticks, plant, defuse,
     decisions_left, watch, top, out_edges, edge_target, edge_kind, edge_fall, positions,

@@ -9,19 +9,20 @@ by then (`hold_until` > 0 and tick >= hold_until).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from decoy_cli.compiled import njit_cached
 
 NEVER = 1 << 62
 """A tick no round reaches."""
 
 
-@njit(cache=True)
+@njit_cached
 def is_due(i, waiting, alive, hold_until, tick):
     """Whether agent i is due for a decision at `tick` (module doc)."""
     return alive[i] and (waiting[i] or (hold_until[i] > 0 and tick >= hold_until[i]))
 
 
-@njit(cache=True)
+@njit_cached
 def due_agents(waiting, alive, hold_until, tick):
     """Indices (ascending) of the agents due for a decision at `tick`."""
     out = np.empty(alive.shape[0], dtype=np.int64)
@@ -33,7 +34,7 @@ def due_agents(waiting, alive, hold_until, tick):
     return out[:count]
 
 
-@njit(cache=True)
+@njit_cached
 def next_due(waiting, alive, hold_until, tick):
     """The first tick after `tick` at which an agent is due for a decision, if no agent
     arrives before (NEVER if none holds a STOP or waits)."""
@@ -48,7 +49,7 @@ def next_due(waiting, alive, hold_until, tick):
     return max(first, tick + 1)
 
 
-@njit(cache=True)
+@njit_cached
 def note_arrivals(arrived, alive, node, goal_node, waiting):
     """Alive agents that arrived now stand on their goal node and wait for a decision."""
     for i in range(arrived.shape[0]):

@@ -18,8 +18,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.world.world import World
 
 
@@ -50,7 +50,7 @@ class OcclusionScene:
         return np.asarray(occluded) == -1
 
 
-@njit(cache=True)
+@njit_cached
 def _rays(starts, ends, origin):
     """Embree's rays for the segments: float32 starts relative to `origin`, unit directions
     (straight up for a zero-length segment) and lengths. One compiled pass: on the few rays of

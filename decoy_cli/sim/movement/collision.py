@@ -11,8 +11,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.movement.kernels import line_z, move_to, propose
 from decoy_cli.sim.movement.layout import (
     EPS,
@@ -58,7 +57,7 @@ from decoy_cli.sim.movement.layout import (
 )
 
 
-@njit(cache=True)
+@njit_cached
 def first_blocker(i, cx, cy, cz, ox, oy, oz, res, iv, two_r, cap_len):
     """First agent that agent i's capsule at (cx, cy, cz) would overlap more than it does now
     at (ox, oy, oz), against the agents' positions in `res`; -1 if none.
@@ -85,7 +84,7 @@ def first_blocker(i, cx, cy, cz, ox, oy, oz, res, iv, two_r, cap_len):
     return -1
 
 
-@njit(cache=True)
+@njit_cached
 def physics_resolve(pos, start, target, fv, iv, prop, res, sf, si, need_world, flags, prm):
     """Propose every agent's move (the shared edge motion, or a recovery sidestep), then resolve
     agent-agent overlaps in index order against the already resolved positions (slide along
@@ -183,7 +182,7 @@ def physics_resolve(pos, start, target, fv, iv, prop, res, sf, si, need_world, f
     return count
 
 
-@njit(cache=True)
+@njit_cached
 def physics_commit(pos, start, target, fv, iv, prop, res, sf, si, flags, prm):
     """Apply the resolved moves: arrivals (exact, within tolerance, or next to an agent that
     stands on the goal), progress and stuck detection, and the bounded recovery."""
@@ -250,7 +249,7 @@ def physics_commit(pos, start, target, fv, iv, prop, res, sf, si, flags, prm):
             fv[i, F_SIDE] = 1.0 if iv[i, I_ATTEMPTS] % 2 == 1 else -1.0
 
 
-@njit(cache=True)
+@njit_cached
 def physics_glide(pos, start, target, fv, iv, prop, res, sf, si, need_world, flags, prm, ticks):
     """Up to `ticks` ticks of resolve and commit. Stops after a tick in which an agent arrives,
     is stuck or is teleported, or at a tick whose resolved moves need a world test: that tick

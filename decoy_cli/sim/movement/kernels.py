@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import LADDER_SPEED_M_S
 from decoy_cli.sim.movement.layout import (
     EPS,
@@ -46,7 +45,7 @@ LADDER_EDGE = 4
 """`EdgeKind.LADDER`: climbed along its line at no more than `LADDER_SPEED_M_S`."""
 
 
-@njit(cache=True)
+@njit_cached
 def line_z(x, y, sx, sy, sz, tx, ty, tz):
     """Height of the straight edge line above the projection of (x, y) onto it."""
     dx, dy = tx - sx, ty - sy
@@ -57,7 +56,7 @@ def line_z(x, y, sx, sy, sz, tx, ty, tz):
     return sz + u * (tz - sz)
 
 
-@njit(cache=True)
+@njit_cached
 def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, lookahead, on_line):
     """Move one agent for `t` seconds along its edge from node (sx, sy, sz) to (tx, ty, tz).
 
@@ -121,7 +120,7 @@ def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, looka
     return x, y, z, phase, vz, 0.0, False
 
 
-@njit(cache=True)
+@njit_cached
 def move_to(i, x, y, z, pos, fv, flags):
     """Put agent i at (x, y, z); update its heading and moving flag from the displacement."""
     dx, dy, dz = x - pos[i, 0], y - pos[i, 1], z - pos[i, 2]
@@ -131,7 +130,7 @@ def move_to(i, x, y, z, pos, fv, flags):
     pos[i, 0], pos[i, 1], pos[i, 2] = x, y, z
 
 
-@njit(cache=True)
+@njit_cached
 def propose(i, pos, start, target, fv, iv, prm):
     """The shared edge motion of agent i for this tick (plus time carried from its arrival)."""
     return advance(
@@ -141,7 +140,7 @@ def propose(i, pos, start, target, fv, iv, prm):
     )  # fmt: skip
 
 
-@njit(cache=True)
+@njit_cached
 def kinematic_step(pos, start, target, fv, iv, flags, prm):
     """One tick of the kinematic mover for all agents (no collisions)."""
     for i in range(pos.shape[0]):
@@ -157,7 +156,7 @@ def kinematic_step(pos, start, target, fv, iv, flags, prm):
             start[i, 0], start[i, 1], start[i, 2] = target[i, 0], target[i, 1], target[i, 2]
 
 
-@njit(cache=True)
+@njit_cached
 def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
     """Up to `max_ticks` kinematic ticks, stopping after the first tick in which an agent
     arrives; returns (ticks done, 1 if an agent arrived else 0: `MoveStep.happened`). `flags`
@@ -179,7 +178,7 @@ def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
     return max_ticks, 0
 
 
-@njit(cache=True)
+@njit_cached
 def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target, fv, iv):
     """Start agent i on the edge to (tx, ty, tz) of `kind` (EdgeKind) at `speed` (capped by
     its max speed, first set to `cap` unless that is negative, and on a ladder by the climbing
@@ -209,7 +208,7 @@ def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target
     return True
 
 
-@njit(cache=True)
+@njit_cached
 def stand_still(agents, fv, iv):
     """The agents stop where they are, except those on a jump or drop edge, which land first
     (`MoverBase.clear_goal` for several agents)."""
