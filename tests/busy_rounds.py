@@ -10,7 +10,11 @@ import pytest
 
 from decoy_cli.sim.combat import CombatBatch, DamageResult
 from decoy_cli.sim.engine import Decision, Policy, Simulator
+from decoy_cli.sim.movement import KinematicMover
+from decoy_cli.sim.random_play import RandomPolicy
+from decoy_cli.sim.rules import BombRules, RulesConfig
 from decoy_cli.sim.setup import RoundSetup, open_round
+from decoy_cli.sim.sites import SiteZones
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
@@ -120,3 +124,25 @@ def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
     monkeypatch.setattr(quiet_play, "_play", counting)
     return made
+
+
+def random_round(
+    graph: WaypointGraph, nodes: np.ndarray, seed: int, compiled: bool, ticks: int, every: int
+) -> Simulator:
+    """Random play (`RandomPolicy`, a STOP holds 5 ticks) of 4 T and 4 CT from `nodes` with
+    the kinematic mover, where nobody can plant, recorded every `every` ticks, for `ticks`:
+    `compiled` runs it (`Simulator.run`: quiet stretches in compiled code), else it steps every
+    tick with the same policy deciding one agent at a time."""
+    sides = ["T"] * 4 + ["CT"] * 4
+    agents = Agents.create([f"p{k}" for k in range(8)], sides, graph.positions[nodes], nodes)
+    policy = RandomPolicy(np.random.default_rng(seed), hold_ticks=5)
+    chosen = policy if compiled else type("OneAtATime", (), {"decide": policy.decide})()
+    rules = BombRules(SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]}), RulesConfig())
+    sim = Simulator(graph, agents, KinematicMover(), chosen, rules, seed=0,
+                    record_ticks=range(0, ticks, every))  # fmt: skip
+    if compiled:
+        sim.run(to_tick=ticks)
+    else:
+        while sim.tick < ticks and not sim.done:
+            sim.step()
+    return sim

@@ -138,31 +138,15 @@ def test_stepping_and_running_land_alike(cliff) -> None:
 def test_random_agents_fall_off_the_cliff_alike_compiled_and_stepped(cliff, monkeypatch) -> None:
     """Random agents on the plateau take its drops; in compiled stretches (`quiet_play`) a
     damaging drop hands the tick back to Python, which lands it as stepping does."""
-    from busy_rounds import count_stretch_decisions
-
-    from decoy_cli.sim.random_play import RandomPolicy
+    from busy_rounds import count_stretch_decisions, random_round
 
     _, graph = cliff
     plateau = np.flatnonzero(graph.positions[:, 2] > CLIFF_Z - 0.05)
     made = count_stretch_decisions(monkeypatch)
 
     def play(seed: int, compiled: bool) -> Simulator:
-        rng = np.random.default_rng(seed)
-        nodes = rng.choice(plateau, 8, replace=False)
-        sides = ["T"] * 4 + ["CT"] * 4
-        agents = Agents.create([f"p{k}" for k in range(8)], sides, graph.positions[nodes], nodes)
-        policy = RandomPolicy(np.random.default_rng(seed), hold_ticks=5)
-        chosen = policy if compiled else type("OneAtATime", (), {"decide": policy.decide})()
-        zones = SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]})  # nobody can plant
-        rules = BombRules(zones, RulesConfig())
-        sim = Simulator(graph, agents, KinematicMover(), chosen, rules, seed=0,
-                        record_ticks=range(0, 3000, 9))  # fmt: skip
-        if compiled:
-            sim.run(to_tick=3000)
-        else:
-            while sim.tick < 3000 and not sim.done:
-                sim.step()
-        return sim
+        nodes = np.random.default_rng(seed).choice(plateau, 8, replace=False)
+        return random_round(graph, nodes, seed, compiled, ticks=3000, every=9)
 
     falls = 0
     for seed in range(4):

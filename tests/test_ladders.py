@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from worlds import floor, make_world, seeds_of, wall, walls_around
+from worlds import floor, graph_of, make_world, seeds_of, wall, walls_around
 
 from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, SAFE_DROP_M, TICK_RATE
 from decoy_cli.errors import WorldError
@@ -162,6 +162,13 @@ def test_a_bad_ladder_row_is_one_error_naming_file_and_line(
         read_ladders(path, load_navmesh("de_nuke"))
 
 
+def test_an_unreadable_ladders_file_is_one_error(tmp_path: Path) -> None:
+    path = tmp_path / "nav_ladders.csv"
+    path.write_bytes(b"ladder_id,top_x\n\xff\xfe\n")
+    with pytest.raises(WorldError, match="not a readable CSV file"):
+        read_ladders(path, load_navmesh("de_nuke"))
+
+
 def test_the_shipped_ladders_are_the_maps_nav_files_and_nuke_has_its_five() -> None:
     assert len(load_navmesh("de_nuke").ladders) == 5
     assert len(load_navmesh("de_train").ladders) == 7
@@ -211,18 +218,7 @@ def ladder_u(
 def build(ladders: np.ndarray | None, mirrored: bool = False) -> WaypointGraph:
     world = tower(mirrored)
     with PhysicsWorld(world) as physics:
-        result = build_lattice(physics, seeds_of(world), ladders_u=ladders)
-    return WaypointGraph(
-        positions=result.positions,
-        edge_source=result.edge_source,
-        edge_target=result.edge_target,
-        edge_kind=result.edge_kind,
-        edge_direction=result.edge_direction,
-        node_place=np.full(len(result.positions), -1, dtype=np.int16),
-        place_names=[],
-        regions={},
-        meta={"stats": result.stats.as_dict()},
-    )
+        return graph_of(build_lattice(physics, seeds_of(world), ladders_u=ladders))
 
 
 @cache
@@ -425,35 +421,16 @@ def test_a_replay_over_a_ladder_climbs_at_the_climbing_speed_and_arrives_on_time
 
 def test_random_play_over_a_ladder_is_the_same_compiled_and_stepped() -> None:
     """The compiled quiet stretches (`quiet_play`) climb as stepping every tick does."""
-    from decoy_cli.sim.engine import Simulator
-    from decoy_cli.sim.random_play import RandomPolicy
-    from decoy_cli.sim.rules import BombRules, RulesConfig
-    from decoy_cli.sim.sites import SiteZones
-    from decoy_cli.sim.state import Agents
+    from busy_rounds import random_round
 
     graph = tower_graph()
     up, _ = ladder_edges(graph)
     foot = graph.positions[graph.edge_source[up]]
     near = np.argsort(np.linalg.norm(graph.positions - foot, axis=1))[:8]
-
-    def play(seed: int, compiled: bool) -> Simulator:
-        sides = ["T"] * 4 + ["CT"] * 4
-        agents = Agents.create([f"p{k}" for k in range(8)], sides, graph.positions[near], near)
-        policy = RandomPolicy(np.random.default_rng(seed), hold_ticks=5)
-        chosen = policy if compiled else type("OneAtATime", (), {"decide": policy.decide})()
-        rules = BombRules(SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]}), RulesConfig())
-        sim = Simulator(graph, agents, KinematicMover(), chosen, rules, seed=0,
-                        record_ticks=range(0, 2000, 7))  # fmt: skip
-        if compiled:
-            sim.run(to_tick=2000)
-        else:
-            while sim.tick < 2000 and not sim.done:
-                sim.step()
-        return sim
-
     climbed = 0
     for seed in range(3):
-        stepped, compiled = play(seed, compiled=False), play(seed, compiled=True)
+        stepped = random_round(graph, near, seed, compiled=False, ticks=2000, every=7)
+        compiled = random_round(graph, near, seed, compiled=True, ticks=2000, every=7)
         assert compiled.events == stepped.events, seed
         np.testing.assert_array_equal(compiled.recording.position, stepped.recording.position)
         heights = stepped.recording.position[:, :, 2]

@@ -17,6 +17,7 @@ from worlds import (
     DECK_Z,
     LEDGE_Z,
     floor,
+    graph_of,
     jump_box_world,
     ledge_world,
     make_world,
@@ -79,18 +80,7 @@ def world_graph(name: str) -> tuple[World, WaypointGraph]:
     """A hand-made world and its waypoint graph (built once per test process)."""
     world = WORLDS[name]()
     with PhysicsWorld(world) as physics:
-        res = build_lattice(physics, seeds_of(world))
-    graph = WaypointGraph(
-        positions=res.positions,
-        edge_source=res.edge_source,
-        edge_target=res.edge_target,
-        edge_kind=res.edge_kind,
-        edge_direction=res.edge_direction,
-        node_place=np.full(len(res.positions), -1, dtype=np.int16),
-        place_names=[],
-        regions={},
-    )
-    return world, graph
+        return world, graph_of(build_lattice(physics, seeds_of(world)))
 
 
 @contextmanager

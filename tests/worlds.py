@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeResult
 from decoy_cli.world.world import World
 
 WALL_HEIGHT = 3.0
@@ -98,6 +100,22 @@ def make_world(parts: list[np.ndarray], name: str, seed: tuple[float, float, flo
         name=name,
         source=f"hand-made {name}",
         meta={"seed": [float(v) for v in seed]},
+    )
+
+
+def graph_of(result: LatticeResult) -> WaypointGraph:
+    """The waypoint graph of a lattice built on a hand-made world: no places or regions; the
+    build statistics in `meta["stats"]`."""
+    return WaypointGraph(
+        positions=result.positions,
+        edge_source=result.edge_source,
+        edge_target=result.edge_target,
+        edge_kind=result.edge_kind,
+        edge_direction=result.edge_direction,
+        node_place=np.full(len(result.positions), -1, dtype=np.int16),
+        place_names=[],
+        regions={},
+        meta={"stats": result.stats.as_dict()},
     )
 
 

@@ -158,36 +158,42 @@ def read_ladders(path: Path, nav: NavMesh) -> np.ndarray:
     """The ladders of a `nav_ladders.csv` (`LADDER_ENDS`, Hammer units); a WorldError naming the
     file and line for a malformed row, a ladder whose top is not above its bottom or one off
     the map's nav mesh."""
+    rows = _number_rows(path, LADDER_ENDS, "ladder")
+    for where, ladder in zip(*rows, strict=True):
+        if not ladder[2] > ladder[5]:
+            raise WorldError(f"{where}: the ladder's top is not above its bottom")
+        _on_the_map(where, ladder.reshape(2, 3), nav, "the ladder")
+    return rows[1]
+
+
+def _number_rows(path: Path, columns: tuple[str, ...], what: str) -> tuple[list[str], np.ndarray]:
+    """The rows of a CSV file of numbers in `columns`: where each is ("<file>, line <n>") and
+    its values (R, len(columns)); a WorldError for an unreadable file or a row with a missing
+    or non-finite value."""
     try:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
     except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise WorldError(f"{path}: not a readable ladders file ({error})") from None
-    low, high = _reach(nav)
-    ladders = np.zeros((len(rows), len(LADDER_ENDS)))
-    for line, row in enumerate(rows, start=2):
+        raise WorldError(f"{path}: not a readable CSV file ({error})") from None
+    values = np.zeros((len(rows), len(columns)))
+    wheres = [f"{path}, line {line}" for line in range(2, len(rows) + 2)]
+    for k, row in enumerate(rows):
         try:
-            ladder = np.array([float(row[key]) for key in LADDER_ENDS])
+            values[k] = [float(row[key]) for key in columns]
         except (KeyError, TypeError, ValueError):
-            ladder = np.full(len(LADDER_ENDS), np.nan)
-        where = f"{path}, line {line}"
-        if not np.all(np.isfinite(ladder)):
-            raise WorldError(f"{where}: a ladder needs numbers in {', '.join(LADDER_ENDS)}")
-        if not ladder[2] > ladder[5]:
-            raise WorldError(f"{where}: the ladder's top is not above its bottom")
-        ends = ladder.reshape(2, 3)
-        if np.any(ends < low) or np.any(ends > high):
-            raise WorldError(f"{where}: the ladder lies off the map's nav mesh")
-        ladders[line - 2] = ladder
-    return ladders
+            values[k] = np.nan
+        if not np.all(np.isfinite(values[k])):
+            raise WorldError(f"{wheres[k]}: a {what} needs numbers in {', '.join(columns)}")
+    return wheres, values
 
 
-def _reach(nav: NavMesh) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) x y z corners of the box, the nav mesh's bounds grown by `PATCH_REACH_U`, in
-    which the boxes and ladders of its map must lie."""
+def _on_the_map(where: str, points: np.ndarray, nav: NavMesh, what: str) -> None:
+    """A WorldError unless the (P, 3) points lie within `PATCH_REACH_U` of the nav mesh's
+    bounding box."""
     low = np.array([nav.x_min.min(), nav.y_min.min(), nav.z_at_min.min()]) - PATCH_REACH_U
     high = np.array([nav.x_max.max(), nav.y_max.max(), nav.z_at_max.max()]) + PATCH_REACH_U
-    return low, high
+    if np.any(points < low) or np.any(points > high):
+        raise WorldError(f"{where}: {what} lies off the map's nav mesh")
 
 
 def load_patches(map_name: str = BUILTIN_MAP) -> np.ndarray:
@@ -208,26 +214,10 @@ PATCH_REACH_U = 512.0
 def read_patches(path: Path, nav: NavMesh) -> np.ndarray:
     """The boxes of a patches file (`PATCH_COLUMNS`, Hammer units); a WorldError naming the file
     and line for a malformed row, an empty or upside-down box, or one off the map's nav mesh."""
-    try:
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise WorldError(f"{path}: not a readable patches file ({error})") from None
-    low, high = _reach(nav)
-    boxes = np.zeros((len(rows), len(PATCH_COLUMNS)))
-    for line, row in enumerate(rows, start=2):
-        try:
-            box = np.array([float(row[key]) for key in PATCH_COLUMNS])
-        except (KeyError, TypeError, ValueError):
-            box = np.full(len(PATCH_COLUMNS), np.nan)
-        where = f"{path}, line {line}"
-        if not np.all(np.isfinite(box)):
-            raise WorldError(f"{where}: a patch needs numbers in {', '.join(PATCH_COLUMNS)}")
+    rows = _number_rows(path, PATCH_COLUMNS, "patch")
+    for where, box in zip(*rows, strict=True):
         x0, y0, x1, y1, top, bottom = box
         if not (x0 < x1 and y0 < y1 and bottom < top):
             raise WorldError(f"{where}: an empty or upside-down box")
-        corners = np.array([[x0, y0, bottom], [x1, y1, top]])
-        if np.any(corners < low) or np.any(corners > high):
-            raise WorldError(f"{where}: the box lies off the map's nav mesh")
-        boxes[line - 2] = box
-    return boxes
+        _on_the_map(where, np.array([[x0, y0, bottom], [x1, y1, top]]), nav, "the box")
+    return rows[1]
