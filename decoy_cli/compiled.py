@@ -9,7 +9,8 @@ a fingerprint of every source file of the package: any change to them starts a f
 
 The folders live under `NUMBA_CACHE_DIR` if set, else the user's cache folder
 (`$XDG_CACHE_HOME` or `~/.cache`), in `decoy/numba/<fingerprint>`; the `KEEP_CACHES` most
-recently used are kept. Where no such folder can be written, kernels compile without a cache.
+recently used are kept. Where no such folder can be written, kernels compile without a cache;
+with NUMBA_DISABLE_JIT nothing is compiled or cached.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def cache_root() -> Path:
     numba_dir = os.environ.get("NUMBA_CACHE_DIR")
     if numba_dir:
         return Path(numba_dir) / "decoy"
-    user_cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    user_cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")  # may raise
     return Path(user_cache) / "decoy" / "numba"
 
 
@@ -54,13 +55,13 @@ def cache_root() -> Path:
 def cache_dir() -> str | None:
     """This code's cache folder, created and marked used (older ones beyond `KEEP_CACHES`
     removed); None where it cannot be written."""
-    root = cache_root()
-    folder = root / fingerprint()
     try:
+        root = cache_root()
+        folder = root / fingerprint()
         folder.mkdir(parents=True, exist_ok=True)
         tempfile.TemporaryFile(dir=folder).close()
         (folder / LAST_USED).touch()
-    except OSError:
+    except (OSError, RuntimeError):  # RuntimeError: no home folder to be found
         return None
     _forget_old(root)
     return str(folder)
@@ -84,6 +85,8 @@ def njit_cached(function: F | None = None, **options: Any) -> Any:
     from numba.core import config
 
     def compile_(fn: F) -> F:
+        if config.DISABLE_JIT:  # type: ignore[attr-defined]  # plain Python: nothing to cache
+            return njit(**options)(fn)
         folder = cache_dir()
         if folder is None:
             return njit(cache=False, **options)(fn)

@@ -79,6 +79,7 @@ def test_a_portable_section_runs_this_trees_file_on_the_baselines_package(tmp_pa
     assert row["figure"] == "ticks/s, 10 agents" and row["baseline"][0] > 0
     runs = report["runs"]["kinematic"]
     assert "/baseline-" in runs["baseline"][0]["code"]
+    assert not list(tmp_path.glob("**/.numba-cache"))  # removed with the baseline's tree
     assert runs["baseline"][0]["damage_model"] == "none"
 
 
@@ -102,6 +103,7 @@ def test_a_git_ref_is_exported_beside_the_report_and_removed(tmp_path: Path) -> 
         assert tree.path.name.startswith(f"baseline-{head[:12]}-")
         assert (tree.path / "decoy_cli" / "bench" / "baseline.py").is_file()
         assert tree.label == f"HEAD ({head[:12]})"
+        assert tree.numba_cache == tree.path / ".numba-cache"  # its kernels go with it
     assert list(tmp_path.iterdir()) == []
     assert current_tree().path == CHECKOUT
 

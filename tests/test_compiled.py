@@ -60,6 +60,7 @@ def test_kernels_are_cached_in_the_folder_of_this_code(cache_root: Path) -> None
     cached = [p.name for p in folder.rglob("*.nbi")]
     assert any("doubled" in name for name in cached) and any("summed" in name for name in cached)
     assert doubled.stats.cache_path.startswith(str(folder))
+    assert summed.targetoptions.get("nogil") and not doubled.targetoptions.get("nogil")
 
     @njit(cache=True)
     def tripled(values):  # numba's own caching, for other code: not in decoy's folder
@@ -102,3 +103,43 @@ def test_only_the_most_recently_used_folders_are_kept(cache_root: Path) -> None:
     newest = [f"old{k:02d}" for k in range(compiled.KEEP_CACHES + 3)][-compiled.KEEP_CACHES + 1 :]
     assert [name for name in kept if name.startswith("old")] == newest
     assert (cache_root / "not ours").is_dir()
+
+
+def test_without_numba_cache_dir_the_folder_is_in_the_users_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert compiled.cache_root() == tmp_path / "decoy" / "numba"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert compiled.cache_root() == tmp_path / "home" / ".cache" / "decoy" / "numba"
+
+
+def test_no_home_folder_means_no_cache(monkeypatch: pytest.MonkeyPatch) -> None:
+    def nowhere() -> Path:
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(Path, "home", nowhere)
+    compiled.cache_dir.cache_clear()
+    try:
+        assert compiled.cache_dir() is None
+    finally:
+        compiled.cache_dir.cache_clear()
+
+
+def test_with_the_jit_disabled_nothing_is_cached(
+    cache_root: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from numba.core import config
+
+    monkeypatch.setattr(config, "DISABLE_JIT", True)
+
+    @compiled.njit_cached
+    def plus_two(x):
+        return x + 2
+
+    assert plus_two(1) == 3
+    assert not cache_root.exists()

@@ -380,6 +380,24 @@ def test_an_agent_climbs_at_the_climbing_speed_whatever_it_runs(mover_kind: str)
     assert np.all(np.diff(heights) > 0)  # a steady climb, no jump
 
 
+@pytest.mark.parametrize(
+    ("max_speed", "asked", "climb"),
+    [(150 * HAMMER_TO_M, 150 * HAMMER_TO_M, LADDER_SPEED_M_S), (4.76, 1.5, 1.5)],
+    ids=["a Negev at full speed", "asked to go slow"],
+)
+def test_the_climbing_speed_is_no_weapons_and_a_slower_climb_is_asked_for(
+    max_speed: float, asked: float, climb: float
+) -> None:
+    graph = tower_graph()
+    up, _ = ladder_edges(graph)
+    start, end = graph.positions[graph.edge_source[up]], graph.positions[graph.edge_target[up]]
+    mover = KinematicMover()
+    mover.reset(start[None, :], max_speed=max_speed)
+    mover.set_goal(0, end, EdgeKind.LADDER, asked)
+    ticks = next(t for t in range(1, 20 * TICK_RATE) if mover.step().arrived[0])
+    assert abs(ticks - graph.edge_length[up] / climb * TICK_RATE) <= 1
+
+
 def test_the_shipped_nuke_graph_climbs_to_heaven_and_the_roof() -> None:
     graph = builtin_graph("de_nuke")
     ladder = graph.edge_kind == EdgeKind.LADDER
@@ -389,10 +407,21 @@ def test_the_shipped_nuke_graph_climbs_to_heaven_and_the_roof() -> None:
     assert {"Heaven", "Roof"} <= reached
 
 
-def test_a_replay_over_a_ladder_climbs_at_the_climbing_speed_and_arrives_on_time() -> None:
-    """The plan gives the climb its time at the climbing speed and the walk the rest: 3.5 m and
-    a 2.12 m ladder in 1.5 s. Timed as running (before), the walk went at 3.75 m/s and the
-    climb, capped, made the agent 9 ticks late."""
+@pytest.mark.parametrize(
+    ("nodes", "seconds"),
+    [
+        ((0, 6), 1.5),  # a walk then the climb, tight: the walk needs 4.45 m/s
+        ((0, 6), 3.0),  # the same with time to spare
+        ((6, 0), 2.0),  # down the ladder first, then the walk
+        ((5, 6), 2.0),  # the ladder alone, slowly: on time, not early
+    ],
+    ids=["tight", "slack", "down first", "ladder alone"],
+)
+def test_a_replay_over_a_ladder_reaches_its_target_on_time(
+    nodes: tuple[int, int], seconds: float
+) -> None:
+    """The plan gives the climb its time at the climbing speed and the walk the rest (timed as
+    running, the tight case arrived late: the capped climb took longer than planned)."""
     from test_plans import at, plan_for, with_ladder
 
     from decoy_cli.csgo import tick_at
@@ -403,20 +432,40 @@ def test_a_replay_over_a_ladder_climbs_at_the_climbing_speed_and_arrives_on_time
     from decoy_cli.sim.state import Agents
 
     graph = with_ladder()
+    times = [0.0, seconds, seconds + 1.0]
     plans = [
-        plan_for(graph, at(0, 6, 6, graph=graph), seconds=[0.0, 1.5, 3.0]),
-        plan_for(graph, at(11, 11, 11, graph=graph), seconds=[0.0, 1.5, 3.0]),  # a CT stands
+        plan_for(graph, at(nodes[0], nodes[1], nodes[1], graph=graph), seconds=times),
+        plan_for(graph, at(11, 11, 11, graph=graph), seconds=times),  # a CT stands
     ]
-    nodes = np.array([0, 11])
-    agents = Agents.create(["t", "ct"], ["T", "CT"], graph.positions[nodes], nodes)
+    assert not plans[0].interval_infeasible[0]
+    start = np.array([nodes[0], 11])
+    agents = Agents.create(["t", "ct"], ["T", "CT"], graph.positions[start], start)
     policy = PlanPolicy(plans, tick_at, graph)
     zones = SiteZones(nodes={"A": [[100.0, 100.0, 0.0]]})  # nobody can plant
-    rules = BombRules(zones, RulesConfig())
-    sim = Simulator(graph, agents, KinematicMover(), policy, rules, seed=0)
-    sim.run(to_tick=tick_at(2.0))
+    sim = Simulator(graph, agents, KinematicMover(), policy, BombRules(zones, RulesConfig()))
+    sim.run(to_tick=tick_at(seconds + 0.5))
     log = policy.logs[0]
     assert log.arrival_tick[1] >= 0
     assert abs(log.arrival_tick[1] - log.deadline_tick[1]) <= 1
+
+
+def test_the_cap_leaves_the_climb_out_of_the_players_pace() -> None:
+    """The speed cap is the player's pace over the running time: its straight line less the
+    ladder (climbed in the climb's time), not the whole of it."""
+    from test_plans import at, plan_for, with_ladder
+
+    from decoy_cli.replay.rounds import MAX_ZIGZAG, interval_caps
+
+    graph = with_ladder()
+    positions = at(0, 6, graph=graph)
+    plan = plan_for(graph, positions, seconds=[0.0, 1.5])
+    climbed = plan.interval_length_m[0] - plan.interval_run_m[0]
+    assert climbed == pytest.approx(math.hypot(0.7, 2.0))
+    straight = np.linalg.norm(positions[1] - positions[0]) - climbed
+    pace = straight / plan.interval_running_s[0]
+    zigzag = min(plan.interval_run_m[0] / straight, MAX_ZIGZAG)
+    expected = max(plan.interval_max_speed_m_s[0], pace) * zigzag
+    assert interval_caps(plan, positions)[0] == pytest.approx(expected)
 
 
 def test_random_play_over_a_ladder_is_the_same_compiled_and_stepped() -> None:

@@ -600,7 +600,8 @@ def test_a_ladder_is_planned_as_its_climb_and_the_rest_as_a_run() -> None:
     graph = with_ladder()
     climb = math.hypot(SPACING, 2.0) / LADDER_SPEED_M_S
     plan = plan_for(graph, at(0, 6, graph=graph), seconds=[0.0, 1.5])
-    assert plan.interval_length_m[0] == pytest.approx(5 * SPACING)  # the climb is not run
+    assert plan.interval_run_m[0] == pytest.approx(5 * SPACING)  # the climb is not run
+    assert plan.interval_length_m[0] == pytest.approx(5 * SPACING + math.hypot(SPACING, 2.0))
     assert plan.interval_air_s[0] == pytest.approx(climb)
     assert plan.interval_required_speed_m_s[0] == pytest.approx(5 * SPACING / (1.5 - climb))
     assert not plan.interval_infeasible[0]  # 4.45 m/s: a knife runs it

@@ -299,6 +299,7 @@ def test_a_late_stretch_is_put_down_to_how_its_first_interval_compares_with_the_
     zigzag = replace(
         plan,
         interval_length_m=plan.interval_straight_m * 1.05,
+        interval_run_m=plan.interval_straight_m * 1.05,  # no ladder: all of it is run
         interval_required_speed_m_s=caps * 2,
     )
     assert cause_of(zigzag, caps) == {"zigzag"}

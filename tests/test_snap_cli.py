@@ -23,7 +23,8 @@ from decoy_cli.cli import app
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.esta import read_match
 from decoy_cli.metrics import METRIC_NAMES
-from decoy_cli.replay.plans import MIN_RUN_S, PathCache
+from decoy_cli.replay.pace import MIN_RUN_S
+from decoy_cli.replay.plans import PathCache
 from decoy_cli.replay.snapping import SnapStatus
 from decoy_cli.replay.study import (
     INTERVAL_COLUMNS,

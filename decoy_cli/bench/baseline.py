@@ -84,6 +84,9 @@ class CodeTree:
     label: str
     python: str
     path: Path | None
+    numba_cache: Path | None = None
+    """Where its compiled kernels are cached (an exported baseline's own folder, removed with
+    it); None: where that code caches them."""
 
 
 def current_tree() -> CodeTree:
@@ -118,7 +121,7 @@ def baseline_tree(ref: str, work: Path) -> Iterator[CodeTree]:
         _extract(archive.stdout, target)
         if not (target / "decoy_cli" / "bench" / "__init__.py").is_file():
             raise DecoyError(f"--baseline {ref}: commit {sha[:12]} has no decoy_cli/bench to run")
-        yield CodeTree(f"{ref} ({sha[:12]})", sys.executable, target)
+        yield CodeTree(f"{ref} ({sha[:12]})", sys.executable, target, target / ".numba-cache")
     finally:
         shutil.rmtree(target, ignore_errors=True)
 
@@ -169,6 +172,8 @@ def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | No
         env["PYTHONPATH"] = os.pathsep.join(
             [str(tree.path), *filter(None, [env.get("PYTHONPATH")])]
         )
+    if tree.numba_cache is not None:
+        env["NUMBA_CACHE_DIR"] = str(tree.numba_cache)
     scratch = Path(tempfile.mkdtemp(prefix="section-", dir=work))
     result = scratch / "result.json"
     args = {"config": config, "data": str(data) if data else None, "section": section}

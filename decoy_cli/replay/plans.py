@@ -27,14 +27,13 @@ How a simulator executes a plan (the contract this module promises):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError, GraphError
+from decoy_cli.replay.pace import asks_more, edge_durations, running_seconds
 from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
@@ -46,18 +45,6 @@ ACTION_NAMES = (*DIRECTION_NAMES, "STOP", "RELOCATE")
 
 _NO_EDGE = np.array([-1], dtype=np.int64)
 """The action list of an interval without a move (a STOP or a RELOCATE): no edge."""
-
-RATIO_TOLERANCE = 1e-9
-"""An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
-
-ZIGZAG_MAX = math.cos(math.pi / 8) + (math.sqrt(2) - 1) * math.sin(math.pi / 8) + 1e-6
-"""The longest an eight-way lattice path is against the straight line between its ends: 1.0824,
-22.5° off a lattice axis (straight steps along the axis, then diagonal ones). A way round no
-longer than this is the lattice's zig-zag; a longer one goes round something."""
-
-MIN_RUN_S = 1.0 / TICK_RATE
-"""Shortest running time an interval is given (one simulator tick) when its jumps and falls
-alone take all of it: the required speed is then very large, not infinite."""
 
 
 class PathCache:
@@ -117,14 +104,16 @@ class PlayerPlan:
     interval_skipped_frames: np.ndarray
     """(T-1,) int64 frames between the two targets without a target (absent, unsnappable)."""
     interval_length_m: np.ndarray
-    """(T-1,) float64 shortest-path length run at the player's own speed (`graph.edge_run_m`:
-    a ladder's climb is counted in time instead), 0 when standing still, NaN when unreachable."""
+    """(T-1,) float64 shortest-path length, 0 when standing still, NaN when unreachable."""
+    interval_run_m: np.ndarray
+    """(T-1,) float64 the part of it run at the player's own speed (`graph.edge_run_m`): all of
+    it but the ladders, whose climb is counted in time (`interval_air_s`)."""
     interval_air_s: np.ndarray
     """(T-1,) float64 seconds of the path spent rising, falling or climbing a ladder
     (`graph.edge_fixed_s`)."""
     interval_required_speed_m_s: np.ndarray
-    """(T-1,) float64 length / running time (the time less the air time, at least a tick): the
-    speed needed to arrive on time."""
+    """(T-1,) float64 run length / running time (the time less the air time, at least a tick):
+    the speed needed to arrive on time."""
     interval_max_speed_m_s: np.ndarray
     """(T-1,) float64 CS:GO maximum speed with the weapon held at the interval's start."""
     interval_speed_ratio: np.ndarray
@@ -183,8 +172,16 @@ class PlayerPlan:
     @property
     def interval_running_s(self) -> np.ndarray:
         """(T-1,) float64 each interval's running time: its time less its path's air time, at
-        least a tick (`running_seconds`); the required speed is the length over it."""
+        least a tick (`running_seconds`); the required speed is the run length over it."""
         return running_seconds(self.interval_seconds, self.interval_air_s)
+
+    @property
+    def interval_straight_run_m(self) -> np.ndarray:
+        """(T-1,) float64 the straight line between the targets less the ladders climbed on the
+        way (at least 0): the distance the player's own speed must cover, as `interval_run_m`
+        is the path's."""
+        climb = np.nan_to_num(self.interval_length_m - self.interval_run_m, nan=0.0)
+        return np.maximum(self.interval_straight_m - climb, 0.0)
 
     @property
     def num_intervals(self) -> int:
@@ -300,11 +297,12 @@ def build_plan(
     action_interval = np.repeat(np.arange(count, dtype=np.int64), steps)
     on_edge = action_edge >= 0
     edge = np.where(on_edge, action_edge, 0)
-    edge_length = np.where(on_edge, graph.edge_run_m[edge], 0.0)  # run at the agent's speed
+    edge_run = np.where(on_edge, graph.edge_run_m[edge], 0.0)  # run at the agent's speed
     edge_air = np.where(on_edge, graph.edge_fixed_s[edge], 0.0)  # rising, falling, climbing
     starts = np.cumsum(steps) - steps
-    length, air = (
-        _interval_sums(edge_length, starts, steps),
+    length, run, air = (
+        _interval_sums(np.where(on_edge, graph.edge_length[edge], 0.0), starts, steps),
+        _interval_sums(edge_run, starts, steps),
         _interval_sums(edge_air, starts, steps),
     )
     step_nodes = np.where(on_edge, graph.edge_target[edge], ends[action_interval])
@@ -313,20 +311,22 @@ def build_plan(
         graph.edge_direction[edge],
         np.where(unreachable[action_interval], RELOCATE_ACTION, STOP_ACTION),
     ).astype(np.int8)
-    durations = _edge_durations(
-        interval_seconds[action_interval], edge_length, edge_air, length[action_interval],
+    durations = edge_durations(
+        interval_seconds[action_interval], edge_run, edge_air, run[action_interval],
         air[action_interval], on_edge,
     )  # fmt: skip
     length[unreachable] = np.nan
+    run[unreachable] = np.nan
 
     with np.errstate(divide="ignore", invalid="ignore"):
         running = running_seconds(interval_seconds, air)
-        required = np.where(length == 0, 0.0, length / running)
+        required = np.where(run == 0, 0.0, run / running)
     ratio = required / max_speed
     straight = np.linalg.norm(
         graph.positions[target_node[1:]] - graph.positions[target_node[:-1]], axis=1
     )
-    infeasible, detour, zigzag = asks_more(required, straight, running, length, max_speed)
+    straight_run = np.maximum(straight - np.nan_to_num(length - run, nan=0.0), 0.0)
+    infeasible, detour, zigzag = asks_more(required, straight_run, running, run, max_speed)
     path_interval = np.concatenate([np.full(len(target_node[:1]), -1), action_interval])
     target_path_index = np.concatenate([[0], np.cumsum(steps)])[: len(target_node)]
     last_alive_frame, death_frame = _fate(alive, present)
@@ -338,6 +338,7 @@ def build_plan(
         interval_seconds=interval_seconds,
         interval_skipped_frames=np.diff(target_frame).astype(np.int64) - 1,
         interval_length_m=length,
+        interval_run_m=run,
         interval_air_s=air,
         interval_required_speed_m_s=required,
         interval_max_speed_m_s=max_speed,
@@ -360,31 +361,6 @@ def build_plan(
         death_frame=death_frame,
         death_seconds=float(seconds[death_frame]) if death_frame >= 0 else float("nan"),
     )
-
-
-def asks_more(
-    required: np.ndarray,
-    straight: np.ndarray,
-    running: np.ndarray,
-    length: np.ndarray,
-    limit: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Which intervals ask for more than a speed `limit` (m/s, per interval): (over the limit;
-    only by the graph's way, the straight line between the two waypoints would be within it;
-    of those, only by the lattice's zig-zag, `ZIGZAG_MAX`). `required` is the path's speed over
-    the `running` time, `straight` the waypoints' distance, `length` the path's (NaN:
-    unreachable, never a zig-zag)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        over = required / limit > 1.0 + RATIO_TOLERANCE
-        straight_fits = straight / running / limit <= 1.0 + RATIO_TOLERANCE
-    detour = over & straight_fits
-    return over, detour, detour & (length <= ZIGZAG_MAX * straight)
-
-
-def running_seconds(seconds: np.ndarray, air: np.ndarray) -> np.ndarray:
-    """The time an interval leaves for running: its `seconds` less the `air` time its path
-    spends rising, falling or climbing (not at the player's own speed), at least `MIN_RUN_S`."""
-    return np.maximum(seconds - air, MIN_RUN_S)
 
 
 def _max_speeds(names: np.ndarray) -> np.ndarray:
@@ -424,26 +400,3 @@ def _interval_sums(values: np.ndarray, starts: np.ndarray, steps: np.ndarray) ->
     for k in np.flatnonzero(steps > 7).tolist():
         sums[k] = values[starts[k] : starts[k] + steps[k]].sum()
     return sums
-
-
-def _edge_durations(
-    seconds: np.ndarray,
-    length: np.ndarray,
-    air: np.ndarray,
-    total_length: np.ndarray,
-    total_air: np.ndarray,
-    on_edge: np.ndarray,
-) -> np.ndarray:
-    """Each action's share of its interval's `seconds` (all arrays per action, the totals those
-    of its interval): an edge gets its time in the air (rising, falling, climbing), and the rest
-    of the interval by length, run at one speed (all of it by air time when the air time alone
-    exceeds it, or when nothing of the path is run: a ladder alone); a STOP or a RELOCATE gets
-    the whole interval."""
-    by_air = (total_air > 0) & ((seconds <= total_air) | (total_length <= 0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        shared = np.where(
-            by_air,
-            seconds * air / total_air,
-            air + (seconds - total_air) * length / total_length,
-        )
-    return np.where(on_edge, shared, seconds)

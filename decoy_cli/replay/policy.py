@@ -204,11 +204,26 @@ class PlanPolicy:
                 return Decision(STOP_ACTION, hold_ticks=1, plant=True)
             seconds_left = (deadline - now) / TICK_RATE - self._remaining_air[agent][a - 1]
             speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
-            if sim.graph.edge_kind[plan.action_edge[a - 1]] == EdgeKind.LADDER:
-                speed = None  # climbed at the climbing speed: the time the plan gave it
+            edge = int(plan.action_edge[a - 1])
+            if sim.graph.edge_kind[edge] == EdgeKind.LADDER:
+                speed = self._climb_speed(
+                    sim.graph, edge, agent, a - 1, (deadline - now) / TICK_RATE
+                )
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
         return Decision(STOP_ACTION, hold_ticks=FOREVER, plant=plant, defuse=defuse)
+
+    def _climb_speed(
+        self, graph: WaypointGraph, edge: int, agent: int, action: int, seconds_left: float
+    ) -> float | None:
+        """A ladder's speed: the climbing speed (None: the fastest, capped by the movers), the
+        time the plan gave the climb; with nothing left to run in its interval, slow enough to
+        reach the interval's end by its deadline, as a run would."""
+        if self._remaining[agent][action] > 0:
+            return None
+        after = self._remaining_air[agent][action] - float(graph.edge_climb_s[edge])
+        climb_s = seconds_left - after
+        return float(graph.edge_length[edge]) / climb_s if climb_s > 0 else None
 
     def _arrive(self, agent: int, interval: int, now: int) -> None:
         """Log the arrival at the target that ends `interval` (first arrival only)."""

@@ -33,7 +33,8 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
-from decoy_cli.replay.plans import PlayerPlan, asks_more
+from decoy_cli.replay.pace import asks_more
+from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
@@ -151,9 +152,9 @@ def stretch_causes(plan: PlayerPlan, caps: np.ndarray, late: np.ndarray) -> np.n
     if count > 1:
         over, detour, zigzag = asks_more(
             plan.interval_required_speed_m_s,
-            plan.interval_straight_m,
+            plan.interval_straight_run_m,
             plan.interval_running_s,
-            plan.interval_length_m,
+            plan.interval_run_m,
             caps,
         )
         interval[1:] = np.select(

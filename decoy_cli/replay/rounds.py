@@ -194,7 +194,7 @@ def expected_lateness(plan: PlayerPlan, caps: np.ndarray) -> np.ndarray:
     at its deadline, or at once when it is already late."""
     late = np.zeros(len(plan.target_node))
     deadline = plan.target_seconds
-    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
+    length = np.nan_to_num(plan.interval_run_m, nan=0.0)
     with np.errstate(divide="ignore"):
         run = np.where(length > 0, length / caps, 0.0) + plan.interval_air_s
     for k in range(len(length)):
@@ -216,9 +216,10 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     8-direction lattice is longer than the straight line the player ran (zig-zag, snapping). So
     the cap is the larger of the weapon's maximum and the player's own measured speed over the
     interval's running time (as the required speed: without the path's air time), times the
-    path's zig-zag factor: path length over the player's own displacement,
-    at most `MAX_ZIGZAG`. (Measured against the straight line between the two snapped
-    waypoints instead, snap jitter made agents late, and the real rounds' replay error grew.)
+    path's zig-zag factor: path length over the player's own displacement (both less the
+    ladders climbed, whose time is the climb's), at most `MAX_ZIGZAG`. (Measured against the
+    straight line between the two snapped waypoints instead, snap jitter made agents late, and
+    the real rounds' replay error grew.)
     A replay is never asked to run faster than the player did except for the lattice's
     geometry; what remains infeasible (a detour around a missing edge) stays late, and the
     lateness says so.
@@ -226,9 +227,10 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     if len(plan.target_node) < 2:
         return np.zeros(0)
     displacement = np.linalg.norm(np.diff(original[plan.target_frame], axis=0), axis=1)
-    straight = np.nan_to_num(displacement, nan=0.0)  # a frame without a position: no measure
+    climbed = np.nan_to_num(plan.interval_length_m - plan.interval_run_m, nan=0.0)  # ladders
+    straight = np.maximum(np.nan_to_num(displacement, nan=0.0) - climbed, 0.0)  # NaN: no measure
     ran = straight / plan.interval_running_s
-    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
+    length = np.nan_to_num(plan.interval_run_m, nan=0.0)
     zigzag = np.clip(
         np.where(straight > 0.05, length / np.maximum(straight, 1e-9), 1.0), 1.0, MAX_ZIGZAG
     )

@@ -181,17 +181,19 @@ def kinematic_glide(pos, start, target, fv, iv, flags, prm, max_ticks):
 @njit_cached
 def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target, fv, iv):
     """Start agent i on the edge to (tx, ty, tz) of `kind` (EdgeKind) at `speed` (capped by
-    its max speed, first set to `cap` unless that is negative, and on a ladder by the climbing
-    speed): its phase, vertical speed and heading. Returns False, changing nothing, if the
-    agent is in the air (it lands first)."""
+    its max speed, first set to `cap` unless that is negative; on a ladder, the climbing speed
+    when the agent is asked for its max speed, which no weapon slows, else the speed asked up to
+    it): its phase, vertical speed and heading. Returns False, changing nothing, if the agent is
+    in the air (it lands first)."""
     if iv[i, I_PHASE] in (RISE, GLIDE, FALL):
         return False
     if cap >= 0.0:
         fv[i, F_MAX_SPEED] = cap
     target[i, 0], target[i, 1], target[i, 2] = tx, ty, tz
     fv[i, F_SPEED] = min(speed, fv[i, F_MAX_SPEED])
-    if kind == LADDER_EDGE:
-        fv[i, F_SPEED] = min(fv[i, F_SPEED], LADDER_SPEED_M_S)
+    if kind == LADDER_EDGE:  # asked for its full speed, an agent climbs at the climbing speed
+        full = speed >= fv[i, F_MAX_SPEED] - EPS
+        fv[i, F_SPEED] = LADDER_SPEED_M_S if full else min(speed, LADDER_SPEED_M_S)
     fv[i, F_VZ] = 0.0
     z = pos[i, 2]
     if kind == JUMP_EDGE and tz > z + EPS:
