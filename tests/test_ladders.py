@@ -322,6 +322,11 @@ def test_two_ladders_from_one_foot_take_two_directions() -> None:
     assert sorted(up[:, 3].tolist()) == [2, 3]  # east, then the next free one (south-east)
 
 
+def test_a_ladder_whose_ends_find_one_node_joins_nothing() -> None:
+    edges, joined = joined_edges([[0.0, 0.0, 0.3, 0.0, 0.0, 0.0]], [])  # a step, not a climb
+    assert joined == 0 and len(edges) == 0
+
+
 def test_a_second_ladder_between_the_same_nodes_adds_nothing() -> None:
     edges, joined = joined_edges(
         [[0.6, 0.0, 3.0, 0.0, 0.0, 0.0], [0.6, 0.02, 3.0, 0.0, 0.02, 0.0]], []
