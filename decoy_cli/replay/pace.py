@@ -48,6 +48,12 @@ def asks_more(
     return over, detour, detour & (length <= ZIGZAG_MAX * straight)
 
 
+def less_climbed(distance: np.ndarray, length: np.ndarray, run: np.ndarray) -> np.ndarray:
+    """A straight `distance` less the ladders climbed on a path of `length` of which `run` is
+    run (at least 0; NaN lengths: nothing climbed): what the player's own speed must cover."""
+    return np.maximum(distance - np.nan_to_num(length - run, nan=0.0), 0.0)
+
+
 def running_seconds(seconds: np.ndarray, air: np.ndarray) -> np.ndarray:
     """The time an interval leaves for running: its `seconds` less the `air` time its path
     spends rising, falling or climbing (not at the player's own speed), at least `MIN_RUN_S`."""

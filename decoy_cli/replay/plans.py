@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError, GraphError
-from decoy_cli.replay.pace import asks_more, edge_durations, running_seconds
+from decoy_cli.replay.pace import asks_more, edge_durations, less_climbed, running_seconds
 from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
@@ -180,8 +180,7 @@ class PlayerPlan:
         """(T-1,) float64 the straight line between the targets less the ladders climbed on the
         way (at least 0): the distance the player's own speed must cover, as `interval_run_m`
         is the path's."""
-        climb = np.nan_to_num(self.interval_length_m - self.interval_run_m, nan=0.0)
-        return np.maximum(self.interval_straight_m - climb, 0.0)
+        return less_climbed(self.interval_straight_m, self.interval_length_m, self.interval_run_m)
 
     @property
     def num_intervals(self) -> int:
@@ -325,7 +324,7 @@ def build_plan(
     straight = np.linalg.norm(
         graph.positions[target_node[1:]] - graph.positions[target_node[:-1]], axis=1
     )
-    straight_run = np.maximum(straight - np.nan_to_num(length - run, nan=0.0), 0.0)
+    straight_run = less_climbed(straight, length, run)
     infeasible, detour, zigzag = asks_more(required, straight_run, running, run, max_speed)
     path_interval = np.concatenate([np.full(len(target_node[:1]), -1), action_interval])
     target_path_index = np.concatenate([[0], np.cumsum(steps)])[: len(target_node)]

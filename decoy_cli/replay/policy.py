@@ -60,8 +60,8 @@ class PlanPolicy:
         self.plant = plant
         self.defuse_window = defuse_window or {}  # agent -> ticks it wants to defuse
         self.logs = []
-        # per plan and action: path length of this and the later moves of its interval, and
-        # whether it is the last move of its interval
+        # per plan and action: the run (metres at the agent's own speed) of this and the later
+        # moves of its interval, and whether it is the last move of its interval
         self._remaining = []
         self._remaining_air = []  # seconds of those moves spent rising, falling, climbing
         self._last_move = []
@@ -202,28 +202,26 @@ class PlanPolicy:
             if self._plants_here(sim, agent, interval):
                 self.next_action[agent] = a - 1  # the move waits until the plant completes
                 return Decision(STOP_ACTION, hold_ticks=1, plant=True)
-            seconds_left = (deadline - now) / TICK_RATE - self._remaining_air[agent][a - 1]
-            speed = None if seconds_left <= 0 else self._remaining[agent][a - 1] / seconds_left
-            edge = int(plan.action_edge[a - 1])
-            if sim.graph.edge_kind[edge] == EdgeKind.LADDER:
-                speed = self._climb_speed(
-                    sim.graph, edge, agent, a - 1, (deadline - now) / TICK_RATE
-                )
+            speed = self._speed(sim.graph, agent, a - 1, (deadline - now) / TICK_RATE)
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
         return Decision(STOP_ACTION, hold_ticks=FOREVER, plant=plant, defuse=defuse)
 
-    def _climb_speed(
-        self, graph: WaypointGraph, edge: int, agent: int, action: int, seconds_left: float
+    def _speed(
+        self, graph: WaypointGraph, agent: int, action: int, seconds_left: float
     ) -> float | None:
-        """A ladder's speed: the climbing speed (None: the fastest, capped by the movers), the
-        time the plan gave the climb; with nothing left to run in its interval, slow enough to
-        reach the interval's end by its deadline, as a run would."""
-        if self._remaining[agent][action] > 0:
-            return None
-        after = self._remaining_air[agent][action] - float(graph.edge_climb_s[edge])
-        climb_s = seconds_left - after
-        return float(graph.edge_length[edge]) / climb_s if climb_s > 0 else None
+        """The speed of a move that reaches its interval's end in `seconds_left`: the run left
+        over the time its rises, falls and climbs leave (None: as fast as it can). A ladder is
+        climbed at the climbing speed (None), the time the plan gave it; with nothing left to
+        run, slow enough to reach the interval's end by its deadline, as a run would."""
+        run, fixed = self._remaining[agent][action], self._remaining_air[agent][action]
+        edge = int(self.plans[agent].action_edge[action])
+        if graph.edge_kind[edge] == EdgeKind.LADDER:
+            if run > 0:
+                return None
+            run, fixed = float(graph.edge_length[edge]), fixed - float(graph.edge_climb_s[edge])
+        running_s = seconds_left - fixed
+        return run / running_s if running_s > 0 else None
 
     def _arrive(self, agent: int, interval: int, now: int) -> None:
         """Log the arrival at the target that ends `interval` (first arrival only)."""

@@ -18,6 +18,7 @@ import pandas as pd
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
+from decoy_cli.replay.pace import less_climbed
 from decoy_cli.replay.plans import PathCache, PlayerPlan, build_plan
 from decoy_cli.replay.snapping import (
     DEFAULT_MAX_SNAP_M,
@@ -227,8 +228,8 @@ def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:
     if len(plan.target_node) < 2:
         return np.zeros(0)
     displacement = np.linalg.norm(np.diff(original[plan.target_frame], axis=0), axis=1)
-    climbed = np.nan_to_num(plan.interval_length_m - plan.interval_run_m, nan=0.0)  # ladders
-    straight = np.maximum(np.nan_to_num(displacement, nan=0.0) - climbed, 0.0)  # NaN: no measure
+    displacement = np.nan_to_num(displacement, nan=0.0)  # a frame without a position: no measure
+    straight = less_climbed(displacement, plan.interval_length_m, plan.interval_run_m)
     ran = straight / plan.interval_running_s
     length = np.nan_to_num(plan.interval_run_m, nan=0.0)
     zigzag = np.clip(

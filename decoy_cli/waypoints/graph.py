@@ -174,11 +174,7 @@ class WaypointGraph:
         """(E,) what an edge costs a running agent, in metres: what it runs of it plus the
         distance it would have run (at knife speed) in the time it spends rising, falling or
         climbing."""
-        climb = self.edge_kind == EdgeKind.LADDER  # the climb's time as run metres
-        length = np.where(
-            climb, self.edge_length * RUN_SPEED_M_S / LADDER_SPEED_M_S, self.edge_length
-        )
-        return length + RUN_SPEED_M_S * self.edge_air_s
+        return self.edge_run_m + RUN_SPEED_M_S * self.edge_fixed_s
 
     @cached_property
     def adjacency(self) -> csr_matrix:

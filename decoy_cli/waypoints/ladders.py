@@ -86,40 +86,39 @@ def add_ladder_edges(
     """`edges` (E, 4: source, target, kind, direction) with a LADDER edge each way for every
     ladder whose two ends have a node (see the module docstring for nodes already joined);
     returns (edges, ladders joined)."""
-    edges = np.array(edges, dtype=np.int64).reshape(-1, 4)
-    used = {(int(s), int(d)) for s, d in edges[:, [0, 3]]}
-    joining = {(int(s), int(t)): k for k, (s, t) in enumerate(edges[:, :2].tolist())}
+    rows = np.asarray(edges, dtype=np.int64).reshape(-1, 4).tolist()
+    used = {(s, d) for s, _, _, d in rows}
+    joining = {(s, t): k for k, (s, t, _, _) in enumerate(rows)}
     reach = LADDER_REACH * params.spacing
     ends = ladder_ends(ladders_u)
-    added: list[tuple[int, int, int, int]] = []
     joined = 0
     for top_end, bottom_end in zip(ends[0::2], ends[1::2], strict=True):
         top = _end_node(positions, *top_end, reach)
         bottom = _end_node(positions, *bottom_end, reach)
         if top < 0 or bottom < 0 or top == bottom:
             continue
-        ways = []  # (source, target, direction, the edge already joining them or -1)
-        for source, target in ((bottom, top), (top, bottom)):
-            known = joining.get((source, target), -1)
-            direction = _free_direction(used, source, positions[target] - positions[source])
-            ways.append((source, target, direction, known))
-        if any(direction < 0 and known < 0 for _, _, direction, known in ways):
+        ways = [(bottom, top), (top, bottom)]
+        new = {
+            (s, t): _free_direction(used, s, positions[t] - positions[s])
+            for s, t in ways
+            if (s, t) not in joining
+        }
+        if any(d < 0 for d in new.values()):
             continue
-        for source, target, direction, known in ways:
-            if known >= len(edges):
-                continue  # a ladder added for another ladder between the same two nodes
-            if known >= 0:
-                depth = positions[source, 2] - positions[target, 2]
-                if edges[known, 2] == EdgeKind.DROP and depth > SAFE_DROP_M:
-                    edges[known, 2] = int(EdgeKind.LADDER)
-                continue
-            used.add((source, direction))
-            joining[source, target] = len(edges) + len(added)
-            added.append((source, target, int(EdgeKind.LADDER), direction))
+        for s, t in ways:
+            if (s, t) in new:
+                used.add((s, new[s, t]))
+                joining[s, t] = len(rows)
+                rows.append([s, t, int(EdgeKind.LADDER), new[s, t]])
+            elif rows[joining[s, t]][2] == EdgeKind.DROP and _hurts(positions, s, t):
+                rows[joining[s, t]][2] = int(EdgeKind.LADDER)
         joined += 1
-    if added:
-        edges = np.concatenate([edges, np.asarray(added, dtype=np.int64)])
-    return edges, joined
+    return np.asarray(rows, dtype=np.int64).reshape(-1, 4), joined
+
+
+def _hurts(positions: np.ndarray, source: int, target: int) -> bool:
+    """Whether a drop from `source` to `target` is deeper than the safe fall."""
+    return bool(positions[source, 2] - positions[target, 2] > SAFE_DROP_M)
 
 
 def _end_node(

@@ -158,12 +158,13 @@ def read_ladders(path: Path, nav: NavMesh) -> np.ndarray:
     """The ladders of a `nav_ladders.csv` (`LADDER_ENDS`, Hammer units); a WorldError naming the
     file and line for a malformed row, a ladder whose top is not above its bottom or one off
     the map's nav mesh."""
-    rows = _number_rows(path, LADDER_ENDS, "ladder")
-    for where, ladder in zip(*rows, strict=True):
+    wheres, ladders = _number_rows(path, LADDER_ENDS, "ladder")
+    bounds = _reach(nav)
+    for where, ladder in zip(wheres, ladders, strict=True):
         if not ladder[2] > ladder[5]:
             raise WorldError(f"{where}: the ladder's top is not above its bottom")
-        _on_the_map(where, ladder.reshape(2, 3), nav, "the ladder")
-    return rows[1]
+        _on_the_map(where, ladder.reshape(2, 3), bounds, "the ladder")
+    return ladders
 
 
 def _number_rows(path: Path, columns: tuple[str, ...], what: str) -> tuple[list[str], np.ndarray]:
@@ -187,11 +188,18 @@ def _number_rows(path: Path, columns: tuple[str, ...], what: str) -> tuple[list[
     return wheres, values
 
 
-def _on_the_map(where: str, points: np.ndarray, nav: NavMesh, what: str) -> None:
-    """A WorldError unless the (P, 3) points lie within `PATCH_REACH_U` of the nav mesh's
-    bounding box."""
+def _reach(nav: NavMesh) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) corners of the nav mesh's bounding box grown by `PATCH_REACH_U`."""
     low = np.array([nav.x_min.min(), nav.y_min.min(), nav.z_at_min.min()]) - PATCH_REACH_U
     high = np.array([nav.x_max.max(), nav.y_max.max(), nav.z_at_max.max()]) + PATCH_REACH_U
+    return low, high
+
+
+def _on_the_map(
+    where: str, points: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], what: str
+) -> None:
+    """A WorldError unless the (P, 3) points lie within `bounds` (`_reach`)."""
+    low, high = bounds
     if np.any(points < low) or np.any(points > high):
         raise WorldError(f"{where}: {what} lies off the map's nav mesh")
 
@@ -214,10 +222,11 @@ PATCH_REACH_U = 512.0
 def read_patches(path: Path, nav: NavMesh) -> np.ndarray:
     """The boxes of a patches file (`PATCH_COLUMNS`, Hammer units); a WorldError naming the file
     and line for a malformed row, an empty or upside-down box, or one off the map's nav mesh."""
-    rows = _number_rows(path, PATCH_COLUMNS, "patch")
-    for where, box in zip(*rows, strict=True):
+    wheres, boxes = _number_rows(path, PATCH_COLUMNS, "patch")
+    bounds = _reach(nav)
+    for where, box in zip(wheres, boxes, strict=True):
         x0, y0, x1, y1, top, bottom = box
         if not (x0 < x1 and y0 < y1 and bottom < top):
             raise WorldError(f"{where}: an empty or upside-down box")
-        _on_the_map(where, np.array([[x0, y0, bottom], [x1, y1, top]]), nav, "the box")
-    return rows[1]
+        _on_the_map(where, np.array([[x0, y0, bottom], [x1, y1, top]]), bounds, "the box")
+    return boxes
