@@ -36,13 +36,14 @@ from decoy_cli.world.physics import PhysicsWorld
 
 LADDER_REACH = 2
 """How far from a ladder's end (horizontally, in lattice spacings) its floor node may lie: the
-top's floor starts beyond the lip (on the five maps with ladders, up to 1.4 m away)."""
+top's floor starts beyond the lip (`python benchmarks/ladder_ends.py` lists each shipped
+ladder's)."""
 TOP_BAND_M = (-JUMP_HEIGHT_M, STEP_HEIGHT_M)
 """Heights of a top's floor relative to the ladder's top: down to a crouch-jump below (the brush
 rising past the lip), up to a step above."""
 BOTTOM_BAND_M = (-0.9, STEP_HEIGHT_M)
-"""Heights of a bottom's floor relative to the ladder's bottom: chosen by hand above the ladder
-bottoms of the five maps, which lie 0.04-0.79 m above their floors."""
+"""Heights of a bottom's floor relative to the ladder's bottom: chosen by hand just beyond the
+deepest of the shipped ladders' (`python benchmarks/ladder_ends.py`)."""
 _ANGLES = np.arange(8) * (math.pi / 4)
 
 
@@ -58,26 +59,33 @@ def ladder_ends(ladders_u: np.ndarray) -> list[tuple[np.ndarray, tuple[float, fl
 def ladder_seeds(physics: PhysicsWorld, ladders_u: np.ndarray, params: LatticeParams) -> np.ndarray:
     """(S, 3) floor points (metres) beside the ends of the ladders (Hammer units, (L, 6) tops and
     bottoms), one per end that has a floor in its band; see the module docstring."""
-    seeds = []
-    rings = np.arange(2 * LADDER_REACH + 1) * (params.spacing / 2)
-    for end, (below, above) in ladder_ends(ladders_u):
-        for radius in rings:
-            angles = _ANGLES[:1] if radius == 0.0 else _ANGLES
-            probes = np.column_stack(
-                [
-                    end[0] + radius * np.cos(angles),
-                    end[1] + radius * np.sin(angles),
-                    np.full(len(angles), end[2] + above + params.jump_height),
-                ]
-            )
-            z, normal_z = physics.first_floor_below(probes, params.jump_height + above - below)
-            ok = np.isfinite(z) & (normal_z >= params.min_floor_normal_z)
-            ok &= (z >= end[2] + below) & (z <= end[2] + above)
-            if ok.any():
-                k = int(np.argmax(ok))
-                seeds.append([probes[k, 0], probes[k, 1], z[k]])
-                break
-    return np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
+    found = [end_floor(physics, end, band, params) for end, band in ladder_ends(ladders_u)]
+    return np.asarray([f[0] for f in found if f is not None], dtype=np.float64).reshape(-1, 3)
+
+
+def end_floor(
+    physics: PhysicsWorld, end: np.ndarray, band: tuple[float, float], params: LatticeParams
+) -> tuple[np.ndarray, float] | None:
+    """The floor point nearest a ladder's `end` (metres) on rings around it, half a lattice
+    spacing apart out to `LADDER_REACH` spacings, whose height relative to the end lies in
+    `band`, with its ring's radius; None if there is none."""
+    below, above = band
+    for radius in np.arange(2 * LADDER_REACH + 1) * (params.spacing / 2):
+        angles = _ANGLES[:1] if radius == 0.0 else _ANGLES
+        probes = np.column_stack(
+            [
+                end[0] + radius * np.cos(angles),
+                end[1] + radius * np.sin(angles),
+                np.full(len(angles), end[2] + above + params.jump_height),
+            ]
+        )
+        z, normal_z = physics.first_floor_below(probes, params.jump_height + above - below)
+        ok = np.isfinite(z) & (normal_z >= params.min_floor_normal_z)
+        ok &= (z >= end[2] + below) & (z <= end[2] + above)
+        if ok.any():
+            k = int(np.argmax(ok))
+            return np.array([probes[k, 0], probes[k, 1], z[k]]), float(radius)
+    return None
 
 
 def add_ladder_edges(
