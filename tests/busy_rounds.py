@@ -21,13 +21,18 @@ from decoy_cli.world.physics import PhysicsWorld
 
 
 class Shots:
-    """A damage model that hits a tenth of the visible pairs for 10 HP (drawn from the
-    engine's generator, so both runs must ask it at the same ticks in the same order)."""
+    """A damage model that hits a `share` of the visible pairs (a tenth) for `damage` HP (10),
+    drawn from the engine's generator, so both runs must ask it at the same ticks in the same
+    order."""
+
+    def __init__(self, share: float = 0.1, damage: int = 10) -> None:
+        self.share = share
+        self.damage = damage
 
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
-        hit = rng.random(len(batch)) < 0.1
+        hit = rng.random(len(batch)) < self.share
         groups = np.where(hit, 2, -1).astype(np.int8)
-        return DamageResult(np.where(hit, 10, 0).astype(np.int64), groups, hit)
+        return DamageResult(np.where(hit, self.damage, 0).astype(np.int64), groups, hit)
 
 
 class Wanderers:
@@ -124,6 +129,39 @@ def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
     monkeypatch.setattr(quiet_play, "_play", counting)
     return made
+
+
+def count_quiet_steps(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """From now on, how each of the environment's compiled steps ended (`env_step`'s
+    `_quiet_step`: `env_step.PLAYED` when it played the step whole), call by call."""
+    from decoy_cli.sim import env_step
+
+    ended: list[int] = []
+    step = env_step._quiet_step
+
+    def counting(*args):
+        out = step(*args)
+        ended.append(int(out[0]))
+        return out
+
+    monkeypatch.setattr(env_step, "_quiet_step", counting)
+    return ended
+
+
+def no_compiled_steps(monkeypatch: pytest.MonkeyPatch) -> None:
+    """From now on, simulators step every tick (the environment's steps too): the reference
+    the compiled paths are compared with."""
+
+    def stepping(sim: Simulator, until=None, *, stop_when_due: bool = False):
+        first = sim.tick
+        while not sim.done and not (until is not None and until(sim)):
+            if stop_when_due and sim.tick > first and sim.needs_decision.any():
+                break
+            sim.step()
+        return sim.recording
+
+    monkeypatch.setattr(Simulator, "run", stepping)
+    monkeypatch.setattr(Simulator, "quiet_horizon", lambda sim: sim.tick)
 
 
 def random_round(

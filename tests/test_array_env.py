@@ -5,14 +5,17 @@ seeding, masks and timing are tested through the PettingZoo API in tests/test_si
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 
 import numpy as np
 import pytest
+from busy_rounds import Shots, count_quiet_steps, no_compiled_steps
 
 from decoy_cli.sim.array_env import ArrayStep, DecoyArrayEnv
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
 from decoy_cli.sim.env import DecoyParallelEnv
+from decoy_cli.sim.env_step import LEFT_TO_RUN, PLAYED
 from decoy_cli.waypoints.graph import STOP_ACTION
 
 
@@ -132,3 +135,67 @@ def test_actions_of_agents_not_due_are_ignored_and_bad_actions_named(env: DecoyA
     actions = np.full(10, -5)  # the agents not due may be given anything
     actions[0] = STOP_ACTION
     env.step(actions)
+
+
+def _same_state(one: ArrayStep, other: ArrayStep) -> bool:
+    return all(
+        np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b
+        for a, b in zip(dataclasses.astuple(one), dataclasses.astuple(other), strict=True)
+    )
+
+
+@pytest.mark.parametrize("map_name", ["dust2", "nuke"])
+def test_compiled_steps_give_what_stepping_every_tick_gives(monkeypatch, map_name) -> None:
+    """Quiet steps are played in one compiled call (`env_step`); with none of it and every
+    tick stepped, the same actions give the same states step for step, and the same events:
+    deaths, dropped bombs, impossible moves, the drops and ladders of de_nuke."""
+
+    def play() -> tuple[list[ArrayStep], list]:
+        env = DecoyArrayEnv(map=map_name, damage_model=Shots(share=0.5, damage=25))
+        graph = env.graph
+        edges = graph.out_edges
+        damaging = (edges >= 0) & (graph.fall_m[np.maximum(edges, 0)] > 0)
+        rng = np.random.default_rng(1)
+        states, events = [], []
+        for seed in range(3):
+            state = env.reset(seed)
+            assert env.sim is not None
+            if seed == 0:  # onto damaging drops, which they take: fall damage
+                others = [t for t in range(5) if t != env.sim.bomb.carrier]
+                for agent, node in zip(
+                    others, np.flatnonzero(damaging.any(axis=1))[:3], strict=False
+                ):
+                    env.sim.relocate(agent, int(node))
+            if seed == 1:  # onto the bomb carrier: fights, deaths, a dropped bomb
+                for ct in (5, 6, 7, 8):
+                    env.sim.relocate(ct, int(env.sim.agents.node[env.sim.bomb.carrier]))
+            steps = 0
+            while state.winner is None:
+                actions = random_masked(state, rng)
+                wild = rng.random(len(actions)) < 0.03  # any action, possible or not
+                actions[wild] = rng.integers(0, STOP_ACTION + 1, int(wild.sum()))
+                drops = damaging[env.sim.agents.node]  # take damaging drops where there are
+                taken = drops.any(axis=1) & state.needs_decision
+                actions[taken] = np.argmax(drops[taken], axis=1)
+                state = env.step(actions)
+                states.append(state)
+                steps += 1
+                if seed == 2 and steps > 300 and not state.needs_decision[5:].any():
+                    for ct in np.flatnonzero(env.sim.agents.alive[5:]) + 5:
+                        env.sim.kill(int(ct), "test")  # from outside: the round ends
+            events += env.sim.events
+        env.close()
+        return states, events
+
+    ended = count_quiet_steps(monkeypatch)
+    compiled, compiled_events = play()
+    assert ended.count(PLAYED) > 500 and ended.count(LEFT_TO_RUN) > 50  # both ways were taken
+    no_compiled_steps(monkeypatch)
+    stepped, stepped_events = play()
+    assert len(compiled) == len(stepped)
+    for k, (one, other) in enumerate(zip(compiled, stepped, strict=True)):
+        assert _same_state(one, other), k
+    assert compiled_events == stepped_events
+    kinds = {event.kind for event in stepped_events}
+    assert {"kill", "death", "bomb_drop", "invalid_action", "round_end"} <= kinds, kinds
+    assert "fall_damage" in kinds

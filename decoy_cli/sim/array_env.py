@@ -17,19 +17,18 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from contextlib import ExitStack
-from dataclasses import dataclass
 from numbers import Integral
 from typing import TypeGuard, cast
 
 import numpy as np
 
-from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import BUILTIN_MAP, seconds_to_ticks
 from decoy_cli.errors import GraphError
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.observation import NUM_ACTIONS, ObservationEncoder
+from decoy_cli.sim.env_step import ArrayStep, RoundSteps
+from decoy_cli.sim.observation import ObservationEncoder
 from decoy_cli.sim.quiet_play import Choices, play_stretch
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
@@ -42,21 +41,6 @@ from decoy_cli.world.world import World
 
 DEFAULT_WEAPONS = {"T": "Glock-18", "CT": "USP-S"}
 """The pistol each side starts a pistol round with."""
-
-
-@dataclass(frozen=True, slots=True)
-class ArrayStep:
-    """The state after a reset or a step, one row per agent (`possible_agents` order)."""
-
-    observations: np.ndarray  # (N, size) float32 (`DecoyParallelEnv` documents the entries)
-    action_masks: np.ndarray  # (N, 9) int8: the moves with an edge and STOP; STOP only if not due
-    needs_decision: np.ndarray  # (N,) bool: whose action the next step uses
-    rewards: np.ndarray  # (N,) float32: +1/-1 by side at the round's end, else 0
-    terminated: np.ndarray  # (N,) bool: left the episode at this step (died, or the round ended)
-    active: np.ndarray  # (N,) bool: still in the episode (alive and the round goes on)
-    tick: int  # the simulator's tick of this state
-    winner: str | None  # "T" or "CT" once the round has ended
-    reason: str | None  # how it ended, named as in ESTA
 
 
 class _ChosenActions:
@@ -173,9 +157,8 @@ class DecoyArrayEnv:
 
         self._rng: np.random.Generator | None = None
         self._sim: Simulator | None = None
+        self._steps: RoundSteps | None = None
         self._policy = _ChosenActions(self.sides, self.stop_ticks)
-        self._due = np.zeros(len(self.sides), dtype=bool)  # whose action the next step uses
-        self._active = np.zeros(len(self.sides), dtype=bool)
         self.physics: PhysicsWorld | None = None
         """The pybullet client of the current round (None with the kinematic mover and no
         combat, or after `close()`)."""
@@ -222,8 +205,10 @@ class DecoyArrayEnv:
                 seed=int(rng.integers(2**63)),
             )
         )
-        self._active = np.ones(len(self.sides), dtype=bool)
-        return self._state(np.zeros(len(self.sides), dtype=bool))
+        self._steps = RoundSteps(
+            self._sim, self.encoder, self._policy.choices, self.possible_agents, self._is_t
+        )
+        return self._steps.first()
 
     def step(self, actions: np.ndarray) -> ArrayStep:
         """Apply the actions of the agents that need a decision, then run the simulator until
@@ -232,27 +217,11 @@ class DecoyArrayEnv:
         if sim.done:
             raise RuntimeError("the round has ended: call reset() before step()")
         chosen = np.asarray(actions)
-        if chosen.shape != self._due.shape or chosen.dtype.kind not in "iu":
+        if chosen.shape != (len(self.sides),) or chosen.dtype.kind not in "iu":
             raise ValueError(
-                f"actions are ({len(self._due)},) integers, got {chosen.dtype} {chosen.shape}"
+                f"actions are ({len(self.sides)},) integers, got {chosen.dtype} {chosen.shape}"
             )
-        given = self._policy.choices.given
-        bad = _hand_in(chosen, self._due, given)
-        if bad >= 0:
-            raise ValueError(f"{self.possible_agents[bad]}: action {chosen[bad]} is not in 0..8")
-        sim.run(stop_when_due=True)  # the first tick takes the decisions, then on to the next
-        outcome = sim.outcome
-        winner = -1 if outcome is None else int(outcome.winner == "T")
-        was_active = self._active
-        rewards, terminated, self._active, unused = _settle(
-            given, was_active, sim.agents.alive, self._is_t, winner
-        )
-        if unused >= 0:
-            raise RuntimeError(
-                f"the simulator did not ask agent {unused} for the decision the environment "
-                "collected"
-            )
-        return self._state(terminated, rewards)
+        return self._require_steps().play(chosen)
 
     def render(self) -> np.ndarray:
         """A top-down RGB picture (H, W, 3) uint8 of the round (`TopDownView`)."""
@@ -271,27 +240,15 @@ class DecoyArrayEnv:
 
     # ---- internals ----------------------------------------------------------------------------
 
-    def _state(self, terminated: np.ndarray, rewards: np.ndarray | None = None) -> ArrayStep:
-        sim = self._require_sim()
-        observations, masks, due = self.encoder.encode(sim)
-        self._due = due
-        outcome = sim.outcome
-        return ArrayStep(
-            observations,
-            masks,
-            due.copy(),  # the caller may write to its arrays
-            np.zeros(len(self.sides), np.float32) if rewards is None else rewards,
-            terminated,
-            self._active.copy(),
-            sim.tick,
-            None if outcome is None else outcome.winner,
-            None if outcome is None else outcome.reason,
-        )
-
     def _require_sim(self) -> Simulator:
         if self._sim is None:
             raise RuntimeError("call reset() before step() or render()")
         return self._sim
+
+    def _require_steps(self) -> RoundSteps:
+        if self._steps is None:
+            raise RuntimeError("call reset() before step()")
+        return self._steps
 
     def _weapon_list(self, weapons: Mapping[str, str]) -> list[str]:
         """Every agent's weapon: by agent name, else by side, else the side's pistol."""
@@ -313,41 +270,7 @@ class DecoyArrayEnv:
         self._round.close()
         self._round = ExitStack()
         self._sim = None
-
-
-@njit_cached
-def _hand_in(chosen, due, given):
-    """Put the actions of the due agents into `given` (-1 for the others); the first due agent
-    whose action is not 0..8, or -1."""
-    for i in range(due.shape[0]):
-        given[i] = -1
-        if due[i]:
-            if not 0 <= chosen[i] < NUM_ACTIONS:
-                return i
-            given[i] = chosen[i]
-    return -1
-
-
-@njit_cached
-def _settle(given, was_active, alive, is_t, winner):
-    """After a step: rewards (float32; +1/-1 by side to the agents active before it, once the
-    round is won: `winner` 1 T, 0 CT, -1 not yet), terminated, still active, and an agent whose
-    handed-in action the simulator did not take (-1: none)."""
-    n = given.shape[0]
-    rewards = np.zeros(n, np.float32)
-    terminated = np.zeros(n, np.bool_)
-    active = np.zeros(n, np.bool_)
-    unused = -1
-    for i in range(n):
-        if given[i] >= 0:
-            unused = i
-        if winner >= 0:
-            if was_active[i]:
-                rewards[i] = 1.0 if is_t[i] == (winner == 1) else -1.0
-        else:
-            active[i] = was_active[i] and alive[i]
-        terminated[i] = was_active[i] and not active[i]
-    return rewards, terminated, active, unused
+        self._steps = None
 
 
 def _is_loader(value: object) -> TypeGuard[Callable[[], DamageModel | None]]:

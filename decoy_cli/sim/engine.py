@@ -292,6 +292,16 @@ class Simulator:
             self.agents.position[:] = self.mover.positions
             self.rules.follow(self.agents, self.bomb)
 
+    def quiet_horizon(self) -> int:
+        """The last tick through which nothing but decisions and motion can happen from here
+        (`_stretch_end`), for a caller that plays quiet stretches itself as `run` hands them to
+        a `quiet_play.QuietPlayer` (the environment's compiled steps); the tick itself when the
+        next is not quiet, the round is done, an agent is on a damaging drop or the mover is not
+        kinematic."""
+        if self.done or self._falling or not isinstance(self.mover, KinematicMover):
+            return self.tick
+        return self._stretch_end(self.tick, self._max_tick)
+
     def relocate(self, agent: int, node: int) -> None:
         """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event.
 

@@ -109,10 +109,33 @@ class ObservationEncoder:
             block[:, 1:4] = -1.0
         return low, np.ones_like(low)
 
+    def kernel_arrays(self) -> tuple:
+        """What `encode_into` takes of this encoder, for compiled callers (`env_step`): the
+        starts of the per-agent and round entries, who is a CT, the slot tables, the centre and
+        half size of the positions' box."""
+        return (
+            self._starts, self._bomb_starts, self._is_ct, self._mates, self._enemies, self._centre,
+            self._half,
+        )  # fmt: skip
+
     def encode(self, sim: Simulator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(N, size) float32 observation vectors, (N, 9) int8 action masks and (N,) bool
         `needs_decision` of every agent (who the engine asks for a decision at the next tick:
         nobody once the round is done), in one compiled pass."""
+        agents, bomb = sim.agents, sim.bomb
+        state, carrier, round_inputs = self.round_inputs(sim)
+        return _encode(
+            self.size, self._starts, self._bomb_starts, agents.position, agents.yaw, agents.hp,
+            agents.armor, agents.helmet, agents.has_defuser, self._is_ct, agents.alive,
+            self._mates, self._enemies, self._centre, self._half, bomb.position, state, carrier,
+            round_inputs, sim.done, sim.tick, sim.waiting, sim.hold_until, agents.node,
+            self.graph.out_edges,
+        )  # fmt: skip
+
+    def round_inputs(self, sim: Simulator) -> tuple[int, int, np.ndarray]:
+        """What `_encode` needs of the bomb and the round besides the tick: the bomb state's
+        index into BOMB_STATES, its carrier (-1 unless carried) and `ROUND_INPUTS`. None of
+        them changes on ticks when nothing but decisions and motion happen."""
         agents, bomb, cfg = sim.agents, sim.bomb, self.rules
         state = self._bomb_state(bomb)
         site = BOMB_SITES.index(bomb.site) if bomb.site in BOMB_SITES else -1
@@ -121,20 +144,12 @@ class ObservationEncoder:
         if bomb.defuser >= 0:
             kit = agents.has_defuser[bomb.defuser]
             defuse = bomb.defuse_ticks / (cfg.defuse_kit_ticks if kit else cfg.defuse_ticks)
-        clock = bomb.planted_tick if bomb.planted_tick >= 0 else sim.tick
-        bomb_left = 0.0
-        if bomb.status == BombStatus.PLANTED:
-            bomb_left = (bomb.planted_tick + cfg.bomb_ticks - sim.tick) / cfg.bomb_ticks
-        scalars = np.array(
-            [site, plant, defuse, (cfg.round_ticks - clock) / cfg.round_ticks, bomb_left]
+        planted = bomb.status == BombStatus.PLANTED
+        inputs = np.array(
+            [site, plant, defuse, bomb.planted_tick, planted, cfg.round_ticks, cfg.bomb_ticks],
+            dtype=np.float64,
         )
-        return _encode(
-            self.size, self._starts, self._bomb_starts, agents.position, agents.yaw, agents.hp,
-            agents.armor, agents.helmet, agents.has_defuser, self._is_ct, agents.alive,
-            self._mates, self._enemies, self._centre, self._half, bomb.position, state,
-            bomb.carrier if state == 1 else -1, scalars, sim.done, sim.tick, sim.waiting,
-            sim.hold_until, agents.node, self.graph.out_edges,
-        )  # fmt: skip
+        return state, bomb.carrier if state == 1 else -1, inputs
 
     def _bomb_state(self, bomb: Bomb) -> int:
         """Index into BOMB_STATES."""
@@ -157,25 +172,56 @@ _BOMB = (
 """The round's entries, the same for every agent, in the order of `_encode`'s `bomb_starts`."""
 
 
+ROUND_INPUTS = ("bomb_site", "plant_progress", "defuse_progress", "planted_tick", "planted",
+                "round_ticks", "bomb_ticks")  # fmt: skip
+"""The entries of `_encode`'s `round_inputs`: the bomb site's index or -1, plant and defuse
+progress, the tick of the plant or -1, 1 while the bomb is planted, the round's and the bomb's
+time in ticks."""
+
+
 @njit_cached
 def _encode(
     size, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates, enemies,
-    centre, half, bomb_pos, bomb_state, carrier, scalars, done, tick, waiting, hold_until, node,
-    out_edges,
+    centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick, waiting, hold_until,
+    node, out_edges,
 ):  # fmt: skip
-    """The observation vectors, action masks and due agents (`ObservationEncoder.encode`):
-    each agent's own entries, its teammate and enemy slots and the bomb's offset at `starts`
-    (`_PER_AGENT`), the round's entries at `bomb_starts` (`_BOMB`; `scalars` holds the bomb
-    site index or -1, plant and defuse progress, round and bomb time left, unclipped)."""
+    """The observation vectors, action masks and due agents (`ObservationEncoder.encode`), in
+    new arrays (`encode_into`)."""
     n = pos.shape[0]
-    obs = np.zeros((n, size), np.float32)
-    masks = np.zeros((n, out_edges.shape[1] + 1), np.int8)
-    due = np.zeros(n, np.bool_)
+    obs = np.empty((n, size), np.float32)
+    masks = np.empty((n, out_edges.shape[1] + 1), np.int8)
+    due = np.empty(n, np.bool_)
+    encode_into(
+        obs, masks, due, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive,
+        mates, enemies, centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick,
+        waiting, hold_until, node, out_edges,
+    )  # fmt: skip
+    return obs, masks, due
+
+
+@njit_cached
+def encode_into(
+    obs, masks, due, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates,
+    enemies, centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick, waiting,
+    hold_until, node, out_edges,
+):  # fmt: skip
+    """Write the observation vectors (N, size), action masks (N, 9) and due agents (N,) into
+    `obs`, `masks` and `due`: each agent's own entries, its teammate and enemy slots and the
+    bomb's offset at `starts` (`_PER_AGENT`), the round's entries at `bomb_starts` (`_BOMB`)
+    from `round_inputs` (`ROUND_INPUTS`) and the tick: the round's time left counts to the
+    plant once there is one, the bomb's while it is planted."""
+    n = pos.shape[0]
+    obs[:] = 0.0
+    masks[:] = 0
     p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = starts
     state0, site0, plant0, defuse0, round0, timer0 = bomb_starts
-    site = np.int64(scalars[0])
-    round_left = min(1.0, max(0.0, scalars[3]))
-    bomb_left = min(1.0, max(0.0, scalars[4]))
+    site = np.int64(round_inputs[0])
+    planted_tick, round_ticks, bomb_ticks = round_inputs[3], round_inputs[5], round_inputs[6]
+    clock = planted_tick if planted_tick >= 0 else tick
+    round_left = min(1.0, max(0.0, (round_ticks - clock) / round_ticks))
+    bomb_left = 0.0
+    if round_inputs[4]:
+        bomb_left = min(1.0, max(0.0, (planted_tick + bomb_ticks - tick) / bomb_ticks))
     for i in range(n):
         due[i] = not done and is_due(i, waiting, alive, hold_until, tick + 1)
         masks[i, out_edges.shape[1]] = 1  # STOP
@@ -212,8 +258,8 @@ def _encode(
         obs[i, state0 + bomb_state] = 1.0
         if site >= 0:
             obs[i, site0 + site] = 1.0
-        obs[i, plant0] = scalars[1]
-        obs[i, defuse0] = scalars[2]
+        obs[i, plant0] = round_inputs[1]
+        obs[i, defuse0] = round_inputs[2]
         obs[i, round0] = round_left
         obs[i, timer0] = bomb_left
     return obs, masks, due

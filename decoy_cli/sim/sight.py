@@ -89,7 +89,7 @@ class LineOfSight:
             )
         self._owner = {body: k for k, body in enumerate(self.bodies)}
         self._placed = np.full((count, 3), np.nan)  # feet each capsule stands on; NaN = parked
-        self._pairs_key: tuple[tuple[str, ...], bytes] | None = None  # `_enemy_pairs`' cache
+        self._pairs_key: tuple[bytes, bytes] | None = None  # `_enemy_pairs`' cache
         self._pairs = (np.zeros(0, np.int64), np.zeros(0, np.int64))
 
     def close(self) -> None:
@@ -122,7 +122,7 @@ class LineOfSight:
         if len(first) == 0:
             return _no_pairs()
         feet = np.asarray(agents.position, dtype=np.float64)
-        if not np.isfinite(feet[first]).all() or not np.isfinite(feet[second]).all():
+        if not np.isfinite(feet[alive]).all():  # everyone alive is in a pair
             raise ValueError("an alive agent has a NaN or infinite position")
         eyes = feet + np.array([0.0, 0.0, self.eye_height])
         clear = self.physics.occlusion.clear(eyes[first], eyes[second])
@@ -140,7 +140,7 @@ class LineOfSight:
     def _enemy_pairs(self, agents: Agents, alive: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every (T, CT) pair of alive agents, T-major, as (lower index, higher index): the
         rays run from the lower to the higher. Kept while the sides and the living stay."""
-        key = (tuple(agents.side), alive.tobytes())
+        key = (agents.side.tobytes(), alive.tobytes())
         if key != self._pairs_key:
             t_side = np.flatnonzero(alive & (agents.side == "T"))
             ct_side = np.flatnonzero(alive & (agents.side == "CT"))

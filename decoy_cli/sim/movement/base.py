@@ -106,6 +106,12 @@ class MoverBase:
             "recoveries": read_only(self._iv[:, I_TELEPORTS]),
         }
 
+    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
+        """The packed state the edge kernels work on, for compiled callers that move the agents
+        themselves (`decoy_cli.sim.quiet_play`, with the kinematic mover): positions, edge
+        starts, targets, float and int slots, flag rows, parameters."""
+        return self._pos, self._start, self._target, self._fv, self._iv, self._flags, self._params
+
     @property
     def positions(self) -> np.ndarray:
         """(N, 3) feet positions, metres (a read-only view that follows the agents)."""

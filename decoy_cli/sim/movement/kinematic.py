@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import MoveStep
 from decoy_cli.sim.movement.kernels import kinematic_glide
@@ -15,12 +13,6 @@ class KinematicMover(MoverBase):
     One compiled loop over the agents per tick; an agent is never stuck, so `stuck_events` and
     `recoveries` stay zero.
     """
-
-    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
-        """The packed state `kinematic_glide` works on, for compiled callers that glide
-        themselves (`decoy_cli.sim.quiet_play`): positions, edge starts, targets, float and
-        int slots, flag rows, parameters."""
-        return self._pos, self._start, self._target, self._fv, self._iv, self._flags, self._params
 
     def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
         """Up to `max_ticks` ticks in one compiled call, stopping after the first arrival."""
