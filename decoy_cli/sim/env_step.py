@@ -30,6 +30,7 @@ from numba.experimental import structref
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.movement import KinematicMover
+from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.quiet_play import AIRBORNE, DECIDED, DUE, Choices, _play
 from decoy_cli.sim.schedule import NEVER
@@ -141,6 +142,8 @@ class RoundSteps:
         self.choices = choices
         self.names = names
         graph, agents, mover = sim.graph, sim.agents, sim.mover
+        if not isinstance(mover, MoverBase):
+            raise TypeError("the environment's steps need one of the package's movers")
         first, actions = graph.allowed_actions
         n = agents.count
         self._size = encoder.size
@@ -183,7 +186,7 @@ class RoundSteps:
             sim.note_quiet_play(tick, made, 0, False)
         if status == PLAYED:  # nothing ended
             quiet.tick = tick
-            return ArrayStep(*out, tick, None, None)
+            return _array_step(out, tick, None, None)
         if status == IN_THE_AIR:
             raise ValueError("an agent due for a decision is in the air")
         if status == NOT_TAKEN:
@@ -232,10 +235,10 @@ class RoundSteps:
         if unused >= 0:
             raise _not_taken(unused)
         if outcome is None:
-            return ArrayStep(*out, sim.tick, None, None)
-        return ArrayStep(*out, sim.tick, outcome.winner, outcome.reason)
+            return _array_step(out, sim.tick, None, None)
+        return _array_step(out, sim.tick, outcome.winner, outcome.reason)
 
-    def _outputs(self) -> tuple[np.ndarray, ...]:
+    def _outputs(self) -> _Outputs:
         """New arrays for a step's state, in `ArrayStep`'s order (the caller keeps them)."""
         n = len(self.names)
         return (
@@ -250,6 +253,15 @@ class RoundSteps:
     def _check(self, bad: int, chosen: np.ndarray) -> None:
         if bad >= 0:
             raise ValueError(f"{self.names[bad]}: action {chosen[bad]} is not in 0..8")
+
+
+_Outputs = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""A step's new arrays, in `ArrayStep`'s order."""
+
+
+def _array_step(out: _Outputs, tick: int, winner: str | None, reason: str | None) -> ArrayStep:
+    observations, masks, due, rewards, terminated, active = out
+    return ArrayStep(observations, masks, due, rewards, terminated, active, tick, winner, reason)
 
 
 def _not_taken(agent: int) -> RuntimeError:
