@@ -29,7 +29,7 @@ from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.env_step import ArrayStep, RoundSteps
 from decoy_cli.sim.observation import ObservationEncoder
-from decoy_cli.sim.quiet_play import Choices, play_stretch
+from decoy_cli.sim.quiet_play import Choices
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.sim.view import TopDownView
@@ -46,8 +46,8 @@ DEFAULT_WEAPONS = {"T": "Glock-18", "CT": "USP-S"}
 class _ChosenActions:
     """The engine's policy inside the environment: the actions `step` collected, one per agent
     the engine asks at the step's first tick (-1: none). A STOP holds `stop_ticks` and plants
-    (a T) or defuses (a CT). With the kinematic mover the step's quiet stretches are played in
-    compiled code (`quiet_play`) up to the next tick at which an agent is due."""
+    (a T) or defuses (a CT). The step's quiet stretches take them in compiled code
+    (`env_step`), a tick played by `Simulator.step` through `decide`."""
 
     def __init__(self, sides: list[str], stop_ticks: int) -> None:
         is_t = np.array([side == "T" for side in sides])
@@ -63,13 +63,6 @@ class _ChosenActions:
             )
         self.choices.given[agent] = -1
         return self.choices.decision(agent, action)
-
-    def play_quiet(
-        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
-    ) -> int:
-        """The step's quiet stretches in compiled code (`quiet_play.play_stretch`); a tick with
-        an impossible move is left to Python, which stands the agent still and records it."""
-        return play_stretch(sim, horizon, max_decisions, watch, self.choices)
 
 
 def map_graph(map_name: str | None, graph: WaypointGraph | None) -> WaypointGraph:

@@ -211,14 +211,11 @@ class Simulator:
         to_tick: int | None = None,
         after_end: bool = False,
         max_decisions: int | None = None,
-        stop_when_due: bool = False,
     ) -> Recording:
         """Play until the round ends (the tick bound), `to_tick` is reached, `until(sim)` says
-        stop, this run has made `max_decisions` decisions or, with `stop_when_due`, after the
-        first tick an agent is due for a decision at the next (`decision_due`: the
-        environment's step); with `after_end`, the agents go on moving after the outcome, as
-        `step(after_end=True)` has them, until `to_tick`. The stopping rules are asked as
-        `until` is.
+        stop or this run has made `max_decisions` decisions; with `after_end`, the agents go on
+        moving after the outcome, as `step(after_end=True)` has them, until `to_tick`. The
+        stopping rules are asked as `until` is.
 
         Event by event: after each tick's decisions, the ticks from there on at which nothing
         but motion can happen are crossed by the mover in one call (`glide`), which stops at
@@ -230,20 +227,14 @@ class Simulator:
         tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
-        A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy, the
-        environment's actions) plays whole quiet stretches of decisions and motion in compiled
+        A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy) plays whole
+        quiet stretches of decisions and motion in compiled
         code when the mover is kinematic and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 
-        first = self.tick
-
         def stop() -> bool:
-            return (
-                self.decision_count >= limit
-                or (stop_when_due and self.tick > first and self.decision_due)
-                or (until is not None and until(self))
-            )
+            return self.decision_count >= limit or (until is not None and until(self))
 
         quiet_player = None
         if until is None and isinstance(self.mover, KinematicMover):
@@ -294,8 +285,8 @@ class Simulator:
 
     def quiet_horizon(self) -> int:
         """The last tick through which nothing but decisions and motion can happen from here
-        (`_stretch_end`), for a caller that plays quiet stretches itself as `run` hands them to
-        a `quiet_play.QuietPlayer` (the environment's compiled steps); the tick itself when the
+        (`_stretch_end`), for a caller that plays quiet stretches itself, as `run` hands them to
+        a `quiet_play.QuietPlayer` (the environment's steps, `env_step`); the tick itself when the
         next is not quiet, the round is done, an agent is on a damaging drop or the mover is not
         kinematic."""
         if self.done or self._falling or not isinstance(self.mover, KinematicMover):

@@ -1,21 +1,21 @@
-"""The environment's steps of one round: quiet steps in one compiled call, the others through
-`Simulator.run`, with the same result.
+"""The environment's steps of one round: quiet stretches in compiled code, other ticks by
+`Simulator.step`, with the result of stepping every tick.
 
-Most steps of a round with ten agents are quiet: the agents due take the actions handed in,
+A step plays from the actions handed in to the next tick an alive agent is due (or the round's
+end). Most steps of a round with ten agents are quiet: the agents due take their actions,
 everybody glides to the next arrival or end of a STOP, and nothing else happens (no combat
-step, no recorded tick, no bomb rule, no fall). `RoundSteps.play` plays such a step (the
-hand-in, the quiet stretch of `quiet_play._play`, the rewards and the observations) in one
-compiled call, `_quiet_step`, instead of the dozen Python calls `Simulator.run` makes around
-the same loop. A step it cannot play whole it hands in and leaves to `Simulator.run`.
+step, no recorded tick, no bomb rule, no fall). `_quiet_step` plays such a stretch, and the
+step's rewards and observations, in one compiled call; `RoundSteps.play` plays a tick that is
+not quiet (a combat step, a plant, a fall) with `Simulator.step` and goes on.
 
 The round's arrays (the simulator's, the mover's, the graph's, the encoder's) go to compiled
 code as one `RoundArrays` struct that holds them, not copies: numba's dispatch costs about as
 much per argument as the step's own work does for all of them.
 
-Why a quiet step may skip what `run` asks before every stretch: the stretch's horizon
-(`Simulator.quiet_horizon`), the agents the bomb rules watch and the round's observation inputs
-(`ObservationEncoder.round_inputs`) change only on ticks that are not quiet, so they are asked
-after each step `run` played (or anything else added an event) and kept while the steps stay
+Why a quiet step may skip what `Simulator.run` asks before every stretch: the stretch's
+horizon (`Simulator.quiet_horizon`), the agents the bomb rules watch and the round's observation
+inputs (`ObservationEncoder.round_inputs`) change only on ticks that are not quiet, so they are
+asked after each such tick (or anything else that added an event) and kept while the steps stay
 quiet.
 """
 
@@ -37,12 +37,12 @@ from decoy_cli.sim.schedule import NEVER
 from decoy_cli.waypoints.graph import STOP_ACTION
 
 PLAYED, LEFT_TO_RUN, BAD_ACTION, IN_THE_AIR, NOT_TAKEN, HALF_PLAYED = range(6)
-"""How `_quiet_step` ended: it played the step whole; it handed the actions in and left the
-rest of the step to `Simulator.run` (after a quiet stretch, or at once when an action may hand
-back to Python: a STOP to plant or defuse by an agent the rules watch, a damaging drop, a move
-no edge makes); an action is not 0..8 (nothing was played); an agent asked to move is in the
-air; an action handed in was not taken; the stretch handed back with its tick half played
-(none of the last three can happen on a state the environment left)."""
+"""How `_quiet_step` ended: it played the step to its end; it left the rest of the step to
+Python (at the stretch's horizon, or at once when an action may hand back: a STOP to plant or
+defuse by an agent the rules watch, a damaging drop, a move no edge makes); an action is not
+0..8 (nothing was played); an agent asked to move is in the air; an action handed in was not
+taken; the stretch handed back with its tick half played (none of the last three can happen on
+a state the environment left)."""
 
 
 # ---- the round's arrays as one struct ---------------------------------------------------------
@@ -168,33 +168,44 @@ class RoundSteps:
     def play(self, chosen: np.ndarray) -> ArrayStep:
         """Hand in the actions (N,) of the agents due, play the step (to the next tick an alive
         agent is due, or the round's end) and return the agents' state after it. ValueError for
-        an action not 0..8."""
+        an action not 0..8.
+
+        Quiet stretches are played by `_quiet_step`, a tick that is not quiet by
+        `Simulator.step`; the first tick takes the actions handed in (`Simulator.decide` asks
+        the policy, `array_env._ChosenActions`, for them)."""
         sim = self.sim
-        quiet = self._quiet_from_here()
-        if quiet is None:
-            self._check(_hand_in(self._arrays, chosen), chosen)
-            sim.run(stop_when_due=True)  # the first tick takes the decisions, then on to the next
-            return self._finish()
-        out = self._outputs()
-        status, agent, tick, made = _quiet_step(
-            self._arrays, chosen, sim.tick, quiet.horizon, quiet.watched, quiet.bomb_state,
-            quiet.carrier, quiet.bomb_position, quiet.round_inputs, *out,
-        )  # fmt: skip
-        if status == BAD_ACTION:
-            self._check(agent, chosen)
-        if tick > sim.tick:  # `_quiet_step` took the positions and the bomb over itself
-            sim.note_quiet_play(tick, made, 0, False)
-        if status == PLAYED:  # nothing ended
-            quiet.tick = tick
-            return _array_step(out, tick, None, None)
-        if status == IN_THE_AIR:
-            raise ValueError("an agent due for a decision is in the air")
-        if status == NOT_TAKEN:
-            raise _not_taken(agent)
-        if status == HALF_PLAYED:
-            raise RuntimeError("a compiled step handed back in the middle of a tick")
-        if not (made and sim.decision_due):  # else the step ends after the stretch
-            sim.run(stop_when_due=True)
+        first = sim.tick
+        hand_in = True
+        while not sim.done and not (sim.tick > first and sim.decision_due):
+            quiet = self._quiet_from_here()
+            if quiet is None:
+                if hand_in:
+                    self._check(_hand_in(self._arrays, chosen), chosen)
+                    hand_in = False
+                sim.step()
+                continue
+            out = self._outputs()
+            start = sim.tick
+            status, agent, tick, made = _quiet_step(
+                self._arrays, chosen, hand_in, start, quiet.horizon, quiet.watched,
+                quiet.bomb_state, quiet.carrier, quiet.bomb_position, quiet.round_inputs, *out,
+            )  # fmt: skip
+            if status == BAD_ACTION:
+                self._check(agent, chosen)
+            hand_in = False
+            if tick > start:  # `_quiet_step` took the positions and the bomb over itself
+                sim.note_quiet_play(tick, made, 0, False)
+            if status == PLAYED:  # nothing ended
+                quiet.tick = tick
+                return _array_step(out, tick, None, None)
+            if status == IN_THE_AIR:
+                raise ValueError("an agent due for a decision is in the air")
+            if status == NOT_TAKEN:
+                raise _not_taken(agent)
+            if status == HALF_PLAYED:
+                raise RuntimeError("a compiled step handed back in the middle of a tick")
+            if tick == start:  # handed back before its first tick: play that one whole
+                sim.step()
         return self._finish()
 
     def _quiet_from_here(self) -> _Quiet | None:
@@ -221,7 +232,7 @@ class RoundSteps:
         return quiet
 
     def _finish(self) -> ArrayStep:
-        """The state after a step `Simulator.run` played, or at the round's start."""
+        """The state after a step that ended in Python, or at the round's start."""
         sim = self.sim
         self._quiet = None
         outcome = sim.outcome
@@ -336,20 +347,21 @@ def _hands_back(r, chosen, watch):
 
 @njit_cached
 def _quiet_step(
-    r, chosen, tick, horizon, watch, bomb_state, carrier, bomb_pos, round_inputs, obs, masks,
-    due, rewards, terminated, active,
+    r, chosen, hand_in, tick, horizon, watch, bomb_state, carrier, bomb_pos, round_inputs, obs,
+    masks, due, rewards, terminated, active,
 ):  # fmt: skip
-    """One step from `tick`, whose next ticks are quiet through `horizon`: the hand-in, then,
-    unless an action may hand back (`_hands_back`), the quiet stretch (`_play`); if it ends
-    with an agent due (the step's end), the step's state written as `_finish` writes it after
-    `Simulator.run`. After a glide the agents' positions and a carried bomb's are taken over
-    from the mover. Returns how it ended, the bad
-    or untaken agent (else -1), the tick reached and the decisions made."""
-    bad = _hand_in(r, chosen)
-    if bad >= 0:
-        return BAD_ACTION, bad, tick, 0
-    if _hands_back(r, chosen, watch):
-        return LEFT_TO_RUN, -1, tick, 0
+    """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
+    first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
+    `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
+    where the step ends and its state is written as `_finish` writes it. After a glide the
+    agents' positions and a carried bomb's are taken over from the mover. Returns how it
+    ended, the bad or untaken agent (else -1), the tick reached and the decisions made."""
+    if hand_in:
+        bad = _hand_in(r, chosen)
+        if bad >= 0:
+            return BAD_ACTION, bad, tick, 0
+        if _hands_back(r, chosen, watch):
+            return LEFT_TO_RUN, -1, tick, 0
     reached, _, made, _, glide_end, status = _play(
         tick, horizon, r.given, r.draws, 0, r.first, r.actions, r.hold_ticks, r.plant,
         r.defuse, NEVER, watch, r.top, r.out_edges, r.edge_target, r.edge_kind, r.edge_fall,

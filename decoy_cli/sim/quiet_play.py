@@ -7,8 +7,8 @@ policy whose choices need no Python per decision (`QuietPlayer`) plays it in one
 decision, exactly as `Simulator.run` plays it tick by tick. Choices come from either
 
 * uniform draws over each agent's possible actions (`random_play.RandomPolicy`), or
-* actions handed in for the agents due at the stretch's first tick (the environment's step),
-  after which the loop stops before the next tick at which an agent is due.
+* actions handed in for the agents due at the stretch's first tick (the environment's step,
+  `env_step`), after which the loop stops before the next tick at which an agent is due.
 
 It hands back to Python when anything else may follow: a damaging drop, the decision limit,
 the stretch's end, or a STOP to plant or defuse by an agent the bomb rules watch (the carrier;
