@@ -3,9 +3,11 @@
 Plays `decoy bench`'s environment section (5v5, kinematic mover, the shipped models, each agent
 that needs a decision taking a random allowed action) for ROUNDS rounds after a warm-up round,
 with the environment's parts timed by wrapping them: the whole PettingZoo `step`, the game's
-step under it (`DecoyArrayEnv.step`), the simulator's `run` inside that, the combat and other
-whole ticks (`_finish_tick`), the observation arrays, and the observation and info
-dictionaries; what a step spends outside its parts is its own Python, and what the round costs
+step under it (`DecoyArrayEnv.step`), and in that the compiled quiet stretches
+(`env_step._quiet_step`), the ticks played whole in Python (`Simulator.step`; of them the
+combat steps), the state after steps that ended in Python (`RoundSteps._finish`) and the quiet
+steps' shared state (`RoundSteps._quiet_from_here`); then the observation and info
+dictionaries. What a step spends outside its parts is its own Python, and what the round costs
 outside `step` is the benchmark's loop of random masked actions. Microseconds per step, on this
 machine: compare the parts with each other, not with another machine's figures.
 """
@@ -24,15 +26,17 @@ from decoy_cli.bench.machine import machine_line
 from decoy_cli.bench.portable import _play
 from decoy_cli.damage import load_damage_model
 from decoy_cli.sim import DecoyParallelEnv
+from decoy_cli.sim import env_step
 from decoy_cli.sim.array_env import DecoyArrayEnv
+from decoy_cli.sim.combat import CombatStep
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.observation import ObservationEncoder
 
 SPENT: dict[str, float] = defaultdict(float)
 
 
-def timed(owner: type, name: str, label: str) -> None:
-    """Wrap `owner.name` so that its time adds up in SPENT[label]."""
+def timed(owner: Any, name: str, label: str) -> None:
+    """Wrap `owner.name` (a class's method or a module's function) so that its time adds up in
+    SPENT[label]."""
     method: Callable[..., Any] = getattr(owner, name)
 
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -50,9 +54,11 @@ def main() -> None:
     for owner, name, label in ((DecoyParallelEnv, "step", "step"),
                                (DecoyParallelEnv, "_observe", "_observe"),
                                (DecoyParallelEnv, "_infos", "_infos"),
-                               (DecoyArrayEnv, "step", "game"), (Simulator, "run", "run"),
-                               (ObservationEncoder, "encode", "encode"),
-                               (Simulator, "_finish_tick", "_finish_tick")):  # fmt: skip
+                               (DecoyArrayEnv, "step", "game"),
+                               (env_step, "_quiet_step", "quiet"), (Simulator, "step", "whole"),
+                               (CombatStep, "run", "combat"),
+                               (env_step.RoundSteps, "_finish", "finish"),
+                               (env_step.RoundSteps, "_quiet_from_here", "shared")):  # fmt: skip
         timed(owner, name, label)
     env = DecoyParallelEnv(mover="kinematic", damage_model=load_damage_model("shipped"))
     rng = np.random.default_rng(0)
@@ -72,10 +78,14 @@ def main() -> None:
         "the whole step": wall / steps * 1e6,
         "  env.step (PettingZoo)": per["step"],
         "    the game's step (DecoyArrayEnv)": per["game"],
-        "      simulator run": per["run"],
-        "        of it whole ticks (combat, bomb, recording)": per["_finish_tick"],
-        "      observation arrays": per["encode"],
-        "      the game step's own Python": per["game"] - per["run"] - per["encode"],
+        "      compiled quiet stretches": per["quiet"],
+        "      whole ticks in Python (Simulator.step)": per["whole"],
+        "        of them the combat steps": per["combat"],
+        "      the state after steps ended in Python": per["finish"],
+        "      the quiet steps' shared state": per["shared"],
+        "      the game step's own Python": (
+            per["game"] - per["quiet"] - per["whole"] - per["finish"] - per["shared"]
+        ),
         "    observation dictionaries": per["_observe"],
         "    info dictionaries": per["_infos"],
         "    the PettingZoo step's own Python": (
