@@ -26,10 +26,12 @@ Capsules of another `LineOfSight` in the same pybullet client are in the same gr
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M
 from decoy_cli.sim.state import Agents
 from decoy_cli.world.physics import WORLD_GROUP, PhysicsWorld
@@ -122,13 +124,14 @@ class LineOfSight:
         if len(first) == 0:
             return _no_pairs()
         feet = np.asarray(agents.position, dtype=np.float64)
-        if not np.isfinite(feet[alive]).all():  # everyone alive is in a pair
+        starts, ends, finite = _eye_segments(feet, first, second, self.eye_height)
+        if not finite:
             raise ValueError("an alive agent has a NaN or infinite position")
-        eyes = feet + np.array([0.0, 0.0, self.eye_height])
-        clear = self.physics.occlusion.clear(eyes[first], eyes[second])
+        clear = self.physics.occlusion.clear(starts, ends)
         if not clear.any():
             return _no_pairs()
         if np.count_nonzero(alive) > 2:
+            eyes = feet + np.array([0.0, 0.0, self.eye_height])
             self._place(feet, alive)
             ray = np.flatnonzero(clear)
             clear[ray] = self._bodies_clear(eyes, first[ray], second[ray])
@@ -181,6 +184,24 @@ class LineOfSight:
         hit = np.fromiter((self._owner.get(h[0], -2) if h[0] >= 0 else -1 for h in hits), int)
         clear[cast] = (hit == -1) | (hit == second[cast])
         return clear
+
+
+@njit_cached
+def _eye_segments(feet, first, second, eye):
+    """The segments (K, 3) from the eyes of `first` to those of `second`, `eye` above their
+    feet, and whether all of them are finite. Compiled: a combat step has a few dozen pairs, on
+    which numpy's per-call overhead costs more than the arithmetic."""
+    k = first.shape[0]
+    starts = np.empty((k, 3))
+    ends = np.empty((k, 3))
+    finite = True
+    for i in range(k):
+        for axis in range(3):
+            lift = eye if axis == 2 else 0.0
+            starts[i, axis] = feet[first[i], axis] + lift
+            ends[i, axis] = feet[second[i], axis] + lift
+            finite = finite and math.isfinite(starts[i, axis]) and math.isfinite(ends[i, axis])
+    return starts, ends, finite
 
 
 def _park_position(k: int) -> list[float]:
