@@ -142,6 +142,7 @@ class DecoyArrayEnv:
         self.possible_agents = [f"t_{k}" for k in range(n_t)] + [f"ct_{k}" for k in range(n_ct)]
         self.sides = ["T"] * n_t + ["CT"] * n_ct
         self._is_t = np.array([side == "T" for side in self.sides])
+        self._action_shape = (len(self.sides),)
         self._weapons = self._weapon_list(weapons or {})
         self.encoder = ObservationEncoder(
             self.graph, self.sides, self.setup.rules_config(), self.bomb
@@ -206,15 +207,15 @@ class DecoyArrayEnv:
     def step(self, actions: np.ndarray) -> ArrayStep:
         """Apply the actions of the agents that need a decision, then run the simulator until
         an alive agent needs one or the round ends. After the round's end, call `reset`."""
-        sim = self._require_sim()
-        if sim.done:
+        steps = self._require_steps()
+        if steps.sim.done:
             raise RuntimeError("the round has ended: call reset() before step()")
         chosen = np.asarray(actions)
-        if chosen.shape != (len(self.sides),) or chosen.dtype.kind not in "iu":
+        if chosen.shape != self._action_shape or chosen.dtype.kind not in "iu":
             raise ValueError(
                 f"actions are ({len(self.sides)},) integers, got {chosen.dtype} {chosen.shape}"
             )
-        return self._require_steps().play(chosen)
+        return steps.play(chosen)
 
     def render(self) -> np.ndarray:
         """A top-down RGB picture (H, W, 3) uint8 of the round (`TopDownView`)."""
@@ -240,7 +241,7 @@ class DecoyArrayEnv:
 
     def _require_steps(self) -> RoundSteps:
         if self._steps is None:
-            raise RuntimeError("call reset() before step()")
+            raise RuntimeError("call reset() before step() or render()")
         return self._steps
 
     def _weapon_list(self, weapons: Mapping[str, str]) -> list[str]:

@@ -118,11 +118,9 @@ class _Quiet:
     tick: int  # the tick it holds at, moved on by each quiet step
     events: int  # how many events the round had then
     horizon: int
-    watched: np.ndarray
-    bomb_state: int
-    carrier: int
     bomb_position: np.ndarray  # the simulator's own, which a carried bomb's moves update
-    round_inputs: np.ndarray
+    arrays: tuple  # `_quiet_step`'s horizon, watched agents, bomb state, carrier, bomb position
+    # and round inputs
 
 
 class RoundSteps:
@@ -146,8 +144,8 @@ class RoundSteps:
             raise TypeError("the environment's steps need one of the package's movers")
         first, actions = graph.allowed_actions
         n = agents.count
-        self._size = encoder.size
-        self._width = NUM_ACTIONS
+        self._shapes = ((n, encoder.size), (n, NUM_ACTIONS), n)  # vectors, masks, the rest
+        self._dtypes = (np.dtype(np.float32), np.dtype(np.bool_), np.dtype(np.int8))
         self._arrays = _round_arrays(
             choices.given, choices.draws, first, actions, choices.hold_ticks, choices.plant,
             choices.defuse, choices.top_speeds.of(agents.weapon), graph.out_edges,
@@ -171,8 +169,8 @@ class RoundSteps:
         an action not 0..8.
 
         Quiet stretches are played by `_quiet_step`, a tick that is not quiet by
-        `Simulator.step`; the first tick takes the actions handed in (`Simulator.decide` asks
-        the policy, `array_env._ChosenActions`, for them)."""
+        `Simulator.step`; the first tick takes the actions handed in (`Simulator.step` asks the
+        policy, `array_env._ChosenActions`, for them)."""
         sim = self.sim
         first = sim.tick
         hand_in = True
@@ -187,9 +185,8 @@ class RoundSteps:
             out = self._outputs()
             start = sim.tick
             status, agent, tick, made = _quiet_step(
-                self._arrays, chosen, hand_in, start, quiet.horizon, quiet.watched,
-                quiet.bomb_state, quiet.carrier, quiet.bomb_position, quiet.round_inputs, *out,
-            )  # fmt: skip
+                self._arrays, chosen, hand_in, start, *quiet.arrays, *out
+            )
             if status == BAD_ACTION:
                 self._check(agent, chosen)
             hand_in = False
@@ -197,7 +194,7 @@ class RoundSteps:
                 sim.note_quiet_play(tick, made, 0, False)
             if status == PLAYED:  # nothing ended
                 quiet.tick = tick
-                return _array_step(out, tick, None, None)
+                return ArrayStep(*out, tick, None, None)
             if status == IN_THE_AIR:
                 raise ValueError("an agent due for a decision is in the air")
             if status == NOT_TAKEN:
@@ -223,10 +220,9 @@ class RoundSteps:
                 return None
             watched = sim.rules.watched(sim.agents, sim.bomb)
             state, carrier, inputs = self.encoder.round_inputs(sim)
-            self._quiet = quiet = _Quiet(
-                sim.tick, len(sim.events), horizon, watched, state, carrier, sim.bomb.position,
-                inputs,
-            )  # fmt: skip
+            position = sim.bomb.position
+            arrays = (horizon, watched, state, carrier, position, inputs)
+            self._quiet = quiet = _Quiet(sim.tick, len(sim.events), horizon, position, arrays)
         if quiet.horizon <= sim.tick or quiet.bomb_position is not sim.bomb.position:
             return None
         return quiet
@@ -246,19 +242,20 @@ class RoundSteps:
         if unused >= 0:
             raise _not_taken(unused)
         if outcome is None:
-            return _array_step(out, sim.tick, None, None)
-        return _array_step(out, sim.tick, outcome.winner, outcome.reason)
+            return ArrayStep(*out, sim.tick, None, None)
+        return ArrayStep(*out, sim.tick, outcome.winner, outcome.reason)
 
     def _outputs(self) -> _Outputs:
         """New arrays for a step's state, in `ArrayStep`'s order (the caller keeps them)."""
-        n = len(self.names)
+        (vectors, masks, n), (reals, flags, small) = self._shapes, self._dtypes
+        empty = np.empty
         return (
-            np.empty((n, self._size), np.float32),
-            np.empty((n, self._width), np.int8),
-            np.empty(n, np.bool_),
-            np.empty(n, np.float32),
-            np.empty(n, np.bool_),
-            np.empty(n, np.bool_),
+            empty(vectors, reals),
+            empty(masks, small),
+            empty(n, flags),
+            empty(n, reals),
+            empty(n, flags),
+            empty(n, flags),
         )
 
     def _check(self, bad: int, chosen: np.ndarray) -> None:
@@ -268,11 +265,6 @@ class RoundSteps:
 
 _Outputs = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 """A step's new arrays, in `ArrayStep`'s order."""
-
-
-def _array_step(out: _Outputs, tick: int, winner: str | None, reason: str | None) -> ArrayStep:
-    observations, masks, due, rewards, terminated, active = out
-    return ArrayStep(observations, masks, due, rewards, terminated, active, tick, winner, reason)
 
 
 def _not_taken(agent: int) -> RuntimeError:
