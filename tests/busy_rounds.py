@@ -114,53 +114,39 @@ def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
     np.testing.assert_array_equal(a.decisions, b.decisions)
 
 
+def _recorded(monkeypatch: pytest.MonkeyPatch, module: object, name: str, entry: int) -> list[int]:
+    """From now on, entry `entry` of what each call of `module.name` returns, call by call."""
+    seen: list[int] = []
+    function = getattr(module, name)
+
+    def recording(*args):
+        out = function(*args)
+        seen.append(int(out[entry]))
+        return out
+
+    monkeypatch.setattr(module, name, recording)
+    return seen
+
+
 def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """From now on, the decisions each compiled stretch makes (`quiet_play._play`), call by
     call: a test that the compiled path was taken."""
     from decoy_cli.sim import quiet_play
 
-    made: list[int] = []
-    play = quiet_play._play
-
-    def counting(*args):
-        out = play(*args)
-        made.append(int(out[2]))
-        return out
-
-    monkeypatch.setattr(quiet_play, "_play", counting)
-    return made
+    return _recorded(monkeypatch, quiet_play, "_play", 2)
 
 
 def count_quiet_steps(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """From now on, how each of the environment's compiled steps ended (`env_step`'s
-    `_quiet_step`: `env_step.PLAYED` when it played the step whole), call by call."""
+    `_quiet_step`: `env_step.PLAYED` when it played the step to its end), call by call."""
     from decoy_cli.sim import env_step
 
-    ended: list[int] = []
-    step = env_step._quiet_step
-
-    def counting(*args):
-        out = step(*args)
-        ended.append(int(out[0]))
-        return out
-
-    monkeypatch.setattr(env_step, "_quiet_step", counting)
-    return ended
+    return _recorded(monkeypatch, env_step, "_quiet_step", 0)
 
 
 def no_compiled_steps(monkeypatch: pytest.MonkeyPatch) -> None:
-    """From now on, simulators step every tick (the environment's steps too): the reference
-    the compiled paths are compared with."""
-
-    def stepping(sim: Simulator, until=None, *, stop_when_due: bool = False):
-        first = sim.tick
-        while not sim.done and not (until is not None and until(sim)):
-            if stop_when_due and sim.tick > first and sim.needs_decision.any():
-                break
-            sim.step()
-        return sim.recording
-
-    monkeypatch.setattr(Simulator, "run", stepping)
+    """From now on, the environment's steps play every tick with `Simulator.step` (no tick is
+    quiet): the reference its compiled steps are compared with."""
     monkeypatch.setattr(Simulator, "quiet_horizon", lambda sim: sim.tick)
 
 
