@@ -229,12 +229,15 @@ class DecoyParallelEnv(ParallelEnv):
         state = self.game.step(chosen)
         self._due = state.needs_decision
         index = self._index
-        rewards = {name: float(state.rewards[index[name]]) for name in live}
-        terminations = {name: bool(state.terminated[index[name]]) for name in live}
+        reward, ended, active = (
+            a.tolist() for a in (state.rewards, state.terminated, state.active)
+        )
+        rewards = {name: reward[index[name]] for name in live}
+        terminations = {name: ended[index[name]] for name in live}
         truncations = dict.fromkeys(live, False)
         observations = self._observe(live, state)
         infos = self._infos(live, state)
-        self.agents = [name for name in live if state.active[index[name]]]
+        self.agents = [name for name in live if active[index[name]]]
         return observations, rewards, terminations, truncations, infos
 
     def render(self) -> np.ndarray | None:
@@ -273,7 +276,5 @@ class DecoyParallelEnv(ParallelEnv):
         end = {}
         if state.winner is not None:
             end = {"winner": state.winner, "reason": state.reason}
-        due, index, tick = state.needs_decision, self._index, state.tick
-        return {
-            name: {"needs_decision": bool(due[index[name]]), "tick": tick, **end} for name in names
-        }
+        due, index, tick = state.needs_decision.tolist(), self._index, state.tick
+        return {name: {"needs_decision": due[index[name]], "tick": tick, **end} for name in names}
