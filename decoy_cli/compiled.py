@@ -78,6 +78,13 @@ def _forget_old(root: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
+def jit_enabled() -> bool:
+    """Whether numba compiles (not `NUMBA_DISABLE_JIT`, under which kernels run as Python)."""
+    from numba.core import config
+
+    return not config.DISABLE_JIT  # type: ignore[attr-defined]  # set at run time
+
+
 def njit_cached(function: F | None = None, **options: Any) -> Any:
     """`numba.njit(cache=True, **options)` with this code's cache folder (module docstring);
     used bare (`@njit_cached`) or with options (`@njit_cached(nogil=True)`)."""

@@ -6,6 +6,9 @@ seeding, masks and timing are tested through the PettingZoo API in tests/test_si
 from __future__ import annotations
 
 import dataclasses
+import os
+import subprocess
+import sys
 from collections.abc import Iterator
 
 import numpy as np
@@ -16,6 +19,7 @@ from decoy_cli.sim.array_env import ArrayStep, DecoyArrayEnv
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
 from decoy_cli.sim.env import DecoyParallelEnv
 from decoy_cli.sim.env_step import LEFT_TO_RUN, PLAYED
+from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.graph import STOP_ACTION
 
 
@@ -183,7 +187,7 @@ def test_compiled_steps_give_what_stepping_every_tick_gives(monkeypatch, map_nam
                 if seed == 2 and steps > 300 and not state.needs_decision[5:].any():
                     for ct in np.flatnonzero(env.sim.agents.alive[5:]) + 5:
                         env.sim.kill(int(ct), "test")  # from outside: the round ends
-            events += env.sim.events
+            events += [*env.sim.events, _round_summary(env)]
         env.close()
         return states, events
 
@@ -196,6 +200,105 @@ def test_compiled_steps_give_what_stepping_every_tick_gives(monkeypatch, map_nam
     for k, (one, other) in enumerate(zip(compiled, stepped, strict=True)):
         assert _same_state(one, other), k
     assert compiled_events == stepped_events
-    kinds = {event.kind for event in stepped_events}
+    kinds = {getattr(event, "kind", None) for event in stepped_events}
     assert {"kill", "death", "bomb_drop", "invalid_action", "round_end"} <= kinds, kinds
     assert "fall_damage" in kinds
+
+
+def test_compiled_steps_with_plants_and_defuses_give_what_stepping_gives(monkeypatch) -> None:
+    """Everyone on bomb site A, the Ts stopping often (a STOP holds 6 s) and CTs put beside a
+    planted bomb: plants, defuses, explosions, the same with no tick quiet."""
+
+    def play() -> tuple[list[ArrayStep], list]:
+        env = DecoyArrayEnv(damage_model=Shots(share=0.05), stop_seconds=6.0)
+        site = env.graph.region_of("bombsite_a")
+        rng = np.random.default_rng(7)
+        states, events = [], []
+        for seed in range(4):
+            state = env.reset(seed)
+            assert env.sim is not None
+            for agent, node in enumerate(rng.choice(site, 10, replace=False)):
+                env.sim.relocate(agent, int(node))
+            moved = 0
+            while state.winner is None:
+                bomb = env.sim.bomb
+                if bomb.status == BombStatus.PLANTED and moved < 3:
+                    offsets = env.graph.positions - bomb.position
+                    near = int(np.argmin(np.linalg.norm(offsets, axis=1)))
+                    for ct in np.flatnonzero(state.needs_decision[5:])[: 3 - moved] + 5:
+                        env.sim.relocate(int(ct), near)  # a CT due: asked again anyway
+                        moved += 1
+                actions = random_masked(state, rng)
+                stop = rng.random(10) < np.where(np.arange(10) >= 5, 0.8, 0.4)
+                actions[stop] = STOP_ACTION
+                state = env.step(actions)
+                states.append(state)
+            events += [*env.sim.events, _round_summary(env)]
+        env.close()
+        return states, events
+
+    ended = count_quiet_steps(monkeypatch)
+    compiled, compiled_events = play()
+    assert ended.count(PLAYED) > 100 and ended.count(LEFT_TO_RUN) > 20
+    no_compiled_steps(monkeypatch)
+    stepped, stepped_events = play()
+    assert len(compiled) == len(stepped)
+    for k, (one, other) in enumerate(zip(compiled, stepped, strict=True)):
+        assert _same_state(one, other), k
+    assert compiled_events == stepped_events
+    kinds = {getattr(event, "kind", None) for event in stepped_events}
+    assert {"plant", "defuse_start", "defuse"} <= kinds, kinds
+
+
+def _round_summary(env: DecoyArrayEnv) -> tuple:
+    """What a round left in its simulator beside the events: outcome, tick, decisions, the
+    agents' positions, yaw, health and life, and the bomb."""
+    sim = env.sim
+    assert sim is not None
+    agents, bomb = sim.agents, sim.bomb
+    return (
+        sim.outcome, sim.tick, sim.decision_count, sim.decisions.tolist(),
+        agents.position.tobytes(), agents.yaw.tobytes(), agents.hp.tolist(),
+        agents.alive.tolist(), bomb.status, bomb.carrier, bomb.site, bomb.position.tobytes(),
+    )  # fmt: skip
+
+
+def test_an_agent_made_due_from_outside_is_named(env: DecoyArrayEnv) -> None:
+    """Relocating an agent between steps makes it due at the next tick, unasked: the step
+    says which agent the simulator asked."""
+    rng = np.random.default_rng(2)
+    state = env.reset(2)
+    for _ in range(40):
+        state = env.step(random_masked(state, rng))
+    assert env.sim is not None
+    while env.sim.quiet_horizon() == env.sim.tick:  # the next tick is quiet: a compiled step
+        state = env.step(random_masked(state, rng))
+    idle = int(np.flatnonzero(~state.needs_decision & state.active)[0])
+    env.sim.relocate(idle, int(env.sim.agents.node[idle]))
+    with pytest.raises(RuntimeError, match=f"asked agent {idle} for a decision"):
+        env.step(random_masked(state, rng))
+
+
+def test_the_environment_plays_with_numba_off() -> None:
+    """With NUMBA_DISABLE_JIT the compiled steps run as Python (a plain object holds the
+    round's arrays), for debugging: a few steps in a fresh process."""
+    script = (
+        "import numpy as np\n"
+        "from decoy_cli.sim.array_env import DecoyArrayEnv\n"
+        "env = DecoyArrayEnv(combat=False)\n"
+        "state = env.reset(0)\n"
+        "rng = np.random.default_rng(0)\n"
+        "for _ in range(5):\n"
+        "    masks = state.action_masks\n"
+        "    state = env.step(np.argmax(rng.random(masks.shape) * masks, 1))\n"
+        "print('tick', state.tick)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        env={**os.environ, "NUMBA_DISABLE_JIT": "1"},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert int(done.stdout.split()[-1]) > 0

@@ -281,8 +281,9 @@ def test_bad_construction_is_refused() -> None:
         DecoyParallelEnv(weapons={"T": "Banana"})
     with pytest.raises(ValueError, match="keyed by side"):
         DecoyParallelEnv(weapons={"terrorists": "AK-47"})
-    with pytest.raises(ValueError, match="stop_seconds"):
-        DecoyParallelEnv(stop_seconds=0)
+    for stop in (0, 1e-9, float("nan"), float("inf")):  # a STOP lasts at least a tick
+        with pytest.raises(ValueError, match="stop_seconds"):
+            DecoyParallelEnv(stop_seconds=stop)
     with pytest.raises(ValueError, match="render_mode"):
         DecoyParallelEnv(render_mode="human")
 

@@ -15,6 +15,7 @@ the observation vector and the rewards.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from contextlib import ExitStack
 from numbers import Integral
@@ -109,8 +110,8 @@ class DecoyArrayEnv:
                 raise ValueError(f"{name} must be an int >= 0, got {count!r}")
         if n_t + n_ct == 0:
             raise ValueError("a round needs at least one agent")
-        if not stop_seconds > 0:
-            raise ValueError(f"stop_seconds must be > 0, got {stop_seconds!r}")
+        if not (math.isfinite(stop_seconds) and seconds_to_ticks(stop_seconds) >= 1):
+            raise ValueError(f"stop_seconds must last a tick (1/60 s) or more: {stop_seconds!r}")
         self.graph = map_graph(map, graph)
         self.world = world
         self.mover_kind = mover

@@ -9,8 +9,8 @@ step's rewards and observations, in one compiled call; `RoundSteps.play` plays a
 not quiet (a combat step, a plant, a fall) with `Simulator.step` and goes on.
 
 The round's arrays (the simulator's, the mover's, the graph's, the encoder's) go to compiled
-code as one `RoundArrays` struct that holds them, not copies: numba's dispatch costs about as
-much per argument as the step's own work does for all of them.
+code as one `RoundArrays` struct that holds them, not copies: numba's dispatch checks and
+converts every argument of every call, and a step is short.
 
 Why a quiet step may skip what `Simulator.run` asks before every stretch: the stretch's
 horizon (`Simulator.quiet_horizon`), the agents the bomb rules watch and the round's observation
@@ -22,12 +22,13 @@ quiet.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 from numba.core import types
 from numba.experimental import structref
 
-from decoy_cli.compiled import njit_cached
+from decoy_cli.compiled import jit_enabled, njit_cached
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.base import MoverBase
@@ -93,6 +94,12 @@ def _round_arrays(
     )  # fmt: skip
 
 
+def _plain_round_arrays(*arrays: object) -> SimpleNamespace:
+    """`RoundArrays`' fields on a plain object, for the kernels run as Python (numba's JIT
+    disabled), where numba's struct cannot be made."""
+    return SimpleNamespace(**dict(zip(ROUND_FIELDS, arrays, strict=True)))
+
+
 # ---- the steps --------------------------------------------------------------------------------
 
 
@@ -119,8 +126,8 @@ class _Quiet:
     events: int  # how many events the round had then
     horizon: int
     bomb_position: np.ndarray  # the simulator's own, which a carried bomb's moves update
-    arrays: tuple  # `_quiet_step`'s horizon, watched agents, bomb state, carrier, bomb position
-    # and round inputs
+    arrays: tuple[int, np.ndarray, int, int, np.ndarray, np.ndarray]  # `_quiet_step`'s horizon,
+    # watched agents, bomb state, carrier, bomb position and round inputs
 
 
 class RoundSteps:
@@ -146,7 +153,8 @@ class RoundSteps:
         n = agents.count
         self._shapes = ((n, encoder.size), (n, NUM_ACTIONS), n)  # vectors, masks, the rest
         self._dtypes = (np.dtype(np.float32), np.dtype(np.bool_), np.dtype(np.int8))
-        self._arrays = _round_arrays(
+        make = _round_arrays if jit_enabled() else _plain_round_arrays
+        self._arrays = make(
             choices.given, choices.draws, first, actions, choices.hold_ticks, choices.plant,
             choices.defuse, choices.top_speeds.of(agents.weapon), graph.out_edges,
             graph.edge_target, graph.edge_kind, graph.fall_m, graph.positions, agents.node,
@@ -369,7 +377,7 @@ def _quiet_step(
         return IN_THE_AIR, -1, reached, made
     if status == DECIDED:  # `_hands_back` missed a way back: the tick is half played
         return HALF_PLAYED, -1, reached, made
-    if status != DUE:
+    if status != DUE or reached == tick:  # (an agent due with no action: Python says whom)
         return LEFT_TO_RUN, -1, reached, made
     unused = _finish(
         r, -1, bomb_state, carrier, bomb_pos, round_inputs, False, reached, obs, masks, due,

@@ -109,7 +109,7 @@ class ObservationEncoder:
             block[:, 1:4] = -1.0
         return low, np.ones_like(low)
 
-    def kernel_arrays(self) -> tuple:
+    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """What `encode_into` takes of this encoder, for compiled callers (`env_step`): the
         starts of the per-agent and round entries, who is a CT, the slot tables, the centre and
         half size of the positions' box."""
