@@ -9,7 +9,7 @@ import dataclasses
 import os
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -191,16 +191,7 @@ def test_compiled_steps_give_what_stepping_every_tick_gives(monkeypatch, map_nam
         env.close()
         return states, events
 
-    ended = count_quiet_steps(monkeypatch)
-    compiled, compiled_events = play()
-    assert ended.count(PLAYED) > 500 and ended.count(LEFT_TO_RUN) > 50  # both ways were taken
-    no_compiled_steps(monkeypatch)
-    stepped, stepped_events = play()
-    assert len(compiled) == len(stepped)
-    for k, (one, other) in enumerate(zip(compiled, stepped, strict=True)):
-        assert _same_state(one, other), k
-    assert compiled_events == stepped_events
-    kinds = {getattr(event, "kind", None) for event in stepped_events}
+    kinds = _compiled_against_stepping(monkeypatch, play, played=500, left=50)
     assert {"kill", "death", "bomb_drop", "invalid_action", "round_end"} <= kinds, kinds
     assert "fall_damage" in kinds
 
@@ -237,17 +228,29 @@ def test_compiled_steps_with_plants_and_defuses_give_what_stepping_gives(monkeyp
         env.close()
         return states, events
 
+    kinds = _compiled_against_stepping(monkeypatch, play, played=100, left=20)
+    assert {"plant", "defuse_start", "defuse"} <= kinds, kinds
+
+
+def _compiled_against_stepping(
+    monkeypatch: pytest.MonkeyPatch,
+    play: Callable[[], tuple[list[ArrayStep], list]],
+    played: int,
+    left: int,
+) -> set[str | None]:
+    """`play()` with compiled steps (more than `played` played to their end, more than `left`
+    going on in Python), then with no tick quiet: the same states step for step and the same
+    events and round summaries. Returns the kinds of events seen."""
     ended = count_quiet_steps(monkeypatch)
     compiled, compiled_events = play()
-    assert ended.count(PLAYED) > 100 and ended.count(LEFT_TO_RUN) > 20
+    assert ended.count(PLAYED) > played and ended.count(LEFT_TO_RUN) > left
     no_compiled_steps(monkeypatch)
     stepped, stepped_events = play()
     assert len(compiled) == len(stepped)
     for k, (one, other) in enumerate(zip(compiled, stepped, strict=True)):
         assert _same_state(one, other), k
     assert compiled_events == stepped_events
-    kinds = {getattr(event, "kind", None) for event in stepped_events}
-    assert {"plant", "defuse_start", "defuse"} <= kinds, kinds
+    return {getattr(event, "kind", None) for event in stepped_events}
 
 
 def _round_summary(env: DecoyArrayEnv) -> tuple:
