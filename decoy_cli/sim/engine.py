@@ -228,8 +228,8 @@ class Simulator:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
         A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy) plays whole
-        quiet stretches of decisions and motion in compiled
-        code when the mover is kinematic and no `until` is given, with the same result."""
+        quiet stretches of decisions and motion in compiled code when the mover is kinematic
+        and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 

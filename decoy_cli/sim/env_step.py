@@ -30,12 +30,10 @@ from numba.experimental import structref
 
 from decoy_cli.compiled import jit_enabled, njit_cached
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.observation import NUM_ACTIONS, ObservationEncoder, encode_into
-from decoy_cli.sim.quiet_play import AIRBORNE, DECIDED, DUE, Choices, _play
+from decoy_cli.sim.quiet_play import AIRBORNE, DECIDED, DUE, Choices, _play, hands_back
 from decoy_cli.sim.schedule import NEVER
-from decoy_cli.waypoints.graph import STOP_ACTION
 
 PLAYED, LEFT_TO_RUN, BAD_ACTION, IN_THE_AIR, NOT_TAKEN, HALF_PLAYED = range(6)
 """How `_quiet_step` ended: it played the step to its end; it left the rest of the step to
@@ -124,10 +122,17 @@ class _Quiet:
 
     tick: int  # the tick it holds at, moved on by each quiet step
     events: int  # how many events the round had then
-    horizon: int
-    bomb_position: np.ndarray  # the simulator's own, which a carried bomb's moves update
     arrays: tuple[int, np.ndarray, int, int, np.ndarray, np.ndarray]  # `_quiet_step`'s horizon,
-    # watched agents, bomb state, carrier, bomb position and round inputs
+    # watched agents, bomb state, carrier, bomb position (the simulator's own array, which a
+    # carried bomb's moves update) and round inputs
+
+    @property
+    def horizon(self) -> int:
+        return self.arrays[0]
+
+    @property
+    def bomb_position(self) -> np.ndarray:
+        return self.arrays[4]
 
 
 class RoundSteps:
@@ -164,7 +169,6 @@ class RoundSteps:
             mover.jump_speed, mover.gravity, is_t, *encoder.kernel_arrays(),
             np.zeros(n, np.bool_), np.ones(n, np.bool_),
         )  # fmt: skip
-        self._kinematic = isinstance(mover, KinematicMover)
         self._quiet: _Quiet | None = None
 
     def first(self) -> ArrayStep:
@@ -215,12 +219,11 @@ class RoundSteps:
 
     def _quiet_from_here(self) -> _Quiet | None:
         """The shared state of quiet steps from the simulator's tick on, or None when the next
-        tick is not quiet: kept from the last quiet step when nothing else happened since, else
-        asked anew."""
+        tick is not quiet (`Simulator.quiet_horizon`, which also says so for a mover that is not
+        kinematic): kept from the last quiet step when nothing else happened since, else asked
+        anew."""
         sim = self.sim
         quiet = self._quiet
-        if not self._kinematic:
-            return None
         if quiet is None or quiet.tick != sim.tick or quiet.events != len(sim.events):
             self._quiet = quiet = None
             horizon = sim.quiet_horizon()
@@ -228,9 +231,8 @@ class RoundSteps:
                 return None
             watched = sim.rules.watched(sim.agents, sim.bomb)
             state, carrier, inputs = self.encoder.round_inputs(sim)
-            position = sim.bomb.position
-            arrays = (horizon, watched, state, carrier, position, inputs)
-            self._quiet = quiet = _Quiet(sim.tick, len(sim.events), horizon, position, arrays)
+            arrays = (horizon, watched, state, carrier, sim.bomb.position, inputs)
+            self._quiet = quiet = _Quiet(sim.tick, len(sim.events), arrays)
         if quiet.horizon <= sim.tick or quiet.bomb_position is not sim.bomb.position:
             return None
         return quiet
@@ -329,19 +331,13 @@ def _finish(
 
 @njit_cached
 def _hands_back(r, chosen, watch):
-    """Whether an action handed in may end `_play`'s stretch with the tick half played: it
-    hands back to Python after a STOP to plant or defuse by a watched agent and after a
-    damaging drop. (A move no edge makes it leaves to Python before the tick begins.)"""
+    """Whether an action handed in would end `_play`'s stretch with its first tick half played
+    (`quiet_play.hands_back`). A move no edge makes `_play` leaves to Python before the tick."""
     for i in range(r.due.shape[0]):
-        if not r.due[i]:
-            continue
-        if chosen[i] == STOP_ACTION:
-            if watch[i] and (r.plant[i] or r.defuse[i]):
-                return True
-        else:
-            edge = r.out_edges[r.node[i], chosen[i]]
-            if edge >= 0 and r.edge_fall[edge] > 0.0:
-                return True
+        if r.due[i] and hands_back(
+            i, chosen[i], r.node[i], watch, r.plant, r.defuse, r.out_edges, r.edge_fall
+        ):
+            return True
     return False
 
 

@@ -127,6 +127,17 @@ def play_stretch(
 
 
 @njit_cached
+def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
+    """Whether agent a's decision `act` at node `at` ends a quiet stretch with its tick half
+    played (`_play` returns DECIDED): a STOP to plant or defuse by an agent the bomb rules watch
+    (they may act on it), or a damaging drop (the engine lands it)."""
+    if act == STOP_ACTION:
+        return watch[a] and (plant[a] or defuse[a])
+    edge = out_edges[at, act]
+    return edge >= 0 and edge_fall[edge] > 0.0
+
+
+@njit_cached
 def _play(
     tick, horizon, given, draws, next_draw, first, actions, hold_ticks, plant, defuse,
     decisions_left, watch, top, out_edges, edge_target, edge_kind, edge_fall, positions,
@@ -175,7 +186,7 @@ def _play(
             stop = act == STOP_ACTION
             wants_plant[a] = plant[a] and stop
             wants_defuse[a] = defuse[a] and stop
-            if watch[a] and stop and (plant[a] or defuse[a]):  # the bomb rules may act on it
+            if hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
                 hand_back = True
             if stop:
                 one[0] = a
@@ -188,7 +199,6 @@ def _play(
             if edge_fall[edge] > 0.0:
                 fall_m[a] = edge_fall[edge]
                 falls += 1
-                hand_back = True
             if not begin_edge(
                 a, positions[goal, 0], positions[goal, 1], positions[goal, 2], edge_kind[edge],
                 top[a], top[a], jump_speed, gravity, pos, target, fv, iv,
