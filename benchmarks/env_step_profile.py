@@ -58,7 +58,7 @@ def main() -> None:
                                (env_step, "_quiet_step", "quiet"), (Simulator, "step", "whole"),
                                (CombatStep, "run", "combat"),
                                (env_step.RoundSteps, "_finish", "finish"),
-                               (env_step.RoundSteps, "first", "first"),
+                               (env_step.RoundSteps, "state", "first"),
                                (env_step.RoundSteps, "_quiet_from_here", "shared")):  # fmt: skip
         timed(owner, name, label)
     env = DecoyParallelEnv(mover="kinematic", damage_model=load_damage_model("shipped"))

@@ -1,6 +1,7 @@
-"""The compiled observation encoder against a plain numpy statement of the layout
-(`DecoyParallelEnv` documents every entry), on states of played rounds: bomb carried, dropped
-and planted, agents dead, plants and defuses under way."""
+"""The compiled observation encoder, as the environment's steps run it (`RoundSteps.state`),
+against a plain numpy statement of the layout (`DecoyParallelEnv` documents every entry), on
+states of played rounds: bomb carried, dropped and planted, agents dead, plants and defuses
+under way."""
 
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ import numpy as np
 from busy_rounds import Shots, Wanderers, site_agents
 
 from decoy_cli.sim.engine import Simulator
+from decoy_cli.sim.env_step import RoundSteps
 from decoy_cli.sim.observation import BOMB_SITES, NUM_ACTIONS, ObservationEncoder
+from decoy_cli.sim.quiet_play import Choices
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.build import builtin_graph
@@ -64,6 +67,14 @@ def reference(encoder: ObservationEncoder, sim: Simulator, due: np.ndarray) -> n
     return obs.astype(np.float32)
 
 
+def _steps_of(sim: Simulator, encoder: ObservationEncoder) -> RoundSteps:
+    """The environment's steps over a round played here (its `state` is what a step returns;
+    nothing is handed in)."""
+    is_t = sim.agents.side == "T"
+    choices = Choices(np.full(len(is_t), -1, np.int64), np.zeros(0), 0, 30, is_t, ~is_t)
+    return RoundSteps(sim, encoder, choices, list(sim.agents.names), is_t)
+
+
 def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
     graph = builtin_graph()
     setup = RoundSetup(graph=graph, damage_model=Shots())
@@ -72,11 +83,13 @@ def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
         agents = site_agents(graph, seed)
         encoder = ObservationEncoder(graph, list(agents.side), setup.rules_config(), bomb=True)
         with open_round(setup, agents, Wanderers(seed), bomb_carrier=seed % 5, seed=seed) as sim:
+            steps = _steps_of(sim, encoder)
             while not sim.done:
                 sim.step()
                 due = sim.needs_decision
-                vectors, masks, encoded_due = encoder.encode(sim)
-                np.testing.assert_array_equal(encoded_due, due)
+                state = steps.state()
+                vectors, masks = state.observations, state.action_masks
+                np.testing.assert_array_equal(state.needs_decision, due)
                 expected = reference(encoder, sim, due)
                 np.testing.assert_allclose(vectors, expected, atol=1e-7, err_msg=str(sim.tick))
                 mask = np.zeros((agents.count, NUM_ACTIONS), np.int8)
@@ -88,5 +101,5 @@ def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
                 seen |= {str(sim.bomb.status.name), "planting" * (sim.bomb.planter >= 0)}
                 seen |= {"defusing" * (sim.bomb.defuser >= 0), "dead" * (not agents.alive.all())}
     assert checked > 5000
-    assert not encoder.encode(sim)[2].any()  # nobody decides once the round is done
+    assert not steps.state().needs_decision.any()  # nobody decides once the round is done
     assert {"CARRIED", "DROPPED", "PLANTED", "planting", "defusing", "dead"} <= seen, seen

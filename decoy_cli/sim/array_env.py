@@ -203,7 +203,7 @@ class DecoyArrayEnv:
         self._steps = RoundSteps(
             self._sim, self.encoder, self._policy.choices, self.possible_agents, self._is_t
         )
-        return self._steps.first()
+        return self._steps.state()
 
     def step(self, actions: np.ndarray) -> ArrayStep:
         """Apply the actions of the agents that need a decision, then run the simulator until

@@ -171,8 +171,9 @@ class RoundSteps:
         )  # fmt: skip
         self._quiet: _Quiet | None = None
 
-    def first(self) -> ArrayStep:
-        """The agents' state at the round's start."""
+    def state(self) -> ArrayStep:
+        """The agents' state as it stands, no step taken (the round's start, for `reset`), as
+        a step returns it."""
         return self._finish()
 
     def play(self, chosen: np.ndarray) -> ArrayStep:
@@ -238,7 +239,7 @@ class RoundSteps:
         return quiet
 
     def _finish(self) -> ArrayStep:
-        """The state after a step that ended in Python, or at the round's start."""
+        """The state after a step that ended in Python, or with no step (`state`)."""
         sim = self.sim
         self._quiet = None
         outcome = sim.outcome

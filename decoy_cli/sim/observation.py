@@ -2,7 +2,9 @@
 encoding from the simulator's state (`DecoyParallelEnv` documents every entry).
 
 Kept apart from the environment's API so that the encoding can be read, tested and changed on
-its own; the environment asks an `ObservationEncoder` for the vectors and masks of a state.
+its own. An `ObservationEncoder` holds the layout and what the compiled `encode_into` needs of
+it (`kernel_arrays`) and of the round (`round_inputs`); the environment's steps (`env_step`)
+encode each state with them.
 """
 
 from __future__ import annotations
@@ -118,22 +120,8 @@ class ObservationEncoder:
             self._half,
         )  # fmt: skip
 
-    def encode(self, sim: Simulator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(N, size) float32 observation vectors, (N, 9) int8 action masks and (N,) bool
-        `needs_decision` of every agent (who the engine asks for a decision at the next tick:
-        nobody once the round is done), in one compiled pass."""
-        agents, bomb = sim.agents, sim.bomb
-        state, carrier, round_inputs = self.round_inputs(sim)
-        return _encode(
-            self.size, self._starts, self._bomb_starts, agents.position, agents.yaw, agents.hp,
-            agents.armor, agents.helmet, agents.has_defuser, self._is_ct, agents.alive,
-            self._mates, self._enemies, self._centre, self._half, bomb.position, state, carrier,
-            round_inputs, sim.done, sim.tick, sim.waiting, sim.hold_until, agents.node,
-            self.graph.out_edges,
-        )  # fmt: skip
-
     def round_inputs(self, sim: Simulator) -> tuple[int, int, np.ndarray]:
-        """What `_encode` needs of the bomb and the round besides the tick: the bomb state's
+        """What `encode_into` needs of the bomb and the round besides the tick: the bomb state's
         index into BOMB_STATES, its carrier (-1 unless carried) and `ROUND_INPUTS`. None of
         them changes on ticks when nothing but decisions and motion happen."""
         agents, bomb, cfg = sim.agents, sim.bomb, self.rules
@@ -169,34 +157,14 @@ _BOMB = (
     "bomb_state", "bomb_site", "plant_progress", "defuse_progress", "round_time_left",
     "bomb_time_left",
 )  # fmt: skip
-"""The round's entries, the same for every agent, in the order of `_encode`'s `bomb_starts`."""
+"""The round's entries, the same for every agent, in the order of `encode_into`'s `bomb_starts`."""
 
 
 ROUND_INPUTS = ("bomb_site", "plant_progress", "defuse_progress", "planted_tick", "planted",
                 "round_ticks", "bomb_ticks")  # fmt: skip
-"""The entries of `_encode`'s `round_inputs`: the bomb site's index or -1, plant and defuse
+"""The entries of `encode_into`'s `round_inputs`: the bomb site's index or -1, plant and defuse
 progress, the tick of the plant or -1, 1 while the bomb is planted, the round's and the bomb's
 time in ticks."""
-
-
-@njit_cached
-def _encode(
-    size, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates, enemies,
-    centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick, waiting, hold_until,
-    node, out_edges,
-):  # fmt: skip
-    """The observation vectors, action masks and due agents (`ObservationEncoder.encode`), in
-    new arrays (`encode_into`)."""
-    n = pos.shape[0]
-    obs = np.empty((n, size), np.float32)
-    masks = np.empty((n, out_edges.shape[1] + 1), np.int8)
-    due = np.empty(n, np.bool_)
-    encode_into(
-        obs, masks, due, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive,
-        mates, enemies, centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick,
-        waiting, hold_until, node, out_edges,
-    )  # fmt: skip
-    return obs, masks, due
 
 
 @njit_cached
