@@ -63,6 +63,11 @@ WEAPONS: dict[str, tuple[str, float]] = {
     "Zeus x27": ("Equipment", 220.0),
 }
 
+FIREARMS = tuple(
+    name for name, (kind, _) in WEAPONS.items() if kind in ("Pistols", "SMG", "Rifle", "Heavy")
+)
+"""The weapons that shoot bullets (what the damage models know)."""
+
 NO_WEAPON = ""
 """awpy writes an empty `activeWeapon` between weapon switches and for dead players."""
 

@@ -14,7 +14,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -23,7 +22,8 @@ import pytest
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import EstaError
-from decoy_cli.esta import RoundClock
+from decoy_cli.esta import Round, RoundClock
+from decoy_cli.esta.frames import PlayerInfo
 from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK, player_metrics
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.replayer import (
@@ -84,15 +84,6 @@ PLAYER_COLUMNS = (
 
 
 @dataclass(frozen=True)
-class Player:
-    """A round's player record: what the replay reads of the reader's PlayerInfo."""
-
-    name: str
-    side: str
-    steam_id: int | None = None
-
-
-@dataclass(frozen=True)
 class Track:
     """One player in a generated round: a waypoint per frame (-1: not recorded in that frame)."""
 
@@ -129,7 +120,7 @@ def frame_ticks(count: int) -> np.ndarray:
 
 def make_round(
     tracks: list[Track], ticks: np.ndarray | None = None, plant_frame: int | None = None
-) -> SimpleNamespace:
+) -> Round:
     """A round with the reader's attributes; `plant_frame` sets a bomb plant 10 ticks before it."""
     frames = len(tracks[0].nodes) if ticks is None else len(ticks)
     ticks = frame_ticks(frames) if ticks is None else np.asarray(ticks, dtype=np.int64)
@@ -152,12 +143,13 @@ def make_round(
         weapon[p, alive[p]] = np.asarray(names, dtype=object)[alive[p]]
         has_bomb[p] = alive[p] & np.asarray(track.bomb, dtype=bool)
     present = np.isfinite(position).all(axis=2)
-    return SimpleNamespace(
+    return Round(
+        match_id="made-up",
         map_name="de_dust2",
         path=Path("made-up.json"),
         round_num=1,
-        num_players=n,
-        players=[Player(t.name, t.side) for t in tracks],
+        tick_rate=DATA_TICK_RATE,
+        players=[PlayerInfo(t.name, t.name, None, t.side) for t in tracks],
         frame_ticks=ticks,
         frame_seconds=RoundClock(FREEZE_END, DATA_TICK_RATE).seconds(ticks),
         clock=RoundClock(FREEZE_END, DATA_TICK_RATE),
@@ -177,7 +169,13 @@ def make_round(
         bomb_position=np.full((frames, 3), np.nan),
         bombsite=np.full(frames, ""),
         bomb_events=pd.DataFrame(),
-        warnings=(),
+        damages=pd.DataFrame(),
+        kills=pd.DataFrame(),
+        flashes=pd.DataFrame(),
+        winning_side=None,
+        end_reason=None,
+        start_tick=None,
+        end_tick=None,
     )
 
 
@@ -192,9 +190,7 @@ def physics() -> Iterator[PhysicsWorld]:
         yield world
 
 
-def replay(
-    round_: SimpleNamespace, physics: PhysicsWorld, mover: str, bomb: bool = True
-) -> ReplayResult:
+def replay(round_: Round, physics: PhysicsWorld, mover: str, bomb: bool = True) -> ReplayResult:
     """Replay with combat off (deaths in the data are scripted)."""
     options = ReplayOptions(combat=False, bomb=bomb, mover=mover)
     return replay_round(round_, builtin_graph(), options, physics=physics)
@@ -203,11 +199,11 @@ def replay(
 # ---- timing: standing, walking, running late --------------------------------------------------
 
 TIMING_FRAMES = 21  # 10 s
-Timed = tuple[SimpleNamespace, ReplayResult]
+Timed = tuple[Round, ReplayResult]
 STILL, WALKER, DETOURER = range(3)
 
 
-def timing_round() -> SimpleNamespace:
+def timing_round() -> Round:
     """One player stands 10 s; one walks the straight run, two edges per frame (2.8 m/s, below
     the AK-47's 4.1 m/s); one runs the detour there and back in one frame each (4.57 m in 0.5 s:
     over twice the AK-47's speed), then stands still."""
@@ -359,7 +355,7 @@ DEATH_FRAME = 6
 ALIVE, DIES, VANISHES, ABSENT, CT = range(5)
 
 
-def fate_round() -> SimpleNamespace:
+def fate_round() -> Round:
     """A survivor, a walker killed in the data at frame 6, a player who is no longer recorded
     after frame 4 (not killed: it vanishes), a CT who is never recorded, and a CT who stands."""
     run = straight_run(node_at(RUN_START), direction=0, count=FATE_FRAMES)

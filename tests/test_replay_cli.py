@@ -118,8 +118,19 @@ def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_pat
         "mover": "kinematic",
         "seed": 0,
         "implausible": "fail",
+        "deaths": "data (no shooting)",
+        "missing_fields": "infer",
     }
+    # the file's winner is T by elimination, yet its frames keep CTs alive: named, replayed
     assert summary["warnings"] == []
+    assert summary["contradictions"] == [
+        "the round ends TerroristsWin, yet ct1, ct2, ct3, ct4 of the CT side are alive at its end"
+    ]
+    # two players hold no weapon in any frame (round 1: a pistol round); the others have theirs
+    assert summary["inferred"] == [
+        "weapon in hand (t2): Glock-18: a pistol round",
+        "weapon in hand (ct1): USP-S: a pistol round",
+    ]
     assert summary["frames"] == frames and summary["round_num"] == 1
     assert summary["outcome_original"] == {"winner": "T", "reason": "TerroristsWin"}
     assert summary["outcome_replay"] == {"winner": None, "reason": None}

@@ -23,6 +23,7 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import DEATHS_HELP, MISSING_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
@@ -49,6 +50,8 @@ from decoy_cli.evaluate.runner import (
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
+from decoy_cli.replay.deaths import DeathProtocol
+from decoy_cli.replay.missing import Missing
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -92,6 +95,8 @@ def evaluate(
     mover: str = typer.Option(
         "kinematic", "--mover", help="kinematic (default) or physics (capsules that collide)."
     ),
+    deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
+    missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
     out: Path = typer.Option(
         DEFAULT_OUT,
         "--out",
@@ -155,6 +160,8 @@ def evaluate(
         mover=mover,
         seed=seed,
         implausible=check_policy(implausible),
+        deaths=deaths,
+        missing=missing,
         fastdtw=fastdtw,
         graph=graph,
     )
@@ -280,6 +287,19 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
             "(--implausible warn; their warnings are in rounds.csv and report.md)",
             style="yellow",
         )
+    if tables.rounds_with_contradictions:
+        console.print(
+            f"{tables.rounds_with_contradictions} rounds whose frames and events contradict "
+            "each other, replayed (rounds.csv: contradictions; report.md)",
+            style="yellow",
+        )
+    if tables.rounds_with_inferred:
+        console.print(
+            f"{tables.rounds_with_inferred} rounds lack fields the game needs (weapons, armour, "
+            "the bomb's carrier, the defuser): filled by rule, named in rounds.csv (inferred) "
+            "and report.md",
+            style="yellow",
+        )
     groups = table_groups(tables)
     stats = tables.trajectory.set_index(["metric", "group"])
     titles = {
@@ -311,7 +331,7 @@ def _show(console: Console, evaluation: Evaluation, tables: Tables) -> None:
         console.print(table)
     for row in tables.summary.unevaluated.itertuples():
         console.print(f"  {row.group}: {row.count} not evaluated ({row.reason})", highlight=False)
-    caveats = combat_caveats(tables, evaluation.settings.combat)
+    caveats = combat_caveats(tables, evaluation.settings)
     combat = Table(title="HP, deaths and outcomes", caption=" ".join(caveats) or None)
     for column in ("metric", "value", "95% interval", "n", "paper", "over / why not"):
         combat.add_column(column, justify="right" if column in ("value", "n", "paper") else "left")

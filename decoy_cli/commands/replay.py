@@ -11,9 +11,12 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import DEATHS_HELP, MISSING_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+from decoy_cli.replay.deaths import DeathProtocol
+from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
 from decoy_cli.sim.setup import check_mover
@@ -57,6 +60,8 @@ def replay(
         help="Implausible data (README: what the reader and the replay refuse): fail, or warn "
         "and replay it anyway.",
     ),
+    deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
+    missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
     console = make_console()
@@ -74,6 +79,8 @@ def replay(
         mover=mover,
         damage_model=damage_model,
         seed=seed,
+        deaths=deaths,
+        missing=missing,
         implausible=policy,
     )
     run = replay_address(
@@ -109,6 +116,12 @@ def replay(
     console.print(outcome)
     for warning in result.warnings:
         console.print(f"warning: implausible data replayed anyway: {warning}", style="yellow")
+    for note in result.contradictions:
+        console.print(f"data contradicts itself: {note}", style="yellow")
+    for note in result.inferred:
+        console.print(f"inferred: {note}", style="yellow")
+    if options.combat:
+        console.print(f"deaths decided by: {options.deaths}")
     _show_bomb(console, result.bomb_row())
     for title, names in (
         ("clock protocol", METRIC_NAMES_CLOCK),

@@ -244,6 +244,8 @@ def _replay(
         mover=settings.mover,
         damage_model=model,
         seed=round_seed(settings, task.file_sha, task.round_num),
+        deaths=settings.deaths,
+        missing=settings.missing,
         implausible=settings.implausible,
     )
     return replay_round(round_, state.graph, options, physics=state.physics)

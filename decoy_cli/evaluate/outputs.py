@@ -31,6 +31,7 @@ import pandas as pd
 
 from decoy_cli.errors import OutputError
 from decoy_cli.evaluate.figures import draw_figures
+from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
@@ -209,6 +210,8 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
                 "mover": settings.mover,
                 "seed": settings.seed,
                 "implausible": settings.implausible,
+                "deaths": settings.deaths if settings.combat else "data (no shooting)",
+                "missing_fields": settings.missing,
                 "sample": info.sample,
             },
             "mechanics": mechanics(evaluation.settings),
@@ -235,6 +238,11 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
                 "defuse_confusion": tables.bomb.defuse_confusion.to_dict(),
             },
             "failures_by_kind": dict(Counter(f.kind for f in evaluation.failures)),
+            "inferred_by_round": {
+                f"{row.match}:{row.round}": row.inferred.split(WARNING_SEPARATOR)
+                for row in tables.rounds.itertuples()
+                if row.inferred
+            },
         }
     )
 

@@ -17,6 +17,7 @@ import numpy as np
 from decoy_cli.esta import Round
 from decoy_cli.evaluate.settings import HeatGrid
 from decoy_cli.metrics import metric_names, player_metrics
+from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
 
@@ -114,12 +115,19 @@ ROUND_COLUMNS = (
     "recoveries",
     "relocations",
     "warnings",
+    "contradictions",
+    "inferred",
     "wall_seconds",
     *BOMB_COLUMNS,
+    *KILL_COLUMNS,
 )
 """Columns of a round row (rounds.csv); `warnings` holds the implausible data a round was
-replayed with under `--implausible warn`, joined by `WARNING_SEPARATOR` ("" when none); the
-bomb columns (`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off."""
+replayed with under `--implausible warn`, `contradictions` what its frames and events say
+against each other (`decoy_cli.replay.missing`), each joined by `WARNING_SEPARATOR` ("" when
+none); `inferred` the fields the data lacked and the rules that
+filled them (`decoy_cli.replay.missing`), joined likewise; the bomb columns
+(`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off; the kill columns
+(`decoy_cli.metrics.kills`) compare deaths and alive counts."""
 
 WARNING_SEPARATOR = " | "
 
@@ -140,6 +148,12 @@ def build_record(
     hp_r = rec.hp.T.astype(np.int64)
     hp_known = present & (hp_o >= 0)
 
+    kills = result.kill_row(round_)
+    death_original = (
+        result.data_deaths.seconds
+        if result.data_deaths is not None
+        else [plan.death_seconds for plan in result.plan.plans]
+    )
     players = []
     for p, row in enumerate(metrics.to_dict("records")):
         replay_death = np.nan
@@ -159,7 +173,7 @@ def build_record(
                 "died_original": bool(row["died_original"]),
                 "died_replay": bool(row["died_replay"]),
                 "death": row["death"],
-                "death_time_original_s": float(result.plan.plans[p].death_seconds),
+                "death_time_original_s": float(death_original[p]),
                 "death_time_replay_s": replay_death,
                 "hp_frames": len(known),
                 "hp_rmse": float(np.sqrt(np.mean(diff**2))) if len(known) else np.nan,
@@ -187,8 +201,11 @@ def build_record(
         "recoveries": int(metrics["recoveries"].sum()),
         "relocations": int(metrics["relocations"].sum()),
         "warnings": WARNING_SEPARATOR.join(result.warnings),
+        "contradictions": WARNING_SEPARATOR.join(result.contradictions),
+        "inferred": WARNING_SEPARATOR.join(result.inferred),
         "wall_seconds": round(seconds, 4),
         **(result.bomb_row() or dict.fromkeys(BOMB_COLUMNS)),
+        **kills,
     }
     replayed = rec.position.transpose(1, 0, 2)  # (P, F, 3) like the original
     points_o = original[alive_o]  # (M, 3), player-major

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from decoy_cli.evaluate.bomb_report import bomb_section
 from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
+from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
@@ -60,7 +61,12 @@ def mechanics(settings: EvalSettings) -> str:
     if not settings.combat:
         return f"combat off, {bomb}: deaths scripted from the data"
     if settings.models_fingerprint:
-        return f"combat (damage model: {settings.models}), {bomb}"
+        deaths = (
+            "deaths decided by the simulated fight"
+            if settings.deaths == "simulated"
+            else "deaths from the data (the paper's protocol; shooting wounds, does not kill)"
+        )
+        return f"combat (damage model: {settings.models}; {deaths}), {bomb}"
     return f"{bomb}, no shooting (--models none): deaths scripted from the data"
 
 
@@ -76,8 +82,9 @@ def command_line(
     words += ["--seed", str(settings.seed), "--combat" if settings.combat else "--no-combat"]
     words += ["--bomb" if settings.bomb else "--no-bomb"]
     if settings.combat:
-        words += ["--models", settings.models]
+        words += ["--models", settings.models, "--deaths", settings.deaths]
     words += ["--mover", settings.mover, "--implausible", settings.implausible]
+    words += ["--missing-fields", settings.missing]
     words += ["--fastdtw" if settings.fastdtw else "--no-fastdtw", "--out", str(out)]
     return shlex.join(words)
 
@@ -97,6 +104,8 @@ def run_counts(evaluation: Evaluation, tables: Tables) -> dict[str, int]:
         "player_rounds": len(tables.players),
         "failures": len(evaluation.failures),
         "rounds_with_warnings": tables.rounds_with_warnings,
+        "rounds_with_contradictions": tables.rounds_with_contradictions,
+        "rounds_with_inferred_fields": tables.rounds_with_inferred,
     }
 
 
@@ -231,6 +240,12 @@ def report_markdown(
             f"(`--implausible {settings.implausible}`): "
             f"{counts['rounds_with_warnings']} rounds with warnings",
         ],
+        [
+            "fields the data lacks",
+            f"`--missing-fields {settings.missing}`: "
+            f"{counts['rounds_with_inferred_fields']} rounds with fields filled by rule "
+            "(below, and the `inferred` column of `rounds.csv`)",
+        ],
         ["mechanics", mechanics(evaluation.settings)],
         ["mover, seed", f"{settings.mover}, {settings.seed}"],
         ["ran on", f"{info.backend}; {info.machine}"],
@@ -243,12 +258,16 @@ def report_markdown(
     ]
     parts.append("## What was run\n\n" + md_table(["", ""], run_rows))
     parts.append(_trajectory_section(tables, settings))
-    parts.append(_combat_section(tables, settings.combat))
+    parts.append(_combat_section(tables, settings))
     parts.append(bomb_section(tables))
     parts.append(_figures_section(tables, figures))
     parts.append(_failures_section(evaluation))
     if counts["rounds_with_warnings"]:
         parts.append(_warnings_section(tables))
+    if counts["rounds_with_contradictions"]:
+        parts.append(_contradictions_section(tables))
+    if counts["rounds_with_inferred_fields"]:
+        parts.append(_inferred_section(tables))
     return "\n\n".join(parts) + "\n"
 
 
@@ -287,10 +306,21 @@ def _trajectory_section(tables: Tables, settings: EvalSettings) -> str:
     return "\n\n".join(text)
 
 
-def combat_caveats(tables: Tables, combat: bool) -> list[str]:
+def combat_caveats(tables: Tables, settings: EvalSettings) -> list[str]:
     """What the HP, death and outcome numbers do not measure in this run (report and terminal)."""
     caveats = []
-    if not combat:
+    if settings.combat and settings.deaths == "simulated":
+        caveats.append(
+            "Deaths were decided by the simulated fight (--deaths simulated); the paper's HP, "
+            "death and outcome figures come from deaths that follow the data: compare them "
+            "with a --deaths data run."
+        )
+    elif settings.combat:
+        caveats.append(
+            "Deaths followed the data (--deaths data, the paper's protocol): death times and "
+            "outcomes measure the scripting and the bomb, HP the wounds."
+        )
+    if not settings.combat:
         caveats.append(
             "Combat was off: HP changes only where a death is scripted from the data, so these "
             "measure the scripting, not a damage model."
@@ -303,8 +333,8 @@ def combat_caveats(tables: Tables, combat: bool) -> list[str]:
     return caveats
 
 
-def _combat_section(tables: Tables, combat: bool) -> str:
-    text = ["## HP, deaths and outcomes", *combat_caveats(tables, combat)]
+def _combat_section(tables: Tables, settings: EvalSettings) -> str:
+    text = ["## HP, deaths and outcomes", *combat_caveats(tables, settings)]
     rows = [
         [
             f"`{r.metric}`",
@@ -403,6 +433,39 @@ def _failures_section(evaluation: Evaluation) -> str:
     ]
     text.append(first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))
     return "\n\n".join(text)
+
+
+def _contradictions_section(tables: Tables) -> str:
+    """The rounds whose frames and events say against each other, replayed as they are."""
+    rounds = tables.rounds[tables.rounds["contradictions"] != ""]
+    rows = [
+        [Path(str(row.file)).name, str(row.round), str(row.contradictions)]
+        for row in rounds.itertuples()
+    ]
+    return "\n\n".join(
+        [
+            "## Frames and events that contradict each other",
+            f"{len(rounds)} rounds were replayed as their data has them; what does not add up "
+            "is in the `contradictions` column of `rounds.csv`.",
+            first_rows(["file", "round", "contradictions"], rows, "rounds.csv"),
+        ]
+    )
+
+
+def _inferred_section(tables: Tables) -> str:
+    """The fields the data lacked and the rules that filled them, by how many rounds."""
+    notes = tables.rounds["inferred"].str.split(WARNING_SEPARATOR, regex=False).explode()
+    rules = notes[notes != ""].str.replace(r" \([^)]*\):", ":", regex=True).value_counts()
+    rows = [[text, str(count)] for text, count in rules.items()]
+    return "\n\n".join(
+        [
+            "## Fields the data lacks, filled by rule",
+            "The game needs them and the data does not record them; each was filled by the "
+            "rule named (decoy_cli/replay/missing.py). Per round and player: the `inferred` "
+            "column of `rounds.csv`. `--missing-fields error` fails such rounds instead.",
+            first_rows(["field: rule (players left out)", "times"], rows, "rounds.csv"),
+        ]
+    )
 
 
 def _warnings_section(tables: Tables) -> str:

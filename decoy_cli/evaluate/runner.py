@@ -51,6 +51,8 @@ from decoy_cli.evaluate.settings import (
     round_key,
 )
 from decoy_cli.evaluate.tables import Accumulator
+from decoy_cli.replay.deaths import DeathProtocol
+from decoy_cli.replay.missing import Missing
 from decoy_cli.waypoints.graph import WaypointGraph
 
 
@@ -110,6 +112,8 @@ def make_settings(
     mover: str,
     seed: int,
     implausible: Implausible = "fail",
+    deaths: DeathProtocol = "simulated",
+    missing: Missing = "infer",
     fastdtw: bool | None = None,
     graph: Path | None = None,
 ) -> EvalSettings:
@@ -148,6 +152,8 @@ def make_settings(
         code=code_fingerprint(name),
         models_fingerprint=models_fingerprint,
         implausible=implausible,
+        deaths=deaths,
+        missing=missing,
         fastdtw=(not combat and not bomb) if fastdtw is None else fastdtw,
         graph=graph_path,
         graph_sha=graph_sha,

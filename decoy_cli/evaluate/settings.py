@@ -14,12 +14,17 @@ import math
 from dataclasses import asdict, dataclass
 from functools import cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.world.navmesh import asset_dir, load_navmesh
 
-RECORD_VERSION = 5
+if TYPE_CHECKING:
+    from decoy_cli.replay.deaths import DeathProtocol
+    from decoy_cli.replay.missing import Missing
+
+RECORD_VERSION = 6
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HEAT_CELL_M = 0.5
@@ -107,6 +112,10 @@ class EvalSettings:
     models_fingerprint: str
     """Fingerprint of the damage model files ("" without combat or with no model)."""
     implausible: Implausible = "fail"
+    deaths: DeathProtocol = "simulated"
+    """Who decides deaths with shooting on (`ReplayOptions.deaths`)."""
+    missing: Missing = "infer"
+    """Fill the fields the data lacks by rule, or fail the round (`ReplayOptions.missing`)."""
     fastdtw: bool = False
     """Also compute `paper_dtw_fastdtw` (the paper's FastDTW; slow, `metrics.fastdtw_metric`)."""
     hp_bin_s: float = HP_BIN_S

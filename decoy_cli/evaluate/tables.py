@@ -44,6 +44,7 @@ from decoy_cli.metrics import (
     pearson,
     summarize,
 )
+from decoy_cli.metrics.kills import kill_table
 
 PAPER_TABLE2: dict[str, dict[str, tuple[float, float]]] = {
     "T": {
@@ -222,6 +223,10 @@ class Tables:
     rounds_with_winner: int
     rounds_with_warnings: int
     """Rounds replayed with implausible data (`--implausible warn`)."""
+    rounds_with_contradictions: int
+    """Rounds whose frames and events contradict each other (`decoy_cli.replay.missing`)."""
+    rounds_with_inferred: int
+    """Rounds with fields the data lacked, filled by rule (`decoy_cli.replay.missing`)."""
     bomb: BombMetrics | None = None
     """Bomb fidelity over the rounds whose data records the bomb; None with the bomb off."""
 
@@ -234,9 +239,10 @@ def build_tables(acc: Accumulator) -> Tables:
     summary = summarize(players[["side", *names, "reason"]], names)
     seed = acc.settings.seed
     trajectory = trajectory_intervals(trajectory_table(summary), players, seed)
+    fights = _fight_deaths(players, acc.settings)
     deaths = death_time_metrics(
-        players["death_time_original_s"].to_numpy(np.float64),
-        players["death_time_replay_s"].to_numpy(np.float64),
+        fights["death_time_original_s"].to_numpy(np.float64),
+        fights["death_time_replay_s"].to_numpy(np.float64),
     )
     known = rounds[rounds["winner_original"].notna()]
     outcome = None
@@ -255,8 +261,16 @@ def build_tables(acc: Accumulator) -> Tables:
         after = float((known["played_out_s"] > 0).mean())
         note = "share of rounds decided by playing on after the data's last frame"
         combat.loc[len(combat)] = ("decided_after_data", after, len(known), math.nan, note)
-    combat = combat_intervals(combat, players, rounds, acc.hp_by_round(), seed)
-    both = int(((rounds["players_t"] > 0) & (rounds["players_ct"] > 0)).sum()) if len(rounds) else 0
+    combat = combat_intervals(combat, fights, rounds, acc.hp_by_round(), seed)
+    both = 0
+    if len(rounds):
+        both_teams = (rounds["players_t"] > 0) & (rounds["players_ct"] > 0)
+        both = int(both_teams.sum())
+    if both:
+        kills = kill_table(rounds[both_teams], seed).assign(paper=math.nan)
+        combat = pd.concat([combat, kills[combat.columns]], ignore_index=True)
+    if not (acc.settings.combat and acc.settings.deaths == "data"):
+        combat["paper"] = math.nan  # the paper's figures come from deaths that follow the data
     return Tables(
         players=players,
         rounds=rounds,
@@ -270,7 +284,26 @@ def build_tables(acc: Accumulator) -> Tables:
         rounds_both_teams=both,
         rounds_with_winner=len(known),
         rounds_with_warnings=int((rounds["warnings"] != "").sum()) if len(rounds) else 0,
+        rounds_with_contradictions=_count_filled(rounds, "contradictions"),
+        rounds_with_inferred=_count_filled(rounds, "inferred"),
         bomb=bomb_metrics(rounds, seed=seed) if acc.settings.bomb else None,
+    )
+
+
+def _count_filled(rounds: pd.DataFrame, column: str) -> int:
+    """Rounds with something in a text column of notes ("" when none)."""
+    return int((rounds[column] != "").sum()) if len(rounds) else 0
+
+
+def _fight_deaths(players: pd.DataFrame, settings: EvalSettings) -> pd.DataFrame:
+    """The players with the deaths the death-time metrics compare: with the fight deciding
+    (`--deaths simulated`), a death scripted from the data (the fight did not kill within the
+    window, `decoy_cli.replay.replayer`) counts as not died in the replay."""
+    if not (settings.combat and settings.deaths == "simulated") or not len(players):
+        return players
+    scripted = players["death"] == "scripted"
+    return players.assign(
+        death_time_replay_s=players["death_time_replay_s"].where(~scripted, np.nan)
     )
 
 

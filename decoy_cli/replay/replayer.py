@@ -5,8 +5,16 @@ move runs at the speed that reaches the interval's target waypoint by its frame 
 holds until the deadline, and the arrival at every target is logged against its deadline (the
 lateness). The anchor implementation moved everyone at knife speed, collapsed STOPs and killed
 every agent at the end of its actions; here a survivor survives, and a player who died in the
-data is removed at its death time only when combat is off ("scripted" deaths, recorded as such)
-— with combat on, only the simulation's own combat kills.
+data is removed at its death time when combat is off or the deaths follow the data
+(`ReplayOptions.deaths`, "scripted" deaths, recorded as such). Otherwise the simulation's own
+fight kills, and a player the data shows dead whom the fight has not killed within
+`DEATH_WINDOW_S` of its real death (the tolerance of the kill-level metrics) is removed then,
+as "scripted" too: its data has ended, there is nothing left to replay, and a player standing
+on at the spot where he died would fight a round that no longer exists. The metrics count such
+deaths as not reproduced by the fight.
+
+Fields the game needs and the data lacks (weapons, armour, the bomb's carrier, the defuser) are
+filled by the rules of `decoy_cli.replay.missing` and named in `ReplayResult.inferred`.
 
 The state of every agent is recorded at every data frame time, so the metrics compare O_t and
 S_t on the same clock.
@@ -23,6 +31,7 @@ from decoy_cli.csgo import TICK_RATE, tick_at
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round
 from decoy_cli.esta.plausibility import Implausible, first_offender
+from decoy_cli.metrics.kills import DEATH_WINDOW_S, kill_row
 from decoy_cli.metrics.players import ReplayTrace
 from decoy_cli.replay.bomb import (
     DataBomb,
@@ -33,6 +42,8 @@ from decoy_cli.replay.bomb import (
     read_data_bomb,
 )
 from decoy_cli.replay.bomb_fidelity import bomb_fidelity
+from decoy_cli.replay.deaths import DeathProtocol, RoundDeaths, data_deaths, replay_deaths
+from decoy_cli.replay.missing import Missing, contradictions, fill_missing
 from decoy_cli.replay.pace import asks_more
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
@@ -43,7 +54,7 @@ from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import OpenRound, RoundSetup, check_mover, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import max_speed_m_s
+from decoy_cli.weapons import FIREARMS, max_speed_m_s
 from decoy_cli.world.physics import PhysicsWorld
 
 DATA_FRAME_S = 0.5
@@ -66,11 +77,29 @@ class ReplayResult:
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
     played_out_s: float = 0.0  # game seconds simulated after the data's last frame (play_out)
     warnings: tuple[str, ...] = ()  # implausible data replayed anyway (ReplayOptions.implausible)
+    inferred: tuple[str, ...] = ()  # fields the data lacked, filled by rule (replay/missing.py)
+    contradictions: tuple[str, ...] = ()  # what the data's frames and events say against each other
+    data_deaths: RoundDeaths | None = None  # the data's death times and killers (replay/deaths.py)
     bomb: DataBomb | None = None  # the data's bomb, when the replay followed it
 
     def bomb_row(self) -> dict[str, object] | None:
         """The bomb fidelity of this replay (`BOMB_COLUMNS`), None when the bomb was off."""
         return None if self.bomb is None else bomb_fidelity(self.bomb, self.events)
+
+    def kill_row(self, round_: Round) -> dict[str, object]:
+        """The kill-level fidelity of this replay of `round_` (`KILL_COLUMNS`)."""
+        truth = self.data_deaths or data_deaths(round_, self.plan.plans)
+        count = len(self.plan.plans)
+        replay = replay_deaths(self.events, count)
+        alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
+        return kill_row(
+            [p.name for p in self.plan.players],
+            [p.side for p in self.plan.players],
+            (truth.seconds, truth.killer),
+            (replay.seconds, replay.killer, replay.by_fight),
+            alive,
+            self.recording.alive.T & np.asarray(round_.present, bool),
+        )
 
     def trace(self) -> ReplayTrace:
         """What the fidelity metrics need from this replay (`decoy_cli.metrics.player_metrics`)."""
@@ -182,7 +211,8 @@ class ReplayOptions:
 
     `combat` and `bomb` are independent switches (shooting needs `damage_model` too); both off
     is the paper's movement-only replay. The default mover is the one measured more faithful
-    on real rounds (the README gives the numbers).
+    on real rounds (the README gives the numbers). `deaths` says who decides deaths when
+    shooting (module docstring); `missing` whether absent fields are filled or fail the round.
     """
 
     combat: bool = True
@@ -197,6 +227,8 @@ class ReplayOptions:
     # which outcomes were decided after the data (`ReplayResult.played_out_s`).
     play_out: bool = True
     seed: int = 0
+    deaths: DeathProtocol = "simulated"
+    missing: Missing = "infer"
     implausible: Implausible = "fail"
     """Whether a player far off the map fails the round or is a warning (as the reader's
     policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
@@ -219,6 +251,7 @@ class ReplayOptions:
             combat=self.combat,
             bomb=self.bomb,
             damage_model=self.damage_model,
+            combat_kills=self.deaths == "simulated",
             rules=rules,
         )
 
@@ -240,13 +273,15 @@ def replay_round(
     """
     options = options if options is not None else ReplayOptions()
     frame_ticks = _frame_ticks(round_)
-    warnings = round_.warnings + _check_on_map(round_, graph, options.implausible)
     setup = options.setup(graph, round_)
     if physics is None:  # snapping finds frames in the air with the world's rays
         with setup.open_physics() as own:
             return replay_round(round_, graph, options, physics=own, open_sim=open_sim)
     rules_config = setup.rules_config()
     zones = setup.site_zones()
+    filled = fill_missing(round_, zones, rules_config, options.missing)
+    round_ = filled.round
+    warnings = round_.warnings + _check_on_map(round_, graph, options.implausible)
     bomb = read_data_bomb(round_, zones, rules_config.plant_s) if options.bomb else None
     plan = snap_round(
         round_,
@@ -257,6 +292,7 @@ def replay_round(
     )
     players = plan.players
     n = len(players)
+    truth = data_deaths(round_, plan.plans)
     first = [int(p.target_frame[0]) if len(p.target_node) else 0 for p in plan.plans]
     start_nodes = np.array(
         [int(p.target_node[0]) if len(p.target_node) else 0 for p in plan.plans], dtype=np.int64
@@ -306,11 +342,17 @@ def replay_round(
         record_ticks=frame_ticks,
         seed=options.seed,
     ) as sim:
-        deaths = {}
-        if sim.combat is None:  # movement only: the data's deaths are scripted
-            deaths = {
-                i: tick_at(p.death_seconds) for i, p in enumerate(plan.plans) if p.death_frame >= 0
-            }
+        if sim.combat is not None and not np.isin(agents.weapon, FIREARMS).any():
+            warnings += ("shooting is on, but no player holds a firearm: nobody can shoot",)
+        # The data's deaths are scripted at their time without shooting or with `deaths` "data";
+        # with the fight deciding, a player the fight has not killed by `DEATH_WINDOW_S` after
+        # its real death is taken out then (its data ends: nothing is left to replay).
+        grace = DEATH_WINDOW_S if sim.combat is not None and options.deaths == "simulated" else 0
+        deaths = {
+            i: tick_at(truth.seconds[i] + grace)
+            for i, p in enumerate(plan.plans)
+            if p.death_frame >= 0
+        }
         # The replay follows the data to its last frame: a round the rules end earlier (the
         # clock, the bomb) goes on moving through the round-end delay, as the real players
         # did, with the outcome as decided (`Simulator.step(after_end=True)`).
@@ -360,6 +402,9 @@ def replay_round(
         recoveries=recoveries,
         played_out_s=(sim.tick - played_from) / TICK_RATE,
         warnings=warnings,
+        inferred=filled.notes,
+        contradictions=contradictions(round_),
+        data_deaths=truth,
         bomb=bomb,
     )
 

@@ -123,8 +123,9 @@ def replay_summary(
     players: pd.DataFrame,
     seconds: float,
 ) -> dict[str, Any]:
-    """The contents of `summary.json`: the round, the options, both outcomes, counts, and the
-    bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off)."""
+    """The contents of `summary.json`: the round, the options, both outcomes, counts, the
+    fields inferred, the bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off) and the
+    kill-level fidelity (`KILL_COLUMNS`)."""
     outcome = result.outcome
     return {
         "round": address,
@@ -136,6 +137,8 @@ def replay_summary(
             "mover": options.mover,
             "seed": options.seed,
             "implausible": options.implausible,
+            "deaths": options.deaths if options.combat else "data (no shooting)",
+            "missing_fields": options.missing,
         },
         "damage_models": models if options.combat else None,
         "played_out_s": round(result.played_out_s, 3),
@@ -150,5 +153,8 @@ def replay_summary(
         "recoveries": int(players["recoveries"].sum()),
         "relocations": int(players["relocations"].sum()),
         "warnings": list(result.warnings),
+        "contradictions": list(result.contradictions),
+        "inferred": list(result.inferred),
         "bomb": result.bomb_row(),
+        "kills": result.kill_row(round_),
     }

@@ -167,14 +167,15 @@ class DamageModel(Protocol):
 
 
 def apply_damage(
-    agents: Agents, batch: CombatBatch, result: DamageResult, tick: int
+    agents: Agents, batch: CombatBatch, result: DamageResult, tick: int, *, kills: bool = True
 ) -> list[SimEvent]:
     """Apply all damage of one combat step at once and return its events.
 
     Each victim loses the sum of the damage of all its attackers (HP stays an integer, clipped
-    at 0); a victim at 0 HP dies. Every attacker fires on the state before the step, so two
-    agents can kill each other. Armor goes down by the result's armor damage (clipped at 0; the
-    learned DIP + DOG give none: their damage is HP after armor).
+    at 0); a victim at 0 HP dies. With `kills` False nobody dies: HP stops at 1 (a replay whose
+    deaths follow the data, `--deaths data`). Every attacker fires on the state before the
+    step, so two agents can kill each other. Armor goes down by the result's armor damage
+    (clipped at 0; the learned DIP + DOG give none: their damage is HP after armor).
 
     Events, in this order: "damage" per hit pair in batch order (agent = attacker, other =
     victim; data: damage, hit_group, weapon, hp_after = the victim's HP after the whole step),
@@ -192,7 +193,7 @@ def apply_damage(
     damage = result.damage
     total = np.zeros(agents.count, dtype=np.int64)
     np.add.at(total, batch.victim, damage)
-    hp_after = np.maximum(agents.hp.astype(np.int64) - total, 0)
+    hp_after = np.maximum(agents.hp.astype(np.int64) - total, 0 if kills else 1)
     died = np.flatnonzero(agents.alive & (total > 0) & (hp_after == 0))
     agents.hp[:] = hp_after.astype(agents.hp.dtype)
     agents.alive[died] = False
@@ -238,10 +239,13 @@ def apply_damage(
 class CombatStep:
     """One combat step: line of sight, the damage model on the visible pairs, damage applied."""
 
-    def __init__(self, los: LineOfSight, model: DamageModel, map_name: str) -> None:
+    def __init__(
+        self, los: LineOfSight, model: DamageModel, map_name: str, *, kills: bool = True
+    ) -> None:
         self.los = los
         self.model = model
         self.map_name = map_name
+        self.kills = kills
 
     def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]:
         """Run the step on the agents (changed in place); the model is not called when no
@@ -250,4 +254,4 @@ class CombatStep:
         if len(pairs) == 0:
             return []
         batch = make_batch(agents, pairs, self.map_name)
-        return apply_damage(agents, batch, self.model(batch, rng), tick)
+        return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)

@@ -65,6 +65,9 @@ class RoundSetup:
     bomb: bool = True
     damage_model: DamageModel | None = None
     combat_every_ticks: int = COMBAT_EVERY_TICKS
+    combat_kills: bool = True
+    """False: shooting wounds but never kills (HP stops at 1): deaths come from elsewhere, as
+    in a replay whose deaths follow the data (`--deaths data`, the paper's protocol)."""
     world: World | None = None
     rules: RulesConfig | None = None
     zones: SiteZones | None = None
@@ -147,7 +150,7 @@ def open_round(
             assert physics is not None and setup.damage_model is not None
             los = LineOfSight(physics, agents.count)
             stack.callback(los.close)
-            combat = CombatStep(los, setup.damage_model, setup.map_name)
+            combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.combat_kills)
         rules = BombRules(setup.site_zones(), setup.rules_config())
         yield Simulator(
             setup.graph,

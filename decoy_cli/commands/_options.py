@@ -1,0 +1,16 @@
+"""Help of the options shared by `replay` and `evaluate`: who decides deaths, and what to do
+with the fields the data lacks (their choices are `Literal` types, which Typer lists)."""
+
+from __future__ import annotations
+
+DEATHS_HELP = (
+    "Who decides deaths when shooting: simulated (the fight; a player the data shows dead "
+    "whom the fight has not killed holds where it died and fights on) or data (the paper's "
+    "protocol: a player dies when the data says so; shooting wounds but does not kill). "
+    "Without shooting, deaths come from the data either way."
+)
+MISSING_HELP = (
+    "Fields the game needs and the data lacks (weapon in hand, armour, the bomb's carrier, the "
+    "defuser): infer (filled by the rules of decoy_cli/replay/missing.py and named per round "
+    "in the outputs) or error (the round fails)."
+)
