@@ -20,6 +20,7 @@ from decoy_cli.metrics import metric_names, player_metrics
 from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
+from decoy_cli.replay.deaths import replay_deaths
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask
@@ -154,12 +155,15 @@ def build_record(
         if result.data_deaths is not None
         else [plan.death_seconds for plan in result.plan.plans]
     )
+    replay_died_at = replay_deaths(result.events, len(result.plan.plans)).seconds
     players = []
     for p, row in enumerate(metrics.to_dict("records")):
         replay_death = np.nan
-        if row["died_replay"]:
+        if row["died_replay"]:  # at its event's tick; else the first frame showing it dead
             last_alive = int(np.flatnonzero(rec.alive[:, p])[-1])
             replay_death = float(frame_seconds[min(last_alive + 1, len(frame_seconds) - 1)])
+            if np.isfinite(replay_died_at[p]):
+                replay_death = float(replay_died_at[p])
         known = np.flatnonzero(hp_known[p])
         diff = hp_o[p, known] - hp_r[p, known]
         players.append(

@@ -1,0 +1,146 @@
+"""Where the simulated fights of real rounds of both teams part from the real ones.
+
+    python benchmarks/fight_study.py FILE|FOLDER... [--models rules] [--mesh MESH.tri] [--seed S]
+
+For every real firearm kill of the rounds (both teams in the frames):
+
+* line of sight between the two players' eyes at the kill (the kill event's x/y, the frame's z)
+  in the map's nav-mesh world, and in `--mesh` (e.g. the brush mesh of ../shared/data/meshes);
+* the DIP's decision for the pair there, with the attacker's yaw along its motion (as the replay
+  has it) and aimed at the victim;
+* what the replay (`--deaths simulated`) did: the victim killed by the fight within 3 s,
+  earlier, later or never, and whether the real killer was dead by then or never hit him.
+
+Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
+frames) against those in which the replay's fight damaged one. Nothing here is timed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.csgo import EYE_HEIGHT_M
+from decoy_cli.damage import load_damage_model
+from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.metrics.kills import DEATH_WINDOW_S
+from decoy_cli.replay.deaths import replay_deaths
+from decoy_cli.replay.missing import fill_missing
+from decoy_cli.replay.replayer import ReplayOptions, replay_round
+from decoy_cli.sim.combat import CombatBatch
+from decoy_cli.sim.rules import RulesConfig, SiteZones
+from decoy_cli.waypoints.build import builtin_graph, graph_world
+from decoy_cli.weapons import FIREARMS
+from decoy_cli.world.meshfile import read_mesh
+from decoy_cli.world.physics import PhysicsWorld
+
+EYE = np.array([0.0, 0.0, EYE_HEIGHT_M])
+
+
+def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:
+    delta = v_pos - a_pos
+    bearing = (np.arctan2(delta[1], delta[0]) - np.radians(yaw) + np.pi) % (2 * np.pi) - np.pi
+    batch = CombatBatch(
+        np.array([attacker]),
+        np.array([victim]),
+        a_pos[None],
+        v_pos[None],
+        np.array([yaw]),
+        np.array([0.0]),
+        np.array([100], np.int16),
+        np.array([100], np.int16),
+        np.array([weapon], dtype=object),
+        np.array([100], np.int16),
+        np.array([True]),
+        np.array([np.linalg.norm(delta)]),
+        np.array([bearing]),
+        "de_dust2",
+    )
+    return bool(model.decision.hit_probability(batch)[0] >= model.decision.threshold)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("inputs", nargs="+", type=Path)
+    parser.add_argument("--models", default="rules")
+    parser.add_argument("--mesh", type=Path)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+    graph = builtin_graph()
+    zones = SiteZones.from_graph(graph)
+    model = load_damage_model(args.models)
+    worlds = {"nav world": PhysicsWorld(graph_world(graph))}
+    if args.mesh:
+        worlds[args.mesh.name] = PhysicsWorld(read_mesh(args.mesh))
+    seen = collections.Counter()
+    dip = collections.Counter()
+    fates = collections.Counter()
+    kills = real_seconds = replay_seconds = 0
+    files, _ = collect_match_files(args.inputs)
+    for round_ in iter_rounds(files, map_name="de_dust2"):
+        if isinstance(round_, RoundFailure) or len(round_.side_indices("CT")) == 0:
+            continue
+        filled = fill_missing(round_, zones, RulesConfig(), "infer").round
+        options = ReplayOptions(damage_model=model, seed=args.seed)
+        result = replay_round(round_, graph, options)
+        truth = result.data_deaths
+        assert truth is not None
+        replay = replay_deaths(result.events, round_.num_players)
+        hit_at = {}
+        for event in result.events:
+            if event.kind == "damage":
+                hit_at.setdefault((event.agent, event.other), event.tick / 60)
+        rows = {p.name: i for i, p in enumerate(round_.players)}
+        for kill in round_.kills.itertuples():
+            a, v = rows.get(kill.attackerName, -1), rows.get(kill.victimName, -1)
+            if a < 0 or v < 0 or kill.weapon not in FIREARMS:
+                continue
+            kills += 1
+            j = int(np.searchsorted(round_.frame_seconds, kill.seconds, side="right") - 1)
+            a_pos = np.array([kill.attackerX_m, kill.attackerY_m, round_.position[a, j, 2]])
+            v_pos = np.array([kill.victimX_m, kill.victimY_m, round_.position[v, j, 2]])
+            if not (np.isfinite(a_pos).all() and np.isfinite(v_pos).all()):
+                a_pos, v_pos = round_.position[a, j], round_.position[v, j]
+            for name, world in worlds.items():
+                seen[name] += bool(world.line_of_sight((a_pos + EYE)[None], (v_pos + EYE)[None])[0])
+            before = round_.position[a, max(j - 1, 0)]
+            step = round_.position[a, j] - before
+            motion = float(np.degrees(np.arctan2(step[1], step[0])))
+            aimed = float(np.degrees(np.arctan2(*(v_pos - a_pos)[[1, 0]])))
+            weapon = str(filled.weapon[a, j])
+            dip["along the motion"] += dip_hits(model, a, v, a_pos, v_pos, motion, weapon)
+            dip["aimed at the victim"] += dip_hits(model, a, v, a_pos, v_pos, aimed, weapon)
+            t, s = truth.seconds[v], replay.seconds[v]
+            fight = bool(replay.by_fight[v]) and np.isfinite(s)
+            if fight and abs(s - t) <= DEATH_WINDOW_S:
+                fates["killed by the fight within 3 s"] += 1
+                continue
+            fate = "killed by the fight earlier" if fight and s < t else "not killed by the fight"
+            if fight and s > t:
+                fate = "killed by the fight later"
+            if np.isfinite(replay.seconds[a]) and replay.seconds[a] < t:
+                fates[f"{fate}; the real killer was dead in the replay by then"] += 1
+            elif (a, v) not in hit_at:
+                fates[f"{fate}; the real killer never hit him"] += 1
+            else:
+                fates[f"{fate}; the real killer hit him first {hit_at[(a, v)] - t:+.0f} s off"] += 1
+        hp = np.where(round_.hp >= 0, round_.hp, np.nan).astype(float)
+        real_seconds += int((np.diff(hp, axis=1) < 0).sum())
+        replay_seconds += len(
+            {(e.other, e.tick // 60) for e in result.events if e.kind == "damage"}
+        )
+    print(f"{kills} real firearm kills")
+    for name, count in seen.items():
+        print(f"  line of sight at the kill, {name}: {count / max(kills, 1):.2f}")
+    for name, count in dip.items():
+        print(f"  DIP says hit, attacker's yaw {name}: {count / max(kills, 1):.2f}")
+    for fate, count in fates.most_common():
+        print(f"  {count:3d} {fate}")
+    print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
+
+
+if __name__ == "__main__":
+    main()
