@@ -235,6 +235,32 @@ def test_who_decides_deaths(tmp_path: Path, deaths: str) -> None:
         assert max(killed.values()) < 2.0
 
 
+class NeverHits:
+    """Nobody hits (a damage model for tests)."""
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        k = len(batch)
+        return DamageResult(np.zeros(k, np.int64), np.full(k, -1), np.zeros(k, bool))
+
+
+@pytest.mark.parametrize("kill_s", [5.5, 9.5])  # the window ends within the data, or after it
+def test_a_death_the_fight_misses_is_taken_from_the_data_after_the_window(
+    tmp_path: Path, kill_s: float
+) -> None:
+    doc = facing_off()
+    doc.kills = [(kill_s, "t1", "ct1", "AK-47")]
+    doc.players[1].dead_from = int(kill_s) + 1
+    round_ = read(doc, tmp_path)
+    options = ReplayOptions(damage_model=NeverHits(), bomb=False)
+    result = replay_round(round_, builtin_graph(), options)
+    (death,) = [e for e in result.events if e.kind in ("death", "kill")]
+    assert death.kind == "death" and death.agent == 1 and death.data["reason"] == "scripted"
+    assert death.tick / 60 == pytest.approx(kill_s + 3.0, abs=2 / 60)
+    assert result.outcome is not None and result.outcome.winner == "T"
+    row = result.kill_row(round_)
+    assert row["deaths_original"] == 1 and row["deaths_recalled"] == 0  # not by the fight
+
+
 def test_kill_row_by_hand() -> None:
     names = ["t1", "t2", "ct1", "ct2"]
     sides = ["T", "T", "CT", "CT"]

@@ -385,9 +385,18 @@ def replay_round(
         while sim.bomb.planter >= 0 and not sim.done:
             sim.step()  # a plant under way when the data ends completes (or aborts) first
         if options.play_out and sim.combat is not None and not sim.done:
+            # the deaths the fight had until after the data's end (`grace`) come first
+            for tick, i in sorted((t, i) for i, t in deaths.items() if agents.alive[i]):
+                sim.run(to_tick=max(tick - 1, sim.tick))
+                if sim.done:
+                    break
+                if agents.alive[i]:
+                    sim.kill(i, "scripted")
+                    scripted[i] = True
             # bounded: the clock ends the round at round_ticks, a bomb at most bomb_ticks later
             limit = max(sim.tick, rules_config.round_ticks) + rules_config.bomb_ticks + 1
-            sim.run(to_tick=limit)
+            if not sim.done:
+                sim.run(to_tick=limit)
         stuck = np.asarray(sim.mover.stuck_events).copy()
         recoveries = np.asarray(sim.mover.recoveries).copy()
     return ReplayResult(
