@@ -37,6 +37,7 @@ class Mate:
     side: str
     nodes: list[int]  # one waypoint per frame (the last repeats to the end)
     dead_from: int | None = None  # first frame shown dead
+    weapon: str | None = None  # written as activeWeapon when given (the export has none)
 
     def node(self, frame: int) -> int:
         return self.nodes[min(frame, len(self.nodes) - 1)]
@@ -109,18 +110,19 @@ class BothTeams:
         for p in self.players:
             x, y, z = self._hammer(p.node(j))
             alive = p.dead_from is None or j < p.dead_from
-            sides[p.side].append(
-                {
-                    "steamID": None,
-                    "name": p.name,
-                    "side": p.side,
-                    "x": x,
-                    "y": y,
-                    "z": z,
-                    "hp": 100 if alive else 0,
-                    "isAlive": alive,
-                }
-            )
+            player = {
+                "steamID": None,
+                "name": p.name,
+                "side": p.side,
+                "x": x,
+                "y": y,
+                "z": z,
+                "hp": 100 if alive else 0,
+                "isAlive": alive,
+            }
+            if p.weapon is not None:
+                player["activeWeapon"] = p.weapon if alive else ""
+            sides[p.side].append(player)
         planted = self.plant is not None and j >= self.plant[0]
         return {
             "frameID": j,

@@ -147,9 +147,11 @@ def test_the_reference_run_evaluates_every_player_round(
     assert np.isfinite(evaluated[list(METRIC_NAMES)].to_numpy(float)).all()
     # players walk waypoints: the replay follows them within a few metres
     assert evaluated["mean_dist"].max() < 3.0
-    # t3 dies in round 1 of each match: scripted at the data's frame, so at the same time
+    # t3 dies in round 1 of each match: scripted at the data's frame, the simulator's tick
+    # before it (the frame shows him dead), so within two 60 Hz ticks of the same time
     t3 = tables.players[(tables.players["player"] == "t3") & (tables.players["round"] == 1)]
-    assert (t3["death_time_original_s"] == t3["death_time_replay_s"]).all()
+    gap = (t3["death_time_original_s"] - t3["death_time_replay_s"]).abs()
+    assert len(t3) == 2 and (gap < 2 / 60).all()
     assert tables.deaths.counts["died_both"] == 2
     # the winners are recorded (both teams in the data): outcome agreement is defined
     assert tables.rounds_with_winner == CLEAN_ROUNDS == tables.rounds_both_teams

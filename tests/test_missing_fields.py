@@ -3,13 +3,17 @@ and events contradict; the two death protocols; the kill-level metrics, checked 
 
 from __future__ import annotations
 
+import csv
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 from bomb_scenarios import site_a_walk
 from both_teams import BothTeams, Mate, site_node
+from typer.testing import CliRunner
 
+from decoy_cli.cli import app
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round, read_match
 from decoy_cli.metrics.kills import kill_row, kill_table
@@ -313,3 +317,57 @@ def test_kill_table_pools_rounds() -> None:
     assert table.loc["first_death_side_agreement", "value"] == pytest.approx(0.5)
     assert table.loc["alive_corr", "value"] == pytest.approx(0.6)
     assert table.loc["death_recall", "low"] <= 0.5 <= table.loc["death_recall", "high"]
+
+
+def test_shooting_with_nobody_armed_is_a_loud_warning(tmp_path: Path) -> None:
+    doc = facing_off()
+    for player in doc.players:
+        player.weapon = "Knife"
+    options = ReplayOptions(damage_model=AlwaysHits(), bomb=False)
+    result = replay_round(read(doc, tmp_path), builtin_graph(), options)
+    assert "shooting is on, but no player holds a firearm: nobody can shoot" in result.warnings
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_evaluate_names_what_it_inferred_and_the_protocol(tmp_path: Path) -> None:
+    file = gunfight().write(tmp_path / "both.json")
+    runner = CliRunner()
+    out = tmp_path / "data"
+    args = ["evaluate", str(file), "--no-bomb", "--workers", "1", "--out", str(out)]
+    result = runner.invoke(app, [*args, "--deaths", "data"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert "1 rounds lack fields the game needs" in result.stdout
+    (row,) = _rows(out / "rounds.csv")
+    assert "weapon in hand (t1, ct3): its own kills' weapons" in row["inferred"]
+    assert row["deaths_original"] == "3" and row["deaths_replay"] == "3"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"]["deaths"] == "data"
+    assert summary["counts"]["rounds_with_inferred_fields"] == 1
+    assert summary["inferred_by_round"]["both-teams:5"] == row["inferred"].split(" | ")
+    combat = {r["metric"]: r for r in summary["combat"]}
+    assert combat["outcome_agreement"]["paper"] == 0.91  # beside the paper's protocol only
+    assert combat["death_recall"]["value"] == 0.0  # deaths scripted: none by the fight
+    report = (out / "report.md").read_text()
+    assert "## Fields the data lacks, filled by rule" in report
+    assert "deaths from the data (the paper's protocol" in report
+    assert "--deaths data" in summary["command"] and "--missing-fields infer" in summary["command"]
+    # the default protocol: the paper's figures are not set beside it
+    out = tmp_path / "simulated"
+    args[-1] = str(out)
+    result = runner.invoke(app, args, env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"]["deaths"] == "simulated"
+    assert all(r["paper"] is None for r in summary["combat"])
+    # missing fields as an error: a recorded failure, one line, exit 1
+    out = tmp_path / "error"
+    args[-1] = str(out)
+    args = [*args, "--no-combat", "--missing-fields", "error"]
+    result = runner.invoke(app, args, env={"COLUMNS": "200"})
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    (failure,) = _rows(out / "failures.csv")
+    assert "lacks what the game needs" in failure["message"]

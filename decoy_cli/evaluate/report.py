@@ -15,8 +15,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from decoy_cli.evaluate.bomb_report import bomb_section
+from decoy_cli.evaluate.data_notes import (
+    contradictions_section,
+    inferred_section,
+    warnings_section,
+)
 from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
-from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
@@ -263,11 +267,11 @@ def report_markdown(
     parts.append(_figures_section(tables, figures))
     parts.append(_failures_section(evaluation))
     if counts["rounds_with_warnings"]:
-        parts.append(_warnings_section(tables))
+        parts.append(warnings_section(tables))
     if counts["rounds_with_contradictions"]:
-        parts.append(_contradictions_section(tables))
+        parts.append(contradictions_section(tables))
     if counts["rounds_with_inferred_fields"]:
-        parts.append(_inferred_section(tables))
+        parts.append(inferred_section(tables))
     return "\n\n".join(parts) + "\n"
 
 
@@ -432,53 +436,4 @@ def _failures_section(evaluation: Evaluation) -> str:
         for f in failures
     ]
     text.append(first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))
-    return "\n\n".join(text)
-
-
-def _contradictions_section(tables: Tables) -> str:
-    """The rounds whose frames and events say against each other, replayed as they are."""
-    rounds = tables.rounds[tables.rounds["contradictions"] != ""]
-    rows = [
-        [Path(str(row.file)).name, str(row.round), str(row.contradictions)]
-        for row in rounds.itertuples()
-    ]
-    return "\n\n".join(
-        [
-            "## Frames and events that contradict each other",
-            f"{len(rounds)} rounds were replayed as their data has them; what does not add up "
-            "is in the `contradictions` column of `rounds.csv`.",
-            first_rows(["file", "round", "contradictions"], rows, "rounds.csv"),
-        ]
-    )
-
-
-def _inferred_section(tables: Tables) -> str:
-    """The fields the data lacked and the rules that filled them, by how many rounds."""
-    notes = tables.rounds["inferred"].str.split(WARNING_SEPARATOR, regex=False).explode()
-    rules = notes[notes != ""].str.replace(r" \([^)]*\):", ":", regex=True).value_counts()
-    rows = [[text, str(count)] for text, count in rules.items()]
-    return "\n\n".join(
-        [
-            "## Fields the data lacks, filled by rule",
-            "The game needs them and the data does not record them; each was filled by the "
-            "rule named (decoy_cli/replay/missing.py). Per round and player: the `inferred` "
-            "column of `rounds.csv`. `--missing-fields error` fails such rounds instead.",
-            first_rows(["field: rule (players left out)", "times"], rows, "rounds.csv"),
-        ]
-    )
-
-
-def _warnings_section(tables: Tables) -> str:
-    """The rounds replayed with implausible data (`--implausible warn`) and their warnings."""
-    rounds = tables.rounds[tables.rounds["warnings"] != ""]
-    text = [
-        "## Implausible data replayed anyway",
-        f"{len(rounds)} rounds were replayed although their data is implausible "
-        "(`--implausible warn`); their numbers are in every table above. Each round's warnings "
-        "are in the `warnings` column of `rounds.csv`.",
-    ]
-    rows = [
-        [Path(str(row.file)).name, str(row.round), str(row.warnings)] for row in rounds.itertuples()
-    ]
-    text.append(first_rows(["file", "round", "warnings"], rows, "rounds.csv"))
     return "\n\n".join(text)

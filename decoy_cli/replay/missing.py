@@ -11,9 +11,9 @@ Rules, the first that applies:
 * Weapon in hand (absent in every frame of a player): the firearm of the player's own kills in
   the round, each frame taking the weapon of its next kill (the last kill's after it); else the
   side's firearm kills in the round: mostly pistols, the side's pistol (`DEFAULT_PISTOL`: an eco
-  or a pistol round), otherwise the side's most used rifle in them (`DEFAULT_RIFLE` if none); else
-  the round's type: a pistol round (`is_pistol_round`) or awpy's buy type "Full Eco"/"Semi Eco",
-  the side's pistol; otherwise the side's rifle.
+  or a pistol round), otherwise the side's most used rifle in them, the AWP aside (one player's
+  weapon; `DEFAULT_RIFLE` if none); else the round's type: a pistol round (`is_pistol_round`) or
+  awpy's buy type "Full Eco"/"Semi Eco", the side's pistol; otherwise the side's rifle.
 * Armour, helmet and kit (armour absent in every frame: the export has no equipment): a player
   whose first weapon is a pistol has a vest in a pistol round (the $800 start buys a vest, not a
   helmet too) and nothing otherwise (an eco); any other weapon means a buy: vest, helmet, and a
@@ -28,7 +28,7 @@ Rules, the first that applies:
 
 `contradictions` names what the frames and the events say against each other (a victim alive
 after its kill, a killer or victim never in the frames, a plant with no T alive, a defuse of a
-bomb never planted, a winner the alive counts deny): warnings, the round is replayed.
+bomb never planted, a winner the alive counts deny): named, and the round is replayed.
 """
 
 from __future__ import annotations
