@@ -4,10 +4,10 @@ with the fields the data lacks (their choices are `Literal` types, which Typer l
 from __future__ import annotations
 
 DEATHS_HELP = (
-    "Who decides deaths when shooting: simulated (the fight; a player the data shows dead "
-    "whom the fight has not killed holds where it died and fights on) or data (the paper's "
-    "protocol: a player dies when the data says so; shooting wounds but does not kill). "
-    "Without shooting, deaths come from the data either way."
+    "Who decides deaths when shooting: simulated (the fight; a player the data shows dead whom "
+    "the fight has not killed within 3 s of his real death is taken out then, counted as not "
+    "reproduced) or data (the paper's protocol: a player dies when the data says so; shooting "
+    "wounds but does not kill). Without shooting, deaths come from the data either way."
 )
 MISSING_HELP = (
     "Fields the game needs and the data lacks (weapon in hand, armour, the bomb's carrier, the "
