@@ -18,7 +18,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round, read_match
 from decoy_cli.metrics.kills import kill_row, kill_table
 from decoy_cli.replay.deaths import data_deaths
-from decoy_cli.replay.missing import contradictions, fill_missing
+from decoy_cli.replay.missing import contradictions, fill_missing, lacking
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import CombatBatch, DamageResult
 from decoy_cli.sim.rules import RulesConfig, SiteZones
@@ -371,3 +371,14 @@ def test_evaluate_names_what_it_inferred_and_the_protocol(tmp_path: Path) -> Non
     assert result.exit_code == 1 and "Traceback" not in result.output
     (failure,) = _rows(out / "failures.csv")
     assert "lacks what the game needs" in failure["message"]
+
+
+def test_info_says_what_a_file_lacks(tmp_path: Path) -> None:
+    doc = planting()
+    doc.reason, doc.winner = "BombDefused", "CT"
+    file = doc.write(tmp_path / "lacking.json")
+    assert lacking(read_match(file).rounds[0]) == ("weapon", "armour", "bomb carrier", "defuser")
+    result = CliRunner().invoke(app, ["info", str(file)], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert "weapon, armour, bomb carrier, defuser" in result.stdout
+    assert "a replay fills them by rule" in result.stdout

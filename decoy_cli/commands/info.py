@@ -14,6 +14,7 @@ from rich.text import Text
 from decoy_cli.commands._console import make_console
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, iter_match_files, parse_round_address, read_match
+from decoy_cli.replay.missing import lacking
 
 
 def info(
@@ -85,8 +86,8 @@ def _show_match(console: Console, match: Match) -> None:
         title=f"{match.match_id}: {match.map_name or 'unknown map'}, {match.tick_rate} tick, "
         f"{len(match.round_numbers)} rounds"
     )
-    for column in ("round", "frames", "T", "CT", "plant tick", "winner", "reason"):
-        table.add_column(column, justify="right" if column != "reason" else "left")
+    for column in ("round", "frames", "T", "CT", "plant tick", "winner", "reason", "lacks"):
+        table.add_column(column, justify="left" if column in ("reason", "lacks") else "right")
     for played in match.rounds:
         seen = np.any(played.present, axis=1)
         table.add_row(
@@ -97,8 +98,15 @@ def _show_match(console: Console, match: Match) -> None:
             _or_dash(played.bomb_plant_tick),
             _or_dash(played.winning_side),
             _or_dash(played.end_reason),
+            ", ".join(lacking(played)) or "-",
         )
     console.print(table)
+    if any(lacking(played) for played in match.rounds):
+        console.print(
+            "lacks: fields the game needs that the file does not record; a replay fills them "
+            "by rule and names them (--missing-fields)",
+            highlight=False,
+        )
     for error in match.round_errors.values():
         console.print(str(error), style="red", highlight=False)
     if match.round_errors:

@@ -84,6 +84,26 @@ def fill_missing(round_: Round, zones: SiteZones, rules: RulesConfig, missing: M
     return Filled(filled, tuple(notes))
 
 
+def lacking(round_: Round) -> tuple[str, ...]:
+    """The fields the game needs that the round's data lacks (what `fill_missing` fills), by
+    name, without filling them (what `decoy info` shows)."""
+    weapon = np.asarray(round_.weapon, dtype=object) != ""
+    armor = np.asarray(round_.armor) >= 0
+    names = []
+    if not weapon.any(axis=1).all():
+        names.append("weapon")
+    if not armor.any(axis=1).all():
+        names.append("armour")
+    carried = np.asarray(round_.has_bomb, bool).any() or _names_planter(_plants(round_))
+    if not carried and _plant_tick(round_) is not None:
+        names.append("bomb carrier")
+    events = round_.bomb_events
+    defused = len(events) and "bombAction" in events and (events["bombAction"] == "defuse").any()
+    if round_.end_reason == "BombDefused" and not defused:
+        names.append("defuser")
+    return tuple(names)
+
+
 def is_pistol_round(round_num: int, tick_rate: int) -> bool:
     """Round 1 and the first of the second half: 13 in CS2's MR12 (its demos run at 64 ticks),
     16 in CS:GO's MR15."""
