@@ -315,9 +315,11 @@ def combat_caveats(tables: Tables, settings: EvalSettings) -> list[str]:
     caveats = []
     if settings.combat and settings.deaths == "simulated":
         caveats.append(
-            "Deaths were decided by the simulated fight (--deaths simulated); the paper's HP, "
-            "death and outcome figures come from deaths that follow the data: compare them "
-            "with a --deaths data run."
+            "Deaths were decided by the simulated fight (--deaths simulated): a player the "
+            "fight had not killed 3 s after his real death was taken out then, and such deaths "
+            "count as died only in the data (death times, recall). The paper's HP, death and "
+            "outcome figures come from deaths that follow the data: compare them with a "
+            "--deaths data run."
         )
     elif settings.combat:
         caveats.append(
