@@ -34,7 +34,8 @@ from decoy_cli.evaluate.figures import draw_figures
 from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
-from decoy_cli.files import json_ready, write_atomic, write_json
+from decoy_cli.files import json_ready, write_atomic, write_csv, write_json
+from decoy_cli.text import visible
 
 FAILURE_COLUMNS = ("file", "round", "kind", "message")
 
@@ -155,7 +156,7 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
     text = report_markdown(
         evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}
     )
-    written.append(write_atomic(out / "report.md", text.encode()))
+    written.append(write_atomic(out / "report.md", visible(text, keep="\n").encode()))
     return written
 
 
@@ -182,7 +183,7 @@ def _bomb_confusion(tables: Tables, name: str) -> pd.DataFrame:
 
 
 def _csv(path: Path, frame: pd.DataFrame) -> Path:
-    return write_atomic(path, frame.to_csv(index=False).encode())
+    return write_csv(path, frame)
 
 
 def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
