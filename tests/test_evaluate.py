@@ -13,6 +13,7 @@ import json
 import lzma
 import os
 import re
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -629,17 +630,34 @@ def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
 
 
 def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path) -> None:
-    """One writer per output folder: a live run's lock refuses a second run with one error
-    line; a lock left by a run that no longer exists is taken over, and released at the end."""
+    """One writer per output folder: a live run's lock (the kernel's, held by a process)
+    refuses a second run with one error line; a lock file no live process holds, whatever
+    process id it names, does not stop a run, and a killed run's staging folder and temporary
+    cache files are cleared."""
+    import fcntl
     import subprocess
 
     from decoy_cli.evaluate.outputs import LOCK_FILE
 
     out = tmp_path / "out"
     out.mkdir()
-    holder = subprocess.Popen(["sleep", "60"])
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import fcntl, os, sys, time\n"
+            "fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)\n"
+            "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+            "os.write(fd, b'%d\\n' % os.getpid())\n"
+            "print('held', flush=True)\n"
+            "time.sleep(60)",
+            str(out / LOCK_FILE),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
-        (out / LOCK_FILE).write_text(f"{holder.pid}\n")
+        assert holder.stdout is not None and holder.stdout.readline() == "held\n"
         refused = _invoke(
             str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out)
         )
@@ -652,9 +670,16 @@ def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path)
     finally:
         holder.kill()
         holder.wait()
-    (out / LOCK_FILE).write_text(f"{holder.pid}\n")  # its run is gone: a stale lock
+    # the holder is gone (as after a SIGKILL): its lock file names it, or a live process
+    (out / LOCK_FILE).write_text(f"{os.getpid()}\n")
+    (out / ".staging-999999" / "tables").mkdir(parents=True)  # left by a killed run
+    (out / "cache" / "rounds").mkdir(parents=True)
+    (out / "cache" / "rounds" / ".abc.msgpack.x1y2.tmp").write_bytes(b"half")
     done = _invoke(str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
     assert done.exit_code == 0, done.output
     names = sorted(p.name for p in out.iterdir())
-    assert LOCK_FILE not in names and not [n for n in names if n.startswith(".staging")]
+    assert not [n for n in names if n.startswith(".staging")]
+    assert not list((out / "cache" / "rounds").glob(".*"))
     assert {"players.csv", "report.md", "summary.json", "tables", "figures"} <= set(names)
+    with open(out / LOCK_FILE) as lock:  # released: another process can take it
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)

@@ -185,6 +185,9 @@ def evaluate(
                     on_progress=on_progress,
                     round_timeout_s=round_timeout or None,
                 )
+            started = time.perf_counter()
+            tables = build_tables(evaluation.accumulator)
+            write_outputs(evaluation, tables, out, info)
         except KeyboardInterrupt:
             console.print(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "
@@ -192,9 +195,6 @@ def evaluate(
                 style="yellow",
             )
             raise typer.Exit(130) from None
-        started = time.perf_counter()
-        tables = build_tables(evaluation.accumulator)
-        write_outputs(evaluation, tables, out, info)
     _show(console, evaluation, tables)
     console.print(
         f"outputs written to {out} (report: {out / 'report.md'}) in "
