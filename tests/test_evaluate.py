@@ -683,3 +683,27 @@ def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path)
     assert {"players.csv", "report.md", "summary.json", "tables", "figures"} <= set(names)
     with open(out / LOCK_FILE) as lock:  # released: another process can take it
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+def test_ctrl_c_while_the_outputs_are_written_keeps_the_last_ones(
+    clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C after the rounds (while the figures are drawn into the staging folder) says
+    how to resume, exits 130 and leaves the previous outputs as they were, no staging."""
+    from decoy_cli.evaluate import outputs
+
+    out = tmp_path / "out"
+    args = (str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
+    assert _invoke(*args).exit_code == 0
+    before = {p: p.read_bytes() for p in out.rglob("*.csv")}
+
+    def pressed(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(outputs, "draw_figures", pressed)
+    result = _invoke(*args)
+    assert result.exit_code == 130, result.output
+    assert "run the same command again to resume" in result.stdout
+    assert "Traceback" not in result.output
+    assert {p: p.read_bytes() for p in out.rglob("*.csv")} == before
+    assert not list(out.glob(".staging*"))

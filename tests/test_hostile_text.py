@@ -13,11 +13,13 @@ from typing import Any
 import pandas as pd
 import pytest
 from esta_fixtures import make_match, write_match
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.evaluate.markdown import md_table
-from decoy_cli.text import csv_inert, md_code, md_inline, visible
+from decoy_cli.text import csv_cell, csv_inert, md_code, md_inline, visible
 
 runner = CliRunner()
 WIDE = {"COLUMNS": "400"}
@@ -159,3 +161,22 @@ def test_evaluate_tables_and_report_are_inert(tmp_path: Path) -> None:
     report = (out / "report.md").read_text()
     assert not RAW.search(report)
     assert "broken\\\\x1b\\[31m=1.json" in report  # escaped for Markdown: shows broken\x1b[31m
+
+
+# ---- property: any text ------------------------------------------------------------------------
+
+ANY_TEXT = st.text(
+    alphabet=st.characters(codec="utf-8", exclude_categories=("Cs",)), max_size=40
+) | st.sampled_from(["=1+1", "-", "+", "@", "\t", "\r", "\x1b[2J", "\u202e", "|", "`"])
+
+
+@settings(max_examples=300, deadline=None)
+@given(text=ANY_TEXT)
+def test_any_text_is_shown_without_control_characters(text: str) -> None:
+    for shown in (visible(text), md_inline(text), md_code(text), str(csv_cell(text))):
+        assert not RAW.search(shown) and "\n" not in shown and "\u2028" not in shown
+    cell = str(csv_cell(text))
+    number = re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", cell)
+    assert not cell.startswith(("=", "+", "-", "@", "\t", "\r")) or number  # numbers as they are
+    assert re.search(r"(?<!\\)\|", md_inline(text)) is None  # no bare "|": no new column
+    assert visible(visible(text)) == visible(text)  # an escape is shown as it is

@@ -5,11 +5,14 @@ starts. The real rounds in ../shared/data trip none of them."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
 import pytest
 from esta_fixtures import make_match, write_match
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import iter_match_files, read_match
@@ -100,3 +103,33 @@ def test_real_rounds_have_possible_histories(folder: str) -> None:
         match = read_match(path, implausible="warn")
         assert not match.round_errors, match.round_errors
         assert [w for r in match.rounds for w in r.warnings] == []
+
+
+# ---- property: any history of one player over the four frames ------------------------------------
+
+FRAME_STATE = st.one_of(
+    st.none(),  # not listed in the frame
+    st.tuples(st.sampled_from([None, 0, 40, 100]), st.booleans()),  # (hp, isAlive)
+)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(history=st.lists(FRAME_STATE, min_size=4, max_size=4))
+def test_revival_and_rising_hp_are_found_exactly_when_they_happen(
+    tmp_path_factory: pytest.TempPathFactory, history: list[tuple[int | None, bool] | None]
+) -> None:
+    document = make_match()
+    frames = document["gameRounds"][0]["frames"]
+    for frame, state in zip(frames, history, strict=True):
+        players = frame["ct"]["players"]
+        if state is None:
+            players.remove(next(p for p in players if p["name"] == "ct1"))
+        else:
+            next(p for p in players if p["name"] == "ct1").update(hp=state[0], isAlive=state[1])
+    listed = [s for s in history if s is not None]
+    revived = any(not a[1] and b[1] for i, a in enumerate(listed) for b in listed[i + 1 :])
+    known = [hp for hp, _ in listed if hp is not None]
+    rose = any(b > a for a, b in itertools.pairwise(known))
+    warnings = " ".join(_warnings(tmp_path_factory.mktemp("h"), document))
+    assert ("ct1 is alive again" in warnings) == revived, (history, warnings)
+    assert ("ct1's HP rose" in warnings) == rose, (history, warnings)

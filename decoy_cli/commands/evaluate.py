@@ -193,6 +193,7 @@ def evaluate(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "
                 "same command again to resume",
                 style="yellow",
+                soft_wrap=True,  # one line, whatever the terminal's width
             )
             raise typer.Exit(130) from None
     _show(console, evaluation, tables)
