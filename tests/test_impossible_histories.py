@@ -9,6 +9,7 @@ import itertools
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
 import pytest
 from esta_fixtures import make_match, write_match
 from hypothesis import HealthCheck, given, settings
@@ -133,3 +134,27 @@ def test_revival_and_rising_hp_are_found_exactly_when_they_happen(
     warnings = " ".join(_warnings(tmp_path_factory.mktemp("h"), document))
     assert ("ct1 is alive again" in warnings) == revived, (history, warnings)
     assert ("ct1's HP rose" in warnings) == rose, (history, warnings)
+
+
+def test_evaluate_replays_a_player_on_both_sides_as_one_agent_per_side(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from decoy_cli.cli import app
+
+    document = make_match()
+    for frame in document["gameRounds"][0]["frames"][2:]:  # ct2 plays for T from frame 2
+        ct2 = next(p for p in frame["ct"]["players"] if p["name"] == "ct2")
+        frame["ct"]["players"].remove(ct2)
+        frame["t"]["players"] = [p for p in frame["t"]["players"] if p["name"] != "t1"]
+        frame["t"]["players"].append(ct2)
+    file = write_match(tmp_path / "m.json", document)
+    out = tmp_path / "out"
+    args = ["evaluate", str(file), "--no-combat", "--implausible", "warn", "--out", str(out)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 1, result.output  # round 3 has no frames: its failure
+    assert "Traceback" not in result.output
+    rounds = pd.read_csv(out / "rounds.csv").set_index("round")
+    assert "ct2 plays for T after playing for CT since frame 0" in rounds.loc[1, "warnings"]
+    players = pd.read_csv(out / "players.csv")
+    ct2 = players[(players["round"] == 1) & (players["player"] == "ct2")]
+    assert sorted(ct2["side"]) == ["CT", "T"]
