@@ -3,14 +3,16 @@ Ctrl-C, a full disk, a read-only folder or a second run leaves behind, and wheth
 the outputs of a run never interrupted.
 
     python benchmarks/crash_consistency.py [--kills 50] [--interrupts 10] [--seed 0]
-        [--only kills,interrupts,lock,disk] [--keep FOLDER]
+        [--from-lock] [--only kills,interrupts,lock,disk,downloads] [--keep FOLDER]
 
 The run under test is `decoy evaluate` on 4 sampled rounds of the shipped synthetic sample
 (`--no-combat`, bomb on, 2 workers), each time in a fresh folder with `--out out`. First one
 uninterrupted run gives the reference outputs and its wall time T. Then:
 
 * kills: the run is killed with SIGKILL at a random moment of the i-th of N equal slices of
-  [0, 1.05 T] (a kill that comes after the run ended is not counted, and another is drawn);
+  [0, 1.05 T] (with `--from-lock`, of the time H it holds its folder, counted from the moment
+  it takes the lock: what Python's start-up leaves out; a kill that comes after the run ended
+  is not counted, and another is drawn);
   what it left is checked (every cache entry decodes and holds its own key), then the same
   command runs again to the end, and its outputs must equal the reference's, with every round
   once in the cache and no temporary file or staging folder left;
@@ -247,14 +249,26 @@ def resumed_equal(folder: Path, reference: dict[str, bytes]) -> list[str]:
     return problems
 
 
-def kills(work: Path, reference: dict[str, bytes], wall: float, count: int, rng, results) -> None:
+def kills(
+    work: Path,
+    reference: dict[str, bytes],
+    window: float,
+    from_lock: bool,
+    count: int,
+    rng: np.random.Generator,
+    results: Results,
+) -> None:
+    """SIGKILL at `count` moments over 1.05 `window` seconds from the start of the run, or from
+    the moment it holds its folder (`from_lock`); see the module doc."""
     landed = attempts = 0
     phases: dict[str, int] = {}
     while landed < count and attempts < 3 * count:
-        moment = (landed + rng.random()) / count * 1.05 * wall
+        moment = (landed + rng.random()) / count * 1.05 * window
         folder = work / f"kill-{attempts}"
         attempts += 1
         process = start(folder)
+        if from_lock:
+            wait_for(lambda f=folder: (f / "out" / LOCK_FILE).exists(), process, 600)
         started = time.perf_counter()
         while process.poll() is None and time.perf_counter() - started < moment:
             time.sleep(0.005)
@@ -537,18 +551,21 @@ def downloads(work: Path, results: Results) -> None:
         server.close()
 
 
-def _reference(work: Path) -> tuple[dict[str, bytes], float]:
-    """The outputs of an uninterrupted run and its wall time (after a warm-up run that
-    compiles what a first run compiles)."""
+def _reference(work: Path) -> tuple[dict[str, bytes], float, float]:
+    """The outputs of an uninterrupted run, its wall time and the time it held its folder
+    (after a warm-up run that compiles what a first run compiles)."""
     run(work / "warm-up")
     shutil.rmtree(work / "warm-up", ignore_errors=True)
     started = time.perf_counter()
-    if run(work / "reference") != 0:
+    process = start(work / "reference")
+    wait_for(lambda: (work / "reference" / "out" / LOCK_FILE).exists(), process, 600)
+    held = time.perf_counter()
+    if finish(process) != 0:
         raise SystemExit(f"the reference run failed: {logs(work / 'reference')[1]}")
-    wall = time.perf_counter() - started
+    wall, held = time.perf_counter() - started, time.perf_counter() - held
     reference = outputs(work / "reference" / "out")
-    print(f"reference: {len(reference)} outputs, {wall:.1f} s", flush=True)
-    return reference, wall
+    print(f"reference: {len(reference)} outputs, {wall:.1f} s, {held:.1f} s holding its folder")
+    return reference, wall, held
 
 
 def main() -> None:
@@ -556,6 +573,11 @@ def main() -> None:
     parser.add_argument("--kills", type=int, default=50)
     parser.add_argument("--interrupts", type=int, default=10)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--from-lock",
+        action="store_true",
+        help="draw the kill moments over the time the run holds its folder (not from its start)",
+    )
     parser.add_argument("--only", default="kills,interrupts,lock,disk,downloads")
     parser.add_argument("--keep", type=Path, help="work in this folder and keep it")
     args = parser.parse_args()
@@ -566,9 +588,10 @@ def main() -> None:
     chosen = args.only.split(",")
     try:
         if set(chosen) - {"downloads"}:
-            reference, wall = _reference(work)
+            reference, wall, held = _reference(work)
         if "kills" in chosen:
-            kills(work, reference, wall, args.kills, rng, results)
+            window = held if args.from_lock else wall
+            kills(work, reference, window, args.from_lock, args.kills, rng, results)
         if "interrupts" in chosen:
             interrupts(work, reference, wall, args.interrupts, rng, results)
         if "lock" in chosen:
