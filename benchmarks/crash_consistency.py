@@ -207,10 +207,10 @@ def phase(out: Path) -> str:
         return "writing outputs"
     if (out / "report.md").exists():
         return "publishing or done"
+    if not (out / "cache").is_dir():
+        return "holding the folder, nothing cached"
     _, rounds = cache_problems(out)
-    return (
-        f"{rounds} of {ROUNDS} rounds cached" if rounds or (out / "cache").is_dir() else "starting"
-    )
+    return f"{rounds} of {ROUNDS} rounds cached"
 
 
 # ---- the cases ----------------------------------------------------------------------------------
