@@ -306,6 +306,19 @@ def crashing_job(task: RoundTask) -> Any:
     return evaluate_round(task)
 
 
+def test_workers_never_receive_ctrl_c(pool: LocalBackend) -> None:
+    """A terminal's Ctrl-C goes to the whole process group: the workers (and the forkserver
+    that starts them) hold SIGINT blocked, so only the parent sees it, and no worker that is
+    still starting dies of it with a traceback."""
+    import functools
+    import signal
+
+    mask = functools.partial(signal.pthread_sigmask, signal.SIG_BLOCK)  # adds nothing: reads
+    [(_, blocked)] = list(pool.run(mask, [[]]))
+    assert signal.SIGINT in blocked
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])  # the parent's
+
+
 def test_a_crashing_worker_fails_its_round_and_the_batch_goes_on(
     clean: Path,
     settings: EvalSettings,
