@@ -24,6 +24,7 @@ from decoy_cli.commands import (
 )
 from decoy_cli.commands.help_text import reflow_help
 from decoy_cli.errors import DecoyError, describe_bug
+from decoy_cli.text import visible
 
 _debug = False
 
@@ -52,7 +53,7 @@ class _Group(TyperGroup):
 def _fail(message: str, code: int) -> None:
     if _debug:
         raise
-    typer.echo(f"error: {message}", err=True)
+    typer.echo(f"error: {visible(message)}", err=True)  # one line, no control character
     sys.exit(code)
 
 

@@ -2,7 +2,7 @@
 one JSON writer (strict JSON: no bare NaN).
 
 A crash, a full disk or an interrupt never leaves a half-written graph, mesh, table or picture
-under the real name; every failure is one OutputError line.
+under the real name; every failure is one OutputError line. And the one CSV writer.
 """
 
 from __future__ import annotations
@@ -17,8 +17,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from decoy_cli.errors import OutputError
+from decoy_cli.text import csv_inert
 
 
 def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> Path:
@@ -41,6 +43,13 @@ def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> P
         tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def write_csv(path: str | Path, frame: pd.DataFrame) -> Path:
+    """Write `frame` as CSV, atomically, its text cells inert (`decoy_cli.text.csv_inert`: no
+    formula a spreadsheet would run, no control character): the one CSV writer of every
+    output."""
+    return write_atomic(path, csv_inert(frame).to_csv(index=False).encode())
 
 
 def json_ready(value: Any) -> Any:

@@ -141,10 +141,10 @@ def test_a_cache_record_under_another_key_counts_as_missing(tmp_path: Path) -> N
 
 def test_evaluate_replays_implausible_rounds_with_warnings_when_asked(tmp_path: Path) -> None:
     document = make_match()
-    frame = document["gameRounds"][0]["frames"][1]
+    frame = document["gameRounds"][0]["frames"][0]  # the first: its HP does not rise after
     next(p for p in frame["ct"]["players"] if p["name"] == "ct1")["hp"] = 250
     file = _write(tmp_path / "in" / "m.json", document)
-    warning = "frame 1 (tick 1064): ct1 has HP 250 (at most 100)"
+    warning = "frame 0 (tick 1000): ct1 has HP 250 (at most 100)"
 
     failing = tmp_path / "fail"
     result = _invoke("evaluate", str(file.parent), "--no-combat", "--out", str(failing))

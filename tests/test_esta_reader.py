@@ -426,7 +426,7 @@ def test_unknown_weapon_in_frame_and_event(tmp_path: Path) -> None:
             lambda r: r["frames"][0]["ct"]["players"].append(
                 dict(r["frames"][0]["t"]["players"][0])
             ),
-            "appears on both sides",
+            "t1 is listed for T and for CT (a player keeps one side within a round)",
         ),
         (
             lambda r: r["damages"].append({"tick": 5000, "hpDamage": 2.5}),

@@ -13,6 +13,7 @@ import json
 import lzma
 import os
 import re
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -305,6 +306,19 @@ def crashing_job(task: RoundTask) -> Any:
     if task.round_num == 2 and Path(task.file).name.startswith("crashy"):
         os._exit(3)
     return evaluate_round(task)
+
+
+def test_workers_never_receive_ctrl_c(pool: LocalBackend) -> None:
+    """A terminal's Ctrl-C goes to the whole process group: the workers (and the forkserver
+    that starts them) hold SIGINT blocked, so only the parent sees it, and no worker that is
+    still starting dies of it with a traceback."""
+    import functools
+    import signal
+
+    mask = functools.partial(signal.pthread_sigmask, signal.SIG_BLOCK)  # adds nothing: reads
+    [(_, blocked)] = list(pool.run(mask, [[]]))
+    assert signal.SIGINT in blocked
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])  # the parent's
 
 
 def test_a_crashing_worker_fails_its_round_and_the_batch_goes_on(
@@ -631,17 +645,34 @@ def test_the_main_job_on_the_shipped_sample_with_combat(tmp_path: Path) -> None:
 
 
 def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path) -> None:
-    """One writer per output folder: a live run's lock refuses a second run with one error
-    line; a lock left by a run that no longer exists is taken over, and released at the end."""
+    """One writer per output folder: a live run's lock (the kernel's, held by a process)
+    refuses a second run with one error line; a lock file no live process holds, whatever
+    process id it names, does not stop a run, and a killed run's staging folder and temporary
+    cache files are cleared."""
+    import fcntl
     import subprocess
 
     from decoy_cli.evaluate.outputs import LOCK_FILE
 
     out = tmp_path / "out"
     out.mkdir()
-    holder = subprocess.Popen(["sleep", "60"])
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import fcntl, os, sys, time\n"
+            "fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)\n"
+            "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+            "os.write(fd, b'%d\\n' % os.getpid())\n"
+            "print('held', flush=True)\n"
+            "time.sleep(60)",
+            str(out / LOCK_FILE),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
-        (out / LOCK_FILE).write_text(f"{holder.pid}\n")
+        assert holder.stdout is not None and holder.stdout.readline() == "held\n"
         refused = _invoke(
             str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out)
         )
@@ -654,9 +685,40 @@ def test_a_second_run_into_a_held_folder_is_refused(clean: Path, tmp_path: Path)
     finally:
         holder.kill()
         holder.wait()
-    (out / LOCK_FILE).write_text(f"{holder.pid}\n")  # its run is gone: a stale lock
+    # the holder is gone (as after a SIGKILL): its lock file names it, or a live process
+    (out / LOCK_FILE).write_text(f"{os.getpid()}\n")
+    (out / ".staging-999999" / "tables").mkdir(parents=True)  # left by a killed run
+    (out / "cache" / "rounds").mkdir(parents=True)
+    (out / "cache" / "rounds" / ".abc.msgpack.x1y2.tmp").write_bytes(b"half")
     done = _invoke(str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
     assert done.exit_code == 0, done.output
     names = sorted(p.name for p in out.iterdir())
-    assert LOCK_FILE not in names and not [n for n in names if n.startswith(".staging")]
+    assert not [n for n in names if n.startswith(".staging")]
+    assert not list((out / "cache" / "rounds").glob(".*"))
     assert {"players.csv", "report.md", "summary.json", "tables", "figures"} <= set(names)
+    with open(out / LOCK_FILE) as lock:  # released: another process can take it
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+def test_ctrl_c_while_the_outputs_are_written_keeps_the_last_ones(
+    clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C after the rounds (while the figures are drawn into the staging folder) says
+    how to resume, exits 130 and leaves the previous outputs as they were, no staging."""
+    from decoy_cli.evaluate import outputs
+
+    out = tmp_path / "out"
+    args = (str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out))
+    assert _invoke(*args).exit_code == 0
+    before = {p: p.read_bytes() for p in out.rglob("*.csv")}
+
+    def pressed(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(outputs, "draw_figures", pressed)
+    result = _invoke(*args)
+    assert result.exit_code == 130, result.output
+    assert "run the same command again to resume" in result.stdout
+    assert "Traceback" not in result.output
+    assert {p: p.read_bytes() for p in out.rglob("*.csv")} == before
+    assert not list(out.glob(".staging*"))

@@ -184,6 +184,25 @@ IMPLAUSIBLE = [
     ("hp", "frame 1 (tick 1064): ct1 has HP 250 (at most 100)"),
     ("teleport", "frame 1 (tick 1064): ct1 moved "),
     ("crowd", "frame 0 (tick 1000): 6 CT players (a side has at most 5)"),
+    (
+        "revival",
+        "frame 2 (tick 1128): ct1 is alive again after being dead in frame 1 (nothing revives a "
+        "player within a round)",
+    ),
+    (
+        "hp_rise",
+        "frame 2 (tick 1128): ct1's HP rose to 100 from 40 in frame 1 (nothing gives back health "
+        "within a round)",
+    ),
+    (
+        "both_sides",
+        "frame 2 (tick 1128): ct2 plays for T after playing for CT since frame 0 (a player keeps "
+        "one side within a round)",
+    ),
+    (
+        "clock_back",
+        "starts at tick 900, before round 0 has ended (tick 5400): the file's clock runs backwards",
+    ),
     ("no_x", "no player has a position (x, y and z) in any frame"),
     ("off_map", "frame 0: ct1 at "),
 ]
@@ -203,6 +222,18 @@ def _make_implausible(document: dict[str, Any], case: str) -> None:
             extra2 = copy.deepcopy(extra)
             extra2["name"], extra2["steamID"] = "ct8", 76561198000000018
             frame["ct"]["players"].append(extra2)
+    elif case == "revival":
+        _first_frame_player(document, "ct1").update(hp=0, isAlive=False)
+    elif case == "hp_rise":
+        _first_frame_player(document, "ct1")["hp"] = 40
+    elif case == "both_sides":
+        for frame in _frames(document, 0)[2:]:
+            ct2 = next(p for p in frame["ct"]["players"] if p["name"] == "ct2")
+            frame["ct"]["players"].remove(ct2)
+            frame["t"]["players"] = [p for p in frame["t"]["players"] if p["name"] != "t1"]
+            frame["t"]["players"].append(ct2)
+    elif case == "clock_back":
+        document["gameRounds"][1]["roundNum"] = 0
     elif case == "no_x":
         for frame in _frames(document, 0):
             for player in frame["t"]["players"] + frame["ct"]["players"]:

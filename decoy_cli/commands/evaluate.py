@@ -192,16 +192,17 @@ def evaluate(
                     on_progress=on_progress,
                     round_timeout_s=round_timeout or None,
                 )
+            started = time.perf_counter()
+            tables = build_tables(evaluation.accumulator)
+            write_outputs(evaluation, tables, out, info)
         except KeyboardInterrupt:
             console.print(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "
                 "same command again to resume",
                 style="yellow",
+                soft_wrap=True,  # one line, whatever the terminal's width
             )
             raise typer.Exit(130) from None
-        started = time.perf_counter()
-        tables = build_tables(evaluation.accumulator)
-        write_outputs(evaluation, tables, out, info)
     _show(console, evaluation, tables)
     console.print(
         f"outputs written to {out} (report: {out / 'report.md'}) in "

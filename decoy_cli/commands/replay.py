@@ -115,11 +115,13 @@ def replay(
     outcome.add_row("replay", *map(str, replayed))
     console.print(outcome)
     for warning in result.warnings:
-        console.print(f"warning: implausible data replayed anyway: {warning}", style="yellow")
+        console.print(
+            f"warning: implausible data replayed anyway: {warning}", style="yellow", markup=False
+        )
     for note in result.contradictions:
-        console.print(f"data contradicts itself: {note}", style="yellow")
+        console.print(f"data contradicts itself: {note}", style="yellow", markup=False)
     for note in result.inferred:
-        console.print(f"inferred: {note}", style="yellow")
+        console.print(f"inferred: {note}", style="yellow", markup=False)
     if options.combat:
         console.print(f"deaths decided by: {options.deaths}")
     _show_bomb(console, result.bomb_row())

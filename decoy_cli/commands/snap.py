@@ -21,6 +21,7 @@ from decoy_cli.commands._snap_output import (
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import Round, iter_match_files, parse_round_address, read_match
+from decoy_cli.files import write_csv
 from decoy_cli.replay import DEFAULT_MAX_SNAP_M
 from decoy_cli.replay.plot import plot_round_plan
 from decoy_cli.replay.snapping import WITHIN_M
@@ -29,7 +30,6 @@ from decoy_cli.replay.study import (
     infeasible_by_place,
     study_files,
     study_round,
-    write_csv,
 )
 from decoy_cli.sim.setup import RoundSetup
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
@@ -132,7 +132,7 @@ def snap(
         )
         console.print(f"plot written to {plot}")
     if csv is not None:
-        write_csv(study.rows, csv)
+        write_csv(csv, study.rows)
         console.print(f"{len(study.rows)} player rows written to {csv}")
 
 
@@ -182,7 +182,7 @@ def _snap_batch(
     if metrics:
         show_summary(console, study)
     if csv is not None:
-        write_csv(study.rows, csv)
+        write_csv(csv, study.rows)
         console.print(f"{len(study.rows)} player-round rows written to {csv}")
     for failure in study.failures:
         console.print(failure.message, style="red", highlight=False)

@@ -1,7 +1,9 @@
 """The frames of one round turned into per-player arrays of shape (P, F), in metres.
 
 Players are keyed by `steamID` (as a string), falling back to `name` when the steamID is null or
-0 (awpy writes 0 for bots); their order inside a frame is not trusted. Rows are ordered T first,
+0 (awpy writes 0 for bots); their order inside a frame is not trusted. A row is a player on one
+side: a key seen on both sides (impossible within a round) has two rows, for the plausibility
+checks to name it. Rows are ordered T first,
 then CT, each by key. A player entry whose x, y or z is null cannot be placed: it counts as absent
 from that frame, like a player missing from the list. Absent cells hold NaN (position, yaw),
 `MISSING` (hp, armor), "" (weapon) and False (flags, `alive`, `present`). A NaN, infinite or off-map
@@ -262,7 +264,7 @@ def _players(
                 frame_of.extend([j] * len(team.players))
                 side_of.extend([side] * len(team.players))
 
-    index: dict[str, int] = {}
+    index: dict[tuple[str, Side], int] = {}
     infos: list[PlayerInfo] = []
     player_of = np.empty(len(entries), dtype=np.int64)
     for e, player in enumerate(entries):
@@ -271,12 +273,10 @@ def _players(
         key = str(steam_id) if steam_id is not None else player.name
         if not key:
             raise Invalid(f"{_where(ticks, frame_of[e])}: a player has neither steamID nor name")
-        i = index.get(key)
-        if i is None:
-            i = index[key] = len(infos)
+        i = index.get((key, side_of[e]))
+        if i is None:  # a player seen on both sides gets a row per side (plausibility.py)
+            i = index[key, side_of[e]] = len(infos)
             infos.append(PlayerInfo(key, player.name or key, steam_id, side_of[e]))
-        elif infos[i].side != side_of[e]:
-            raise Invalid(f"{_where(ticks, frame_of[e])}: player {key} appears on both sides")
         player_of[e] = i
 
     if len(infos) > MAX_PLAYERS:

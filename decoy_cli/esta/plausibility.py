@@ -8,11 +8,16 @@ rules or from measurement on the real ESTA rounds in ../shared/data (the README 
 * HP and armor lie in 0..100 (the game's range);
 * a player alive in a frame has HP above 0 and a dead one has none (never contradicted in the
   real rounds);
+* the history is one a round can have: nothing in CS:GO revives a player or gives back health
+  within a round (no one is alive again after being dead, no HP rises from one frame with HP to
+  the next), and a player keeps one side (never seen for both);
 * at most `MAX_PER_SIDE` players per side in a frame (competitive 5 against 5);
 * no alive player moves faster between two frames than the engine's velocity cap
   (sv_maxvelocity, 3500 u/s, about 67 m/s; the fastest real movement measured between two
   frames is about 10 m/s): faster is a teleport or a broken position, not a player;
-* players that appear in the frames have a position somewhere (x, y and z).
+* players that appear in the frames have a position somewhere (x, y and z);
+* across the rounds of a file (`round_order_problems`), the game's clock runs forwards: no round
+  starts before the round numbered before it has ended.
 
 The policy (`Implausible`) decides what a problem does: "fail" (the default) makes the round a
 failure naming the first offender; "warn" keeps the round and returns one warning per kind of
@@ -23,6 +28,7 @@ ever has a position fails under both: there is nothing to replay or measure.
 from __future__ import annotations
 
 from collections.abc import Callable
+from itertools import pairwise
 from typing import Literal, cast, get_args
 
 import numpy as np
@@ -93,6 +99,60 @@ def _alive_against_hp(arrays: FrameArrays) -> str | None:
     return f"{_at(arrays, f)}: {arrays.players[p].name} is {state}"
 
 
+def _revival(arrays: FrameArrays) -> str | None:
+    """Alive in a frame after being dead in an earlier one (where the player is listed)."""
+    dead = arrays.present & ~arrays.alive
+    revived = arrays.present & arrays.alive & np.logical_or.accumulate(dead, axis=1)
+    if not revived.any():
+        return None
+    p, f = first_offender(revived)
+    since = int(np.argmax(dead[p]))
+    return (
+        f"{_at(arrays, f)}: {arrays.players[p].name} is alive again after being dead in frame "
+        f"{since} (nothing revives a player within a round)"
+    )
+
+
+def _hp_rising(arrays: FrameArrays) -> str | None:
+    """More HP than at the player's previous frame with a known HP."""
+    known = arrays.present & (arrays.hp >= 0)
+    frames = np.arange(arrays.ticks.size)
+    last = np.maximum.accumulate(np.where(known, frames, -1), axis=1)  # (P, F) latest known
+    before = np.concatenate([np.full((known.shape[0], 1), -1), last[:, :-1]], axis=1)
+    earlier = np.take_along_axis(arrays.hp, np.maximum(before, 0), axis=1)
+    rising = known & (before >= 0) & (arrays.hp > earlier)
+    if not rising.any():
+        return None
+    p, f = first_offender(rising)
+    return (
+        f"{_at(arrays, f)}: {arrays.players[p].name}'s HP rose to {arrays.hp[p, f]} from "
+        f"{earlier[p, f]} in frame {before[p, f]} (nothing gives back health within a round)"
+    )
+
+
+def _both_sides(arrays: FrameArrays) -> str | None:
+    """A player (steamID, else name) seen for T and for CT: two rows with one key (frames.py)."""
+    rows: dict[str, list[int]] = {}
+    for i, player in enumerate(arrays.players):
+        rows.setdefault(player.key, []).append(i)
+    found = []
+    for t_row, *ct_rows in (r for r in rows.values() if len(r) > 1):  # T rows come first
+        t_first, ct_first = (int(np.argmax(arrays.present[i])) for i in (t_row, ct_rows[0]))
+        found.append((max(t_first, ct_first), t_first, ct_first, t_row))
+    if not found:
+        return None
+    f, t_first, ct_first, row = min(found)
+    name = arrays.players[row].name
+    if t_first == ct_first:
+        doing = "is listed for T and for CT"
+    else:
+        (now, since), was = (
+            (("CT", t_first), "T") if ct_first > t_first else (("T", ct_first), "CT")
+        )
+        doing = f"plays for {now} after playing for {was} since frame {since}"
+    return f"{_at(arrays, f)}: {name} {doing} (a player keeps one side within a round)"
+
+
 def _players_per_side(arrays: FrameArrays) -> str | None:
     for side in ("T", "CT"):
         rows = [i for i, player in enumerate(arrays.players) if player.side == side]
@@ -129,9 +189,28 @@ _CHECKS: tuple[Callable[[FrameArrays], str | None], ...] = (
     _hp,
     _armor,
     _alive_against_hp,
+    _revival,
+    _hp_rising,
+    _both_sides,
     _players_per_side,
     _speed,
 )
+
+
+def round_order_problems(spans: list[tuple[int, int, int]]) -> dict[int, str]:
+    """The rounds of a file that start before the round numbered before them has ended, each
+    with its problem: `spans` holds (round number, start tick, end tick) of the rounds that
+    have ticks. The game's tick only runs forwards, so such a file's clock contradicts
+    itself; the later round is the one named."""
+    problems = {}
+    ordered = sorted(spans)
+    for (before, _, end), (num, start, _) in pairwise(ordered):
+        if start < end:
+            problems[num] = (
+                f"starts at tick {start}, before round {before} has ended (tick {end}): the "
+                "file's clock runs backwards"
+            )
+    return problems
 
 
 def first_offender(mask: np.ndarray) -> tuple[int, int]:

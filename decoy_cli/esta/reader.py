@@ -28,7 +28,7 @@ measured, and its type errors carry the JSON path.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, cast
 
@@ -38,7 +38,7 @@ import pandas as pd
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import PlayerInfo, RoundClock, Side, build_frames
-from decoy_cli.esta.plausibility import Implausible, check_frames
+from decoy_cli.esta.plausibility import Implausible, check_frames, round_order_problems
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
     DAMAGE_COLUMNS,
@@ -211,7 +211,7 @@ def read_match(path: str | Path, *, implausible: Implausible = "fail") -> Match:
                 f"{path}: more than {MAX_MATCH_PLAYER_FRAMES:,} player-frames by round {num} "
                 "(not a real match; the limit bounds the reader's memory)"
             )
-    rounds.sort(key=lambda r: r.round_num)
+    rounds = _in_clock_order(path, sorted(rounds, key=lambda r: r.round_num), errors, implausible)
     return Match(
         match_id=match_id,
         path=path,
@@ -323,6 +323,31 @@ def _build_round(
             if isinstance(value, str) and value
         },
     )
+
+
+def _in_clock_order(
+    path: Path, rounds: list[Round], errors: dict[int, EstaError], implausible: Implausible
+) -> list[Round]:
+    """`rounds` less those that start before the round before them ended (their failure goes
+    into `errors`), or with that as a warning under "warn" (plausibility.round_order_problems)."""
+    spans = [
+        (r.round_num, r.start_tick, r.end_tick)
+        for r in rounds
+        if r.start_tick is not None and r.end_tick is not None
+    ]
+    problems = round_order_problems(spans)
+    if not problems:
+        return rounds
+    kept = []
+    for round_ in rounds:
+        problem = problems.get(round_.round_num)
+        if problem is None:
+            kept.append(round_)
+        elif implausible == "warn":
+            kept.append(replace(round_, warnings=(*round_.warnings, problem)))
+        else:
+            errors[round_.round_num] = EstaError(f"{path}: round {round_.round_num}: {problem}")
+    return kept
 
 
 def _optional_int(value: float | None, name: str) -> int | None:

@@ -9,10 +9,11 @@ started and waits for what is running.
 Local: a `ProcessPoolExecutor` whose workers are started by forkserver (spawn where there is
 none), never by a plain fork: a worker process builds its own pybullet world on first use, so
 no physics client is ever shared across a fork. Workers ignore Ctrl-C (the parent handles
-it). At most one task per worker is in flight, so when a worker dies (the pool then breaks and
-every in-flight task with it) the suspects are those few tasks: each runs again alone in a
-fresh one-worker pool, where a second death is that task's failure and the others complete;
-the rest of the batch goes on in a new pool.
+it; with forkserver they never even receive it: `_start_forkserver`). At most one task per
+worker is in flight, so when a worker dies (the pool then breaks and every in-flight task
+with it) the suspects are those few tasks: each runs again alone in a fresh one-worker pool,
+where a second death is that task's failure and the others complete; the rest of the batch
+goes on in a new pool.
 
 Dask: the same job functions are submitted to a `dask.distributed` scheduler. The input files
 must be readable by the workers at the same paths (a shared file system); results come back to
@@ -57,8 +58,24 @@ def _context() -> multiprocessing.context.BaseContext:
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload(["decoy_cli.evaluate.job"])
+        _start_forkserver()
         return context
     return multiprocessing.get_context("spawn")
+
+
+def _start_forkserver() -> None:
+    """Start the forkserver with SIGINT blocked: it and every worker it forks keep that signal
+    mask, so a Ctrl-C, which a terminal sends to the whole process group, reaches only this
+    process (a pending one arrives here when the mask is restored) and never stops a worker
+    or the server while Python starts, which would print a traceback."""
+    from multiprocessing import forkserver, resource_tracker
+
+    resource_tracker.ensure_running()  # first: starting it unblocks SIGINT here
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def _internal(error: BaseException) -> RoundFailure:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
+from decoy_cli.evaluate.markdown import first_rows, interval, md_inline, md_table, num
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.metrics import BombMetrics
 
@@ -48,7 +48,8 @@ def bomb_section(tables: Tables) -> str:
             "the `bomb_anomalies` column of `rounds.csv` names them:"
         )
         listed = [
-            [Path(str(r.file)).name, str(r.round), str(r.bomb_anomalies)] for r in odd.itertuples()
+            [md_inline(Path(str(r.file)).name), str(r.round), md_inline(str(r.bomb_anomalies))]
+            for r in odd.itertuples()
         ]
         text.append(first_rows(["file", "round", "anomalies"], listed, "rounds.csv"))
     else:

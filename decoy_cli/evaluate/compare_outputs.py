@@ -6,9 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from decoy_cli.evaluate.compare import Comparison
-from decoy_cli.evaluate.markdown import interval, md_table, num, p_value
+from decoy_cli.evaluate.markdown import interval, md_code, md_table, num, p_value
 from decoy_cli.figures import save_figure
-from decoy_cli.files import write_atomic
+from decoy_cli.files import write_atomic, write_csv
+from decoy_cli.text import visible
 
 PLACES_SHOWN = 10
 """Nav places listed in compare.md (places.csv has them all)."""
@@ -17,7 +18,7 @@ PLACES_SHOWN = 10
 def write_comparison(comparison: Comparison, out: Path) -> list[Path]:
     """Write every output of the comparison into `out`; returns their paths."""
     written = [
-        write_atomic(out / name, frame.to_csv(index=False).encode())
+        write_csv(out / name, frame)
         for name, frame in (
             ("compare.csv", comparison.table),
             ("differences.csv", comparison.differences),
@@ -27,7 +28,8 @@ def write_comparison(comparison: Comparison, out: Path) -> list[Path]:
     figure = out / "differences.png"
     draw_differences(comparison, figure)
     written.append(figure)
-    written.append(write_atomic(out / "compare.md", compare_markdown(comparison).encode()))
+    text = visible(compare_markdown(comparison), keep="\n")
+    written.append(write_atomic(out / "compare.md", text.encode()))
     return written
 
 
@@ -77,7 +79,7 @@ def compare_markdown(comparison: Comparison) -> str:
     ]
     parts = [
         "# Paired comparison of two evaluation runs",
-        f"A: `{comparison.a.folder}`; B: `{comparison.b.folder}`.",
+        f"A: {md_code(str(comparison.a.folder))}; B: {md_code(str(comparison.b.folder))}.",
         f"{len(comparison.differences)} player-rounds of {comparison.rounds} rounds paired, "
         "read from the same content in both runs; "
         f"{comparison.only_a} evaluated only in A, {comparison.only_b} only in B (left out)."

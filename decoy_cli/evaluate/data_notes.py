@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from decoy_cli.evaluate.markdown import first_rows
+from decoy_cli.evaluate.markdown import first_rows, md_inline
 from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.tables import Tables
 
@@ -15,7 +15,7 @@ def contradictions_section(tables: Tables) -> str:
     """The rounds whose frames and events say against each other, replayed as they are."""
     rounds = tables.rounds[tables.rounds["contradictions"] != ""]
     rows = [
-        [Path(str(row.file)).name, str(row.round), str(row.contradictions)]
+        [md_inline(Path(str(row.file)).name), str(row.round), md_inline(str(row.contradictions))]
         for row in rounds.itertuples()
     ]
     return "\n\n".join(
@@ -32,7 +32,7 @@ def inferred_section(tables: Tables) -> str:
     """The fields the data lacked and the rules that filled them, by how many rounds."""
     notes = tables.rounds["inferred"].str.split(WARNING_SEPARATOR, regex=False).explode()
     rules = notes[notes != ""].str.replace(r" \([^)]*\):", ":", regex=True).value_counts()
-    rows = [[text, str(count)] for text, count in rules.items()]
+    rows = [[md_inline(str(text)), str(count)] for text, count in rules.items()]
     return "\n\n".join(
         [
             "## Fields the data lacks, filled by rule",
@@ -54,7 +54,8 @@ def warnings_section(tables: Tables) -> str:
         "are in the `warnings` column of `rounds.csv`.",
     ]
     rows = [
-        [Path(str(row.file)).name, str(row.round), str(row.warnings)] for row in rounds.itertuples()
+        [md_inline(Path(str(row.file)).name), str(row.round), md_inline(str(row.warnings))]
+        for row in rounds.itertuples()
     ]
     text.append(first_rows(["file", "round", "warnings"], rows, "rounds.csv"))
     return "\n\n".join(text)

@@ -1,9 +1,15 @@
-"""Markdown pieces shared by the evaluation's report sections: numbers, tables, long lists."""
+"""Markdown pieces shared by the evaluation's report sections: numbers, tables, long lists.
+Text from data goes in through `decoy_cli.text.md_inline` or `md_code` (re-exported here)."""
 
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
+
+from decoy_cli.text import md_code, md_inline, visible
+
+__all__ = ["first_rows", "interval", "md_code", "md_inline", "md_table", "num", "p_value"]
 
 REPORT_ROWS_SHOWN = 20
 """Rows of a failure, warning or anomaly list shown in the report; the CSVs hold them all."""
@@ -18,9 +24,15 @@ def num(value: Any, digits: int = 3) -> str:
 
 
 def md_table(header: list[str], rows: list[list[str]]) -> str:
+    """A Markdown table; no cell can end its row or add a column (control characters visible,
+    "|" escaped). Cells holding text from data are `md_inline` or `md_code` already."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    lines += ["| " + " | ".join(_cell(cell) for cell in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def _cell(text: str) -> str:
+    return re.sub(r"(?<!\\)\|", r"\\|", visible(text))
 
 
 def first_rows(header: list[str], rows: list[list[str]], csv_name: str) -> str:

@@ -19,8 +19,10 @@ Layout of the output folder:
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
+import signal
 from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -30,76 +32,75 @@ from typing import Any
 import pandas as pd
 
 from decoy_cli.errors import OutputError
+from decoy_cli.evaluate.cache import CACHE_DIR
 from decoy_cli.evaluate.figures import draw_figures
 from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
-from decoy_cli.files import json_ready, write_atomic, write_json
+from decoy_cli.files import json_ready, write_atomic, write_csv, write_json
+from decoy_cli.text import visible
 
 FAILURE_COLUMNS = ("file", "round", "kind", "message")
 
 
 LOCK_FILE = ".decoy-evaluate.lock"
-"""The lock of an output folder: the process id of the run writing to it."""
+"""The lock of an output folder: a file the run writing to the folder holds an exclusive
+`flock` on (and writes its process id into, for the message of a refused run)."""
 
 
 @contextmanager
 def output_lock(out: Path) -> Iterator[None]:
     """Hold the output folder for this run: a second run into the same folder (while this one
-    lives) is one clear error instead of two runs overwriting each other's results. A lock left
-    by a run that no longer exists is taken over."""
+    lives) is one clear error instead of two runs overwriting each other's results.
+
+    The lock is the kernel's (`flock`), so it ends with the process however it ends (a
+    SIGKILL, a power cut): a lock file left by a run that no longer exists never stops the
+    next, whatever process id it names. The file stays (removing it would let two runs lock
+    two files). Holding the lock, the run removes what a killed run left half-done: staging
+    folders and the cache's temporary files."""
     try:
         out.mkdir(parents=True, exist_ok=True)
+        fd = os.open(out / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
     except OSError as error:
-        raise OutputError(f"cannot create {out}: {error.strerror or error}") from None
-    lock = out / LOCK_FILE
-    for _ in range(2):
-        try:
-            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-        except FileExistsError:
-            owner = _lock_owner(lock)
-            if owner is not None and _alive(owner):
-                raise OutputError(
-                    f"{out}: another decoy evaluate (process {owner}) is writing to this folder; "
-                    "wait for it or choose another --out"
-                ) from None
-            lock.unlink(missing_ok=True)  # left by a run that ended without cleaning up
-            continue
-        except OSError as error:
-            raise OutputError(f"cannot write {lock}: {error.strerror or error}") from None
-        with os.fdopen(fd, "w") as handle:
-            handle.write(f"{os.getpid()}\n")
-        break
-    else:
-        raise OutputError(f"{out}: cannot take the folder's lock {lock}")
+        raise OutputError(f"cannot write into {out}: {error.strerror or error}") from None
     try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            owner = os.pread(fd, 32, 0).decode(errors="replace").strip()
+            process = f" (process {owner})" if owner.isdigit() else ""
+            raise OutputError(
+                f"{out}: another decoy evaluate{process} is writing to this folder; wait for "
+                "it or choose another --out"
+            ) from None
+        try:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        except OSError as error:
+            reason = error.strerror or error
+            raise OutputError(f"cannot write {out / LOCK_FILE}: {reason}") from None
+        clear_leftovers(out)
         yield
     finally:
-        lock.unlink(missing_ok=True)
+        os.close(fd)  # releases the lock
 
 
-def _lock_owner(lock: Path) -> int | None:
-    try:
-        return int(lock.read_text().strip())
-    except (OSError, ValueError):
-        return None
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+def clear_leftovers(out: Path) -> None:
+    """Remove the staging folders and the cache's temporary files a killed run left in `out`
+    (only the holder of the folder's lock may: no other run is writing there)."""
+    for stage in out.glob(".staging-*"):
+        shutil.rmtree(stage, ignore_errors=True)
+    for folder in (out / CACHE_DIR / "rounds", out / CACHE_DIR / "index"):
+        for temporary in folder.glob(".*.tmp"):
+            temporary.unlink(missing_ok=True)
 
 
 def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
     """Write every output (see the module docstring) as one set: into a staging folder first,
-    then moved into `out` together, so an interrupt never leaves new tables beside an old
-    report. Returns the paths written."""
+    then moved into `out` together, so a failure or a Ctrl-C (held off during the moves) never
+    leaves new tables beside an old report. Only a SIGKILL or a power cut during the moves can;
+    the next run (every round cached) writes the set again. Returns the paths written."""
     stage = out / f".staging-{os.getpid()}"
     shutil.rmtree(stage, ignore_errors=True)
     try:
@@ -108,6 +109,7 @@ def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunIn
         shutil.rmtree(stage, ignore_errors=True)
         raise
     published = []
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})  # Ctrl-C waits for the moves
     try:
         for entry in sorted(stage.iterdir()):
             target = out / entry.name
@@ -119,6 +121,8 @@ def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunIn
         raise OutputError(
             f"cannot move the outputs into {out}: {error.strerror or error}"
         ) from None
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
     for path in written:
         published.append(out / path.relative_to(stage))
     return published
@@ -156,7 +160,7 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
     text = report_markdown(
         evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}
     )
-    written.append(write_atomic(out / "report.md", text.encode()))
+    written.append(write_atomic(out / "report.md", visible(text, keep="\n").encode()))
     return written
 
 
@@ -183,7 +187,7 @@ def _bomb_confusion(tables: Tables, name: str) -> pd.DataFrame:
 
 
 def _csv(path: Path, frame: pd.DataFrame) -> Path:
-    return write_atomic(path, frame.to_csv(index=False).encode())
+    return write_csv(path, frame)
 
 
 def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:

@@ -20,7 +20,7 @@ from decoy_cli.evaluate.data_notes import (
     inferred_section,
     warnings_section,
 )
-from decoy_cli.evaluate.markdown import first_rows, interval, md_table, num
+from decoy_cli.evaluate.markdown import first_rows, interval, md_code, md_inline, md_table, num
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.evaluate.tables import Tables
@@ -182,7 +182,7 @@ def _provenance_line(evaluation: Evaluation) -> str | None:
     first = stated[0] if len(stated[0]) <= 400 else stated[0][:400] + " …"
     return (
         f"Provenance stated by {len(stated)} of {len(evaluation.files)} match files "
-        f"({len(set(stated))} distinct); the first: `{first}`"
+        f"({len(set(stated))} distinct); the first: {md_code(first)}"
     )
 
 
@@ -223,8 +223,8 @@ def report_markdown(
     if provenance:
         parts.append(provenance)
     run_rows = [
-        ["command", f"`{info.command}`"],
-        ["inputs", ", ".join(f"`{p}`" for p in evaluation.inputs)],
+        ["command", md_code(info.command)],
+        ["inputs", ", ".join(md_code(str(p)) for p in evaluation.inputs)],
         [
             "match files",
             f"{counts['match_files']} ({_count(counts['ignored_files'], 'other file')} "
@@ -434,7 +434,12 @@ def _failures_section(evaluation: Evaluation) -> str:
         + ".",
     ]
     rows = [
-        [Path(f.file).name, "" if f.round_num is None else str(f.round_num), f.kind, f.message]
+        [
+            md_inline(Path(f.file).name),
+            "" if f.round_num is None else str(f.round_num),
+            f.kind,
+            md_inline(f.message),
+        ]
         for f in failures
     ]
     text.append(first_rows(["file", "round", "kind", "reason"], rows, "failures.csv"))

@@ -20,7 +20,7 @@ from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import OutputError
 from decoy_cli.esta import Round
 from decoy_cli.figures import draw_nav_areas, save_figure
-from decoy_cli.files import json_text, write_atomic
+from decoy_cli.files import json_text, write_atomic, write_csv
 from decoy_cli.replay.replayer import ReplayResult
 from decoy_cli.world.navmesh import NavMesh
 
@@ -76,14 +76,11 @@ def write_replay(
         ],
         columns=["tick", "seconds", "kind", "agent", "other", "data"],
     )
-    written = []
-    for name, content in (
-        ("replay.csv", table.to_csv(index=False)),
-        ("events.csv", events.to_csv(index=False)),
-        ("players.csv", players.to_csv(index=False)),
-        ("summary.json", json_text(summary)),
-    ):
-        written.append(write_atomic(folder / name, content.encode()))
+    written = [
+        write_csv(folder / name, frame)
+        for name, frame in (("replay.csv", table), ("events.csv", events), ("players.csv", players))
+    ]
+    written.append(write_atomic(folder / "summary.json", json_text(summary).encode()))
     return written
 
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from decoy_cli.errors import DecoyError, EstaError, OutputError
+from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, iter_matches, match_rounds
 from decoy_cli.metrics import METRIC_NAMES, MetricSummary, PlayerRound, summarize
 from decoy_cli.metrics.trajectory import trajectory_metrics_frame
@@ -354,18 +354,6 @@ def pooled_totals(rows: pd.DataFrame, errors: np.ndarray, *, rounds: int) -> Sna
         unreachable=int(rows["unreachable"].sum()) if len(rows) else 0,
         worst_ratio=float(np.nanmax(ratios)) if np.isfinite(ratios).any() else float("nan"),
     )
-
-
-def write_csv(frame: pd.DataFrame, path: str | Path) -> None:
-    """Write a table as CSV, atomically; an OutputError when the path cannot be written."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        frame.to_csv(tmp, index=False)
-        tmp.replace(path)
-    except OSError as error:
-        raise OutputError(f"cannot write {path}: {error.strerror or error}") from None
 
 
 def _player_rounds(
