@@ -29,7 +29,7 @@ from decoy_cli.replay.snapping import (
     snap_into_sites,
     snap_positions,
 )
-from decoy_cli.replay.targets import hard_frames, resnap, target_seconds
+from decoy_cli.replay.targets import hard_frames, lacks_the_way, resnap, target_seconds
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -175,7 +175,8 @@ def plan_player(
     ends. A soft target inside a stretch the replay runs late for another reason, on the way,
     stays. Then a hard target beside such an interval moves to a neighbouring waypoint by the
     player from which the replay keeps time (`resnap`, tried once for each pair of targets
-    around it).
+    around it); and last an interval whose path the player cannot have taken
+    (`lacks_the_way`) is crossed as a gap (`build_plan`'s `bridged`).
     """
     present = np.isfinite(positions).all(axis=1)
     snapped = (snap.node >= 0) & alive
@@ -184,8 +185,12 @@ def plan_player(
     )
     nodes = np.where(snap.node >= 0, snap.node, snap.ground_node)
     tried: set[tuple[int, int, int]] = set()  # (frame, target before, after) `resnap` tried
+    bridged = np.zeros(len(seconds), dtype=bool)
     while True:
-        plan = build_plan(graph, nodes, seconds, alive, weapons, present=present, paths=paths)
+        plan = build_plan(
+            graph, nodes, seconds, alive, weapons, present=present, paths=paths,
+            bridged=bridged, positions=positions,
+        )  # fmt: skip
         caps = interval_caps(plan, positions)
         late = expected_lateness(plan, caps)
         worse = (np.diff(late) > 1.0 / TICK_RATE) | plan.interval_unreachable
@@ -200,10 +205,14 @@ def plan_player(
         retry = [t for t in np.flatnonzero(beside & snapped[plan.target_frame]).tolist() if t]
         contexts = {t: _context(plan, t) for t in retry}
         retry = [t for t in retry if contexts[t] not in tried]
-        if not retry:
+        if retry:
+            resnap(graph, plan, caps, np.array(retry), nodes, positions, snap.error_m, paths)
+            tried.update(contexts[t] for t in retry)
+            continue
+        lacking = plan.target_frame[1:][lacks_the_way(plan, caps, positions)]
+        if not len(lacking):
             return plan, caps
-        resnap(graph, plan, caps, np.array(retry), nodes, positions, snap.error_m, paths)
-        tried.update(contexts[t] for t in retry)
+        bridged[lacking] = True
 
 
 def _context(plan: PlayerPlan, t: int) -> tuple[int, int, int]:

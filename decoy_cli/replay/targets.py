@@ -2,7 +2,8 @@
 
 Hard targets come no denser than the graph's lattice resolves (`target_seconds`, `hard_frames`);
 a hard target whose waypoint makes the replay late may move to a neighbouring waypoint by the
-player (`resnap`). `decoy_cli.replay.rounds.plan_player` applies them.
+player (`resnap`); an interval whose path the player cannot have taken is crossed as a gap
+(`lacks_the_way`). `decoy_cli.replay.rounds.plan_player` applies them.
 """
 
 from __future__ import annotations
@@ -10,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
-from decoy_cli.replay.pace import MAX_ZIGZAG
+from decoy_cli.replay.pace import MAX_ZIGZAG, RATIO_TOLERANCE
 from decoy_cli.replay.plans import PathCache, PlayerPlan
 from decoy_cli.waypoints.graph import RUN_SPEED_M_S, WaypointGraph
 from decoy_cli.waypoints.lattice_params import LatticeParams
+from decoy_cli.waypoints.patch_check import LENGTHENED_EXTRA_M, LENGTHENED_RATIO
 
 
 def lattice_spacing(graph: WaypointGraph) -> float:
@@ -105,3 +107,19 @@ def resnap(
             worst = [lateness(node) for node in near.tolist()]
             if min(worst) < own - 1e-9:
                 nodes[frame] = int(near[int(np.argmin(worst))])
+
+
+def lacks_the_way(plan: PlayerPlan, caps: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """(T-1,) bool the intervals whose path the player cannot have taken: longer than
+    `LENGTHENED_RATIO` times the player's own displacement plus `LENGTHENED_EXTRA_M` (a detour,
+    as the learned patches' check counts one) and asking more than the cap. The player went a
+    way the graph lacks (a staircase or a gap the map's version has and the graph's world does
+    not, a teleport), and a replay sent round would fall behind and away from it."""
+    if len(plan.target_node) < 2:
+        return np.zeros(0, dtype=bool)
+    displacement = np.linalg.norm(np.diff(positions[plan.target_frame], axis=0), axis=1)
+    length = np.nan_to_num(plan.interval_length_m, nan=0.0)
+    with np.errstate(invalid="ignore"):
+        detour = length > LENGTHENED_RATIO * displacement + LENGTHENED_EXTRA_M
+        over = plan.interval_required_speed_m_s > caps * (1.0 + RATIO_TOLERANCE)
+    return detour & over & ~plan.interval_unreachable
