@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from test_plans import SPACING, lattice, make_graph
 
+from decoy_cli.esta.frame_rate import describe_frame_rate, describe_rates, frame_rates
 from decoy_cli.replay import PathCache, build_plan, snap_positions
 from decoy_cli.replay.rounds import expected_lateness, interval_caps, plan_player
 from decoy_cli.replay.targets import hard_frames, target_seconds
@@ -87,6 +88,21 @@ def test_at_2_hz_a_hard_target_across_the_wall_moves_to_its_neighbour() -> None:
     assert frames == list(range(9))
     assert len(rows) == 1
     assert late <= 1 / 60
+
+
+def test_the_data_s_frame_rate_in_words() -> None:
+    assert describe_frame_rate(np.arange(10) * 0.5) == "2 frames/s"
+    assert describe_frame_rate(np.arange(300) / 128) == "128 frames/s"
+    missing = np.delete(np.arange(20) * 0.5, 7)  # one frame missing: the rate still holds
+    assert describe_frame_rate(missing) == "2 frames/s"
+    changing = np.concatenate([np.arange(20) / 8, 3.0 + np.arange(10)])
+    assert describe_frame_rate(changing) == "1 to 8 frames/s (changes within the round)"
+    assert describe_frame_rate(np.array([1.0])) == "one frame"
+    assert frame_rates(np.array([2.0, 2.0, 2.5]))[0] == pytest.approx(2.0)  # a repeat: no rate
+    assert describe_rates(np.array([8.0, 8.0, np.nan])) == "8 frames/s"
+    assert describe_rates(np.array([1.0, 1.0])) == "1 frame/s"
+    assert describe_rates(np.array([1.0, 8.0])).startswith("1 to 8 frames/s")
+    assert describe_rates(np.array([np.nan])) == "not known"
 
 
 def test_near_lists_the_waypoints_on_the_point_s_floor_nearest_first() -> None:
