@@ -185,6 +185,8 @@ def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(
     # the same numbers as one worker, down to the last digit of the CSV
     assert (out / "players.csv").read_text() == reference[1].players.to_csv(index=False)
     report = (out / "report.md").read_text()
+    assert "| frame rate of the data | 2 frames/s |" in report
+    assert (pd.read_csv(out / "rounds.csv")["frame_rate"] == 2.0).all()
     for heading in (
         "## What was run",
         "### Protocol clock",

@@ -87,7 +87,7 @@ def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_pat
     assert (out / "round.gif").read_bytes()[:6] in (b"GIF87a", b"GIF89a")
 
     stdout = result.stdout
-    assert f"round 1 of {MATCH_ID}: {len(ROUND1_TICKS)} frames replayed" in stdout
+    assert f"round 1 of {MATCH_ID}: {len(ROUND1_TICKS)} frames (2 frames/s) replayed" in stdout
     assert "kinematic mover, combat off, bomb on" in stdout
     for title in ("outcome", "clock protocol (metres)", "paper protocol (metres)"):
         assert title in stdout
@@ -132,6 +132,7 @@ def test_replay_writes_its_files_and_prints_the_tables(match_file: Path, tmp_pat
         "weapon in hand (ct1): USP-S: a pistol round",
     ]
     assert summary["frames"] == frames and summary["round_num"] == 1
+    assert summary["frame_rate"] == "2 frames/s"  # the data's: 64 ticks apart at 128 tick
     assert summary["outcome_original"] == {"winner": "T", "reason": "TerroristsWin"}
     assert summary["outcome_replay"] == {"winner": None, "reason": None}
 

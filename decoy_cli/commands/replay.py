@@ -96,7 +96,8 @@ def replay(
     real = (round_.winning_side, round_.end_reason)
     simulated = (result.outcome.winner, result.outcome.reason) if result.outcome else (None, None)
     console.print(
-        f"round {round_.round_num} of {round_.match_id}: {round_.num_frames} frames replayed in "
+        f"round {round_.round_num} of {round_.match_id}: {round_.num_frames} frames "
+        f"({run.summary['frame_rate']}) replayed in "
         f"{run.seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
         f"bomb {'on' if bomb else 'off'})"
     )

@@ -15,6 +15,7 @@ import msgspec
 import numpy as np
 
 from decoy_cli.esta import Round
+from decoy_cli.esta.frame_rate import frame_rates
 from decoy_cli.evaluate.settings import HeatGrid
 from decoy_cli.metrics import metric_names, player_metrics
 from decoy_cli.metrics.kills import KILL_COLUMNS
@@ -104,6 +105,7 @@ ROUND_COLUMNS = (
     "file",
     "file_sha",
     "frames",
+    "frame_rate",
     "seconds",
     "players_t",
     "players_ct",
@@ -122,11 +124,11 @@ ROUND_COLUMNS = (
     *BOMB_COLUMNS,
     *KILL_COLUMNS,
 )
-"""Columns of a round row (rounds.csv); `warnings` holds the implausible data a round was
-replayed with under `--implausible warn`, `contradictions` what its frames and events say
-against each other (`decoy_cli.replay.missing`), each joined by `WARNING_SEPARATOR` ("" when
-none); `inferred` the fields the data lacked and the rules that
-filled them (`decoy_cli.replay.missing`), joined likewise; the bomb columns
+"""Columns of a round row (rounds.csv); `frame_rate` is the data's median frames per second
+(`decoy_cli.esta.frame_rate`); `warnings` holds the implausible data a round was replayed with
+under `--implausible warn`, `contradictions` what its frames and events say against each other
+(`decoy_cli.replay.missing`), each joined by `WARNING_SEPARATOR` ("" when none); `inferred` the
+fields the data lacked and the rules that filled them, joined likewise; the bomb columns
 (`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off; the kill columns
 (`decoy_cli.metrics.kills`) compare deaths and alive counts."""
 
@@ -193,6 +195,7 @@ def build_record(
         "match": round_.match_id,
         "round": round_.round_num,
         "frames": int(round_.num_frames),
+        "frame_rate": round(frame_rates(frame_seconds)[0], 3),
         "seconds": float(frame_seconds[-1] - frame_seconds[0]) if len(frame_seconds) else 0.0,
         "players_t": sides.count("T"),
         "players_ct": sides.count("CT"),

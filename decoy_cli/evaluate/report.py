@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from decoy_cli.esta.frame_rate import describe_rates
 from decoy_cli.evaluate.bomb_report import bomb_section
 from decoy_cli.evaluate.data_notes import (
     contradictions_section,
@@ -259,6 +260,7 @@ def report_markdown(
             f"{counts['rounds_both_teams']} of {counts['rounds_evaluated']}",
         ],
         ["player-rounds", str(counts["player_rounds"])],
+        ["frame rate of the data", describe_rates(tables.rounds["frame_rate"].to_numpy(float))],
     ]
     parts.append("## What was run\n\n" + md_table(["", ""], run_rows))
     parts.append(_trajectory_section(tables, settings))

@@ -15,6 +15,9 @@ import numpy as np
 
 from decoy_cli.csgo import TICK_RATE
 
+MAX_ZIGZAG = 1.3
+"""Largest path-over-straight-line factor by which a replay may outrun the player."""
+
 RATIO_TOLERANCE = 1e-9
 """An interval is infeasible when its speed ratio exceeds 1 by more than rounding."""
 

@@ -16,9 +16,11 @@ How a simulator executes a plan (the contract this module promises):
   agent that arrives late after an infeasible interval waits less, so it catches up with the
   clock instead of drifting).
 * A RELOCATE marks an `unreachable` interval (the target cannot be reached from the previous
-  waypoint on the directed graph: a gap in the graph). The agent holds its waypoint until the
-  deadline, then is placed at `action_node`; the simulator counts it as a recovery, like a
-  teleport out of a stuck position.
+  waypoint on the directed graph: a gap in the graph; or, `bridged`, the graph's way is one the
+  player cannot have taken). The agent holds its waypoint until the player crossed
+  (`interval_cross_s`, at the latest the deadline), then is placed at `action_node` so that it
+  stands there at that tick; the simulator counts it as a recovery, like a teleport out of a
+  stuck position.
 * After the last target the agent holds its waypoint. A plan never kills its agent: a player
   alive at the end of the data survives (`death_frame == -1`). A player who died in the data has
   `death_frame >= 0`, the first frame where the data shows it dead; a movement-only replay removes
@@ -131,6 +133,10 @@ class PlayerPlan:
     detours go round something (a missing edge, a wall the player got past)."""
     interval_straight_m: np.ndarray
     """(T-1,) float64 straight-line distance between the interval's two waypoints."""
+    interval_cross_s: np.ndarray
+    """(T-1,) float64 when the agent of an unreachable interval is placed on its target: the
+    first frame between the two targets where the player is nearer the target's waypoint than
+    the start's (`build_plan`'s `positions`), else the deadline; NaN for the other intervals."""
 
     path_node: np.ndarray
     """(K,) int64 every waypoint in order; a repeated node is a wait or a relocation target."""
@@ -243,6 +249,8 @@ def build_plan(
     *,
     present: np.ndarray | None = None,
     paths: PathCache | None = None,
+    bridged: np.ndarray | None = None,
+    positions: np.ndarray | None = None,
 ) -> PlayerPlan:
     """Build the timed plan of one player from its snapped waypoints (all arrays (F,)).
 
@@ -251,19 +259,24 @@ def build_plan(
     frames where the player is recorded at all (default: every frame); after the last alive frame
     only a present, not-alive frame counts as a death, so a player who merely vanishes from the
     data is not killed. Frames without a target in the middle are joined over, with the deadline
-    at the next target. `paths` shares a path cache between calls.
+    at the next target. `paths` shares a path cache between calls. `bridged` (F,) marks targets
+    the plan reaches across a gap (a RELOCATE) although the graph has a way: a way the player
+    did not take (`decoy_cli.replay.rounds.plan_player` says when). `positions` (F, 3), the
+    player's real ones (NaN where absent), say when the player crossed a gap (`interval_cross_s`).
     """
     nodes = np.asarray(snapped_nodes, dtype=np.int64)
     seconds = np.asarray(frame_seconds, dtype=np.float64)
     alive = np.asarray(alive, dtype=bool)
     weapons = np.asarray(weapons)
     present = np.ones(len(seconds), dtype=bool) if present is None else np.asarray(present, bool)
+    bridged = np.zeros(len(seconds), dtype=bool) if bridged is None else np.asarray(bridged, bool)
     frames = len(seconds)
     for name, array in (
         ("snapped nodes", nodes),
         ("alive flags", alive),
         ("weapons", weapons),
         ("present flags", present),
+        ("bridged flags", bridged),
     ):
         if array.shape != (frames,):
             raise EstaError(f"{name} have shape {array.shape}, expected ({frames},)")
@@ -286,9 +299,10 @@ def build_plan(
     # Every interval's actions in one array: the edges of its shortest path, or one STOP (the
     # same waypoint) or RELOCATE (unreachable) with no edge (-1).
     sources, ends = target_node[:-1], target_node[1:]
+    across = bridged[target_frame[1:]]
     found = [
-        paths.edges(a, b) if a != b else None
-        for a, b in zip(sources.tolist(), ends.tolist(), strict=True)
+        paths.edges(a, b) if a != b and not gap else None
+        for a, b, gap in zip(sources.tolist(), ends.tolist(), across.tolist(), strict=True)
     ]
     unreachable = np.array([e is None for e in found], dtype=bool) & (sources != ends)
     steps = np.array([1 if e is None else len(e) for e in found], dtype=np.int64)
@@ -347,6 +361,9 @@ def build_plan(
         interval_detour=detour,
         interval_zigzag=zigzag,
         interval_straight_m=straight,
+        interval_cross_s=_crossings(
+            graph, target_frame, target_node, seconds, unreachable, positions
+        ),
         path_node=np.concatenate([target_node[:1], step_nodes]).astype(np.int64),
         path_interval=path_interval,
         path_deadline_s=target_seconds[path_interval + 1],
@@ -360,6 +377,30 @@ def build_plan(
         death_frame=death_frame,
         death_seconds=float(seconds[death_frame]) if death_frame >= 0 else float("nan"),
     )
+
+
+def _crossings(
+    graph: WaypointGraph,
+    target_frame: np.ndarray,
+    target_node: np.ndarray,
+    seconds: np.ndarray,
+    unreachable: np.ndarray,
+    positions: np.ndarray | None,
+) -> np.ndarray:
+    """`PlayerPlan.interval_cross_s` of every interval."""
+    cross = np.full(len(unreachable), np.nan)
+    for k in np.flatnonzero(unreachable).tolist():
+        cross[k] = seconds[target_frame[k + 1]]
+        if positions is None:
+            continue
+        between = np.arange(target_frame[k] + 1, target_frame[k + 1])
+        where = np.asarray(positions, dtype=np.float64)[between]
+        start, end = graph.positions[target_node[k]], graph.positions[target_node[k + 1]]
+        with np.errstate(invalid="ignore"):
+            nearer = np.linalg.norm(where - end, axis=1) < np.linalg.norm(where - start, axis=1)
+        if nearer.any():
+            cross[k] = seconds[between[int(np.argmax(nearer))]]
+    return cross
 
 
 def _max_speeds(names: np.ndarray) -> np.ndarray:

@@ -183,8 +183,12 @@ class PlanPolicy:
             data = self.plant
             if data is not None and agent == data.agent and interval == data.arrive_by - 1:
                 deadline = min(deadline, data.start_tick)  # at the plant spot by its start
-            if act == RELOCATE_ACTION and now < deadline:
-                return Decision(STOP_ACTION, hold_ticks=deadline - now, plant=plant)
+            if act == RELOCATE_ACTION:
+                # placed in the tick before the player crossed, so it stands on the target
+                # when that frame is recorded
+                cross = min(deadline, self.tick_of(plan.interval_cross_s[interval])) - 1
+                if now < cross:
+                    return Decision(STOP_ACTION, hold_ticks=cross - now, plant=plant)
             a += 1
             self.next_action[agent] = a
             if act == RELOCATE_ACTION:

@@ -401,7 +401,7 @@ def replay_round(
         recoveries = np.asarray(sim.mover.recoveries).copy()
     return ReplayResult(
         plan=plan,
-        recording=sim.recording,
+        recording=_per_frame(sim.recording, frame_ticks),
         frame_ticks=frame_ticks,
         scripted_death=scripted,
         logs=policy.logs,
@@ -420,21 +420,38 @@ def replay_round(
 
 def _frame_ticks(round_: Round) -> np.ndarray:
     """(F,) simulator tick of each data frame; an EstaError when the round cannot be replayed
-    on one clock: no frames, no player in any frame, or two frames on the same tick."""
+    on one clock: no frames, no player in any frame, or two frames at the same time. Frames
+    closer than a simulator tick (data parsed at 64 or 128 frames per second) share a tick."""
     where = f"{round_.path}: round {round_.round_num}"
     if len(round_.frame_seconds) == 0:
         raise EstaError(f"round {round_.round_num} has no frames (events only): nothing to replay")
     if round_.num_players == 0:
         raise EstaError(f"{where}: no player in any frame: nothing to replay")
     ticks = np.array([tick_at(s) for s in round_.frame_seconds], dtype=np.int64)
-    repeated = np.flatnonzero(np.diff(ticks) <= 0)
+    repeated = np.flatnonzero(np.diff(round_.frame_seconds) <= 0)
     if len(repeated):
         k = int(repeated[0]) + 1
         raise EstaError(
             f"{where}: frame {k} ({float(round_.frame_seconds[k]):.3f} s) is not after frame "
-            f"{k - 1} on the simulator's {TICK_RATE} Hz clock: frames must be at distinct times"
+            f"{k - 1}: frames must be at distinct times"
         )
     return ticks
+
+
+def _per_frame(recording: Recording, frame_ticks: np.ndarray) -> Recording:
+    """The recording with one sample per data frame: frames that share a simulator tick share
+    its sample (the simulator records each tick once)."""
+    if len(recording.ticks) == len(frame_ticks):
+        return recording
+    at = np.searchsorted(recording.ticks, frame_ticks)
+    return replace(
+        recording,
+        ticks=frame_ticks,
+        position=recording.position[at],
+        yaw=recording.yaw[at],
+        hp=recording.hp[at],
+        alive=recording.alive[at],
+    )
 
 
 OFF_MAP_M = 10.0

@@ -5,7 +5,8 @@ module does not import the reader): `position` (P, F, 3) metres, NaN where absen
 bool; `weapon` (P, F) weapon names; `frame_seconds` (F,); `players`, each with `name` and `side`.
 Given the physics world, frames in the air are found by a ray down from each position and left
 unsnapped (see `decoy_cli.replay.snapping`); the waypoint on the floor under such a frame is a
-soft target of the plan (`plan_player`).
+soft target of the plan (`plan_player`). So are snapped frames denser than the lattice resolves
+(`hard_frames`): whatever the data's frame rate, the plan keeps time with the same motion.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import pandas as pd
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import PlayerInfo, Round
-from decoy_cli.replay.pace import less_climbed
+from decoy_cli.replay.pace import MAX_ZIGZAG, less_climbed
 from decoy_cli.replay.plans import PathCache, PlayerPlan, build_plan
 from decoy_cli.replay.snapping import (
     DEFAULT_MAX_SNAP_M,
@@ -28,6 +29,7 @@ from decoy_cli.replay.snapping import (
     snap_into_sites,
     snap_positions,
 )
+from decoy_cli.replay.targets import hard_frames, lacks_the_way, resnap, target_seconds
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -163,17 +165,32 @@ def plan_player(
 
     A player in the air is over some spot of the floor, and heading for it keeps the replay
     near the real path through a jump; but the spot under a jump across a gap or off a ledge
-    may lie a long way round. So a soft target next to an interval that makes the replay later
-    (its expected lateness, `expected_lateness`, grows over the interval by more than a tick) or
-    that it cannot reach is dropped and the plan rebuilt, until none is: each pass drops at
-    least one target, so it ends. A soft target inside a stretch the replay runs late for
-    another reason, on the way, stays.
+    may lie a long way round. Likewise a snapped frame closer in time to the last hard target
+    than the lattice resolves (`hard_frames`) is a soft target: its waypoint says where the
+    player went, but a waypoint a spacing off (snapping flips between neighbours, levels or
+    the two sides of a door) over a fraction of a second asks more than the player ran. So a
+    soft target next to an interval that makes the replay later (its expected lateness,
+    `expected_lateness`, grows over the interval by more than a tick) or that it cannot reach
+    is dropped and the plan rebuilt, until none is: each pass drops at least one target, so it
+    ends. A soft target inside a stretch the replay runs late for another reason, on the way,
+    stays. Then a hard target beside such an interval moves to a neighbouring waypoint by the
+    player from which the replay keeps time (`resnap`, tried once for each pair of targets
+    around it); and last an interval whose path the player cannot have taken
+    (`lacks_the_way`) is crossed as a gap (`build_plan`'s `bridged`).
     """
     present = np.isfinite(positions).all(axis=1)
-    soft = (snap.ground_node >= 0) & (snap.node < 0)
-    nodes = np.where(soft, snap.ground_node, snap.node)
+    snapped = (snap.node >= 0) & alive
+    soft = ((snap.ground_node >= 0) & (snap.node < 0)) | (
+        snapped & ~hard_frames(seconds, snapped, target_seconds(graph))
+    )
+    nodes = np.where(snap.node >= 0, snap.node, snap.ground_node)
+    tried: set[tuple[int, int, int]] = set()  # (frame, target before, after) `resnap` tried
+    bridged = np.zeros(len(seconds), dtype=bool)
     while True:
-        plan = build_plan(graph, nodes, seconds, alive, weapons, present=present, paths=paths)
+        plan = build_plan(
+            graph, nodes, seconds, alive, weapons, present=present, paths=paths,
+            bridged=bridged, positions=positions,
+        )  # fmt: skip
         caps = interval_caps(plan, positions)
         late = expected_lateness(plan, caps)
         worse = (np.diff(late) > 1.0 / TICK_RATE) | plan.interval_unreachable
@@ -181,10 +198,27 @@ def plan_player(
         beside[:-1] |= worse
         beside[1:] |= worse
         drop = plan.target_frame[beside & soft[plan.target_frame]]
-        if not len(drop):
+        if len(drop):
+            nodes[drop] = -1
+            soft[drop] = False
+            continue
+        retry = [t for t in np.flatnonzero(beside & snapped[plan.target_frame]).tolist() if t]
+        contexts = {t: _context(plan, t) for t in retry}
+        retry = [t for t in retry if contexts[t] not in tried]
+        if retry:
+            resnap(graph, plan, caps, np.array(retry), nodes, positions, snap.error_m, paths)
+            tried.update(contexts[t] for t in retry)
+            continue
+        lacking = plan.target_frame[1:][lacks_the_way(plan, caps, positions)]
+        if not len(lacking):
             return plan, caps
-        nodes[drop] = -1
-        soft[drop] = False
+        bridged[lacking] = True
+
+
+def _context(plan: PlayerPlan, t: int) -> tuple[int, int, int]:
+    """(frame, waypoint of the target before, of the one after or -1) of target `t` > 0."""
+    after = int(plan.target_node[t + 1]) if t + 1 < len(plan.target_node) else -1
+    return int(plan.target_frame[t]), int(plan.target_node[t - 1]), after
 
 
 def expected_lateness(plan: PlayerPlan, caps: np.ndarray) -> np.ndarray:
@@ -203,10 +237,6 @@ def expected_lateness(plan: PlayerPlan, caps: np.ndarray) -> np.ndarray:
         took = 0.0 if plan.interval_unreachable[k] else run[k]
         late[k + 1] = max(0.0, left + took - deadline[k + 1])
     return late
-
-
-MAX_ZIGZAG = 1.3
-"""Largest path-over-straight-line factor by which a replay may outrun the player."""
 
 
 def interval_caps(plan: PlayerPlan, original: np.ndarray) -> np.ndarray:

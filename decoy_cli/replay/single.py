@@ -18,6 +18,7 @@ import pandas as pd
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, load_round
+from decoy_cli.esta.frame_rate import describe_frame_rate
 from decoy_cli.esta.reader import MATCH_SUFFIXES
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
@@ -148,6 +149,7 @@ def replay_summary(
             "reason": outcome.reason if outcome else None,
         },
         "frames": int(round_.num_frames),
+        "frame_rate": describe_frame_rate(round_.frame_seconds),
         "wall_seconds": round(seconds, 3),
         "stuck_episodes": int(players["stuck"].sum()),
         "recoveries": int(players["recoveries"].sum()),

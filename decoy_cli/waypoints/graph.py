@@ -234,6 +234,32 @@ class WaypointGraph:
             raise GraphError(f"nearest() wants points of shape (M, 3), got {pts.shape}")
         if not np.all(np.isfinite(pts)):
             raise GraphError("nearest() got a NaN or infinite position")
+        cand, dist = self._floor_candidates(pts, max_distance)
+        ok = np.isfinite(dist)
+        best = np.argmin(dist, axis=1)
+        rows = np.arange(len(pts))
+        index = np.where(ok[rows, best], cand[rows, best], -1)
+        distance = dist[rows, best]
+        if single:
+            return index[:1], distance[:1]
+        return index, distance
+
+    def near(self, point: np.ndarray, max_distance: float) -> np.ndarray:
+        """The waypoints on the floor of one point (metres, (3,)) within `max_distance` of it,
+        nearest first, as `nearest` finds them (at most its 12 candidates)."""
+        pts = np.asarray(point, dtype=np.float64).reshape(1, 3)
+        if not np.all(np.isfinite(pts)):
+            raise GraphError("near() got a NaN or infinite position")
+        cand, dist = self._floor_candidates(pts, max_distance)
+        order = np.argsort(dist[0], kind="stable")
+        return cand[0, order[np.isfinite(dist[0, order])]].astype(np.int64)
+
+    def _floor_candidates(
+        self, pts: np.ndarray, max_distance: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(candidates, 3-D distances) of each point (M, 3): its `_CANDIDATES` nearest waypoints
+        in the height-stretched metric, the distance inf where one is not on the point's floor
+        (the vertical band) or farther than `max_distance`."""
         k = min(_CANDIDATES, self.num_nodes)
         _, cand = self._tree.query(pts * np.array([1.0, 1.0, _Z_STRETCH]), k=k)
         cand = cand.reshape(len(pts), k)
@@ -242,14 +268,7 @@ class WaypointGraph:
         dist = np.linalg.norm(cand_pos - pts[:, None, :], axis=2)
         ok = (cand < self.num_nodes) & (dz <= SNAP_MAX_ABOVE_M) & (dz >= -SNAP_MAX_BELOW_M)
         ok &= dist <= max_distance
-        dist = np.where(ok, dist, np.inf)
-        best = np.argmin(dist, axis=1)
-        rows = np.arange(len(pts))
-        index = np.where(ok[rows, best], cand[rows, best], -1)
-        distance = dist[rows, best]
-        if single:
-            return index[:1], distance[:1]
-        return index, distance
+        return cand, np.where(ok, dist, np.inf)
 
     # ---- shortest paths ---------------------------------------------------------------------
 
