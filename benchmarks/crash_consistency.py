@@ -17,8 +17,9 @@ uninterrupted run gives the reference outputs and its wall time T. Then:
   command runs again to the end, and its outputs must equal the reference's, with every round
   once in the cache and no temporary file or staging folder left;
 * interrupts: Ctrl-C (SIGINT to the process group) at a random moment once the run holds its
-  folder: one "interrupted ... run the same command again to resume" line, no traceback, then
-  a rerun equal to the reference;
+  folder: one "interrupted ... run the same command again to resume" line (or, once the
+  outputs are written, an exit by the signal), no traceback, then a rerun equal to the
+  reference;
 * lock: a second run into a folder a live run holds is refused in one `error:` line (and the
   live run ends as the reference); a run killed with SIGKILL leaves a lock the next run takes
   over; a lock file naming a live process that is not a decoy run does not stop a run;
@@ -306,6 +307,8 @@ def interrupts(work: Path, reference: dict[str, bytes], wall: float, count: int,
         problems = []
         if code == 0:
             where = "done before the signal"
+        elif "outputs written to" in out and code in (130, -signal.SIGINT):
+            where = "after the outputs were written"  # nothing to resume; checked below
         elif code != 130 or RESUME_LINE not in " ".join(out.split()):
             problems.append(f"exit {code}, no resume line: {(out + err).strip()[-300:]}")
         if "Traceback" in err:

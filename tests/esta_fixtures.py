@@ -321,6 +321,22 @@ def make_match() -> dict[str, Any]:
     )
 
 
+def shift_ticks(value: Any, by: int) -> Any:
+    """A copy of `value` (a round, or any part of one) with every tick (keys `tick` and
+    `...Tick`) later by `by`: a copy of a round that can follow it in a file, as the game's
+    clock runs forwards across rounds."""
+    if isinstance(value, dict):
+        return {
+            k: v + by
+            if (k == "tick" or k.endswith("Tick")) and isinstance(v, int | float)
+            else shift_ticks(v, by)
+            for k, v in value.items()
+        }
+    if isinstance(value, list):
+        return [shift_ticks(v, by) for v in value]
+    return value
+
+
 def _bomb_event(tick: int, action: str) -> dict[str, Any]:
     x, y, z = BOMB_HAMMER
     return {

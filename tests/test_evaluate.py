@@ -724,3 +724,17 @@ def test_ctrl_c_while_the_outputs_are_written_keeps_the_last_ones(
     assert "Traceback" not in result.output
     assert {p: p.read_bytes() for p in out.rglob("*.csv")} == before
     assert not list(out.glob(".staging*"))
+
+
+def test_a_ctrl_c_while_outputs_are_written_waits_for_them() -> None:
+    """`ctrl_c_deferred`: a SIGINT inside the block lets the block finish, then is raised."""
+    import signal
+
+    from decoy_cli.evaluate.outputs import ctrl_c_deferred
+
+    finished = []
+    with pytest.raises(KeyboardInterrupt), ctrl_c_deferred():
+        os.kill(os.getpid(), signal.SIGINT)
+        finished.append(True)
+    assert finished == [True]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

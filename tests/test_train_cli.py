@@ -3,13 +3,12 @@
 
 from __future__ import annotations
 
-import copy
 import json
 from pathlib import Path
 from typing import Any
 
 import pytest
-from esta_fixtures import make_match, write_match
+from esta_fixtures import make_match, shift_ticks, write_match
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
@@ -28,7 +27,9 @@ def many_rounds() -> dict[str, Any]:
     """The fixture match with its round 2 (both teams' frames, two hits) played ROUNDS times."""
     document = make_match()
     template = document["gameRounds"][1]
-    document["gameRounds"] = [{**copy.deepcopy(template), "roundNum": n} for n in range(1, 9)]
+    document["gameRounds"] = [
+        {**shift_ticks(template, 10_000 * n), "roundNum": n} for n in range(1, 9)
+    ]
     return document
 
 

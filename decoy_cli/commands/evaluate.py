@@ -203,12 +203,15 @@ def evaluate(
                 soft_wrap=True,  # one line, whatever the terminal's width
             )
             raise typer.Exit(130) from None
-    _show(console, evaluation, tables)
-    console.print(
-        f"outputs written to {out} (report: {out / 'report.md'}) in "
-        f"{time.perf_counter() - started:.1f} s",
-        highlight=False,
-    )
+    try:
+        _show(console, evaluation, tables)
+        console.print(
+            f"outputs written to {out} (report: {out / 'report.md'}) in "
+            f"{time.perf_counter() - started:.1f} s",
+            highlight=False,
+        )
+    except KeyboardInterrupt:  # the outputs are complete: only the summary is cut short
+        raise typer.Exit(130) from None
     if evaluation.failures:
         raise DecoyError(
             f"{len(evaluation.failures)} files or rounds failed "

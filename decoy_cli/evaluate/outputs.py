@@ -23,6 +23,7 @@ import fcntl
 import os
 import shutil
 import signal
+import threading
 from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -98,9 +99,35 @@ def clear_leftovers(out: Path) -> None:
 
 def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
     """Write every output (see the module docstring) as one set: into a staging folder first,
-    then moved into `out` together, so a failure or a Ctrl-C (held off during the moves) never
-    leaves new tables beside an old report. Only a SIGKILL or a power cut during the moves can;
-    the next run (every round cached) writes the set again. Returns the paths written."""
+    then moved into `out` together, so a failure never leaves new tables beside an old report.
+    A Ctrl-C takes effect once the set is in place (`ctrl_c_deferred`: stopped in the middle,
+    matplotlib can fail with an error of its own). Only a SIGKILL or a power cut during the
+    moves can leave a mix; the next run (every round cached) writes the set again. Returns the
+    paths written."""
+    with ctrl_c_deferred():
+        return _write_and_publish(evaluation, tables, out, info)
+
+
+@contextmanager
+def ctrl_c_deferred() -> Iterator[None]:
+    """Hold a Ctrl-C (SIGINT) back until the block ends, then raise it as KeyboardInterrupt;
+    outside the main thread (where Python handles signals) the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pressed: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, _: pressed.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if pressed:
+        raise KeyboardInterrupt
+
+
+def _write_and_publish(
+    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo
+) -> list[Path]:
     stage = out / f".staging-{os.getpid()}"
     shutil.rmtree(stage, ignore_errors=True)
     try:
@@ -108,8 +135,6 @@ def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunIn
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    published = []
-    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})  # Ctrl-C waits for the moves
     try:
         for entry in sorted(stage.iterdir()):
             target = out / entry.name
@@ -121,11 +146,7 @@ def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunIn
         raise OutputError(
             f"cannot move the outputs into {out}: {error.strerror or error}"
         ) from None
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, held)
-    for path in written:
-        published.append(out / path.relative_to(stage))
-    return published
+    return [out / path.relative_to(stage) for path in written]
 
 
 def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
