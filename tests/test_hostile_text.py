@@ -4,9 +4,11 @@ written as they are."""
 
 from __future__ import annotations
 
+import builtins
 import csv
 import json
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +20,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
+from decoy_cli.entry import main
 from decoy_cli.evaluate.markdown import md_table
 from decoy_cli.text import csv_cell, csv_inert, md_code, md_inline, visible
 
@@ -180,3 +183,21 @@ def test_any_text_is_shown_without_control_characters(text: str) -> None:
     assert not cell.startswith(("=", "+", "-", "@", "\t", "\r")) or number  # numbers as they are
     assert re.search(r"(?<!\\)\|", md_inline(text)) is None  # no bare "|": no new column
     assert visible(visible(text)) == visible(text)  # an escape is shown as it is
+
+
+def test_a_ctrl_c_while_the_application_loads_is_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    real_import = builtins.__import__
+
+    def interrupted(name: str, *args: Any, **kwargs: Any) -> Any:
+        if name == "decoy_cli.cli":
+            raise KeyboardInterrupt  # the user's Ctrl-C while the libraries load
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.delitem(sys.modules, "decoy_cli.cli", raising=False)
+    monkeypatch.setattr(builtins, "__import__", interrupted)
+    with pytest.raises(SystemExit) as stopped:
+        main()
+    assert stopped.value.code == 130
+    assert capsys.readouterr().err == "interrupted while starting: nothing was done\n"
