@@ -11,8 +11,9 @@ import contextlib
 import json
 import math
 import os
+import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +51,35 @@ def write_csv(path: str | Path, frame: pd.DataFrame) -> Path:
     formula a spreadsheet would run, no control character): the one CSV writer of every
     output."""
     return write_atomic(path, csv_inert(frame).to_csv(index=False).encode())
+
+
+@contextlib.contextmanager
+def staged(folder: str | Path) -> Iterator[Path]:
+    """A staging folder inside `folder` for a set of files that replace the previous ones
+    together: written there, then moved into place by renames (which a full disk does not
+    stop). On any error while writing, the stage is removed and the previous files stay as
+    they were; the error passes on."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"cannot create {folder}: {error.strerror or error}") from None
+    stage = folder / f".staging-{os.getpid()}"
+    shutil.rmtree(stage, ignore_errors=True)
+    try:
+        stage.mkdir()
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    try:
+        for entry in sorted(stage.iterdir()):
+            os.replace(entry, folder / entry.name)
+        stage.rmdir()
+    except OSError as error:
+        raise OutputError(
+            f"cannot move the outputs into {folder}: {error.strerror or error}"
+        ) from None
 
 
 def json_ready(value: Any) -> Any:

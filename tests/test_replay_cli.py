@@ -253,3 +253,21 @@ def test_replay_shoots_with_the_default_models_and_decides_the_round(tmp_path: P
     assert end_tick > last_frame_tick  # this round is left open by its data
     assert summary["played_out_s"] == pytest.approx((end_tick - last_frame_tick) / 60, abs=1e-3)
     assert f"({summary['played_out_s']:.1f} s after the data)" in result.stdout
+
+
+def test_a_replay_that_cannot_finish_writing_leaves_the_previous_one_whole(
+    match_file: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = tmp_path / "out"
+    args = (f"{match_file}:1", "--no-combat", "--out", str(out))
+    assert _invoke(*args).exit_code == 0
+    before = {path.name: path.read_bytes() for path in out.iterdir()}
+
+    def disk_full(*args: object, **kwargs: object) -> None:
+        raise OSError(28, "No space left on device")  # after the CSV files and summary.json
+
+    monkeypatch.setattr("decoy_cli.replay.single.plot_paths", disk_full)
+    result = _invoke(*args, "--seed", "7")
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert "No space left on device" in result.output
+    assert {path.name: path.read_bytes() for path in out.iterdir()} == before  # nothing mixed

@@ -20,6 +20,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, load_round
 from decoy_cli.esta.frame_rate import describe_frame_rate
 from decoy_cli.esta.reader import MATCH_SUFFIXES
+from decoy_cli.files import staged
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
@@ -73,13 +74,14 @@ def replay_address(
     players = player_metrics(round_, result.trace())
     summary = replay_summary(address, round_, options, models, result, players, seconds)
     folder = out or DEFAULT_REPLAY_OUT / replay_folder_name(round_.path, round_.round_num)
-    write_replay(folder, round_, result, players, summary)
     nav = load_navmesh(map_id)
     shown = "".join(c if c.isprintable() else "?" for c in round_.match_id[:8])
     title = f"{shown} round {round_.round_num}: original (dashed) vs replay"
-    plot_paths(folder / "paths.png", round_, result, nav, title=title)
-    if gif:
-        animate(folder / "round.gif", round_, result, nav)
+    with staged(folder) as stage:  # all files replace the previous replay's together
+        write_replay(stage, round_, result, players, summary)
+        plot_paths(stage / "paths.png", round_, result, nav, title=title)
+        if gif:
+            animate(stage / "round.gif", round_, result, nav)
     return SingleReplay(round_, options, result, players, summary, folder, seconds)
 
 
