@@ -34,6 +34,7 @@ LAYERS = {
     "rl": 6,
     "commands": 7,
     "cli": 7,
+    "entry": 8,  # the console script: loads the application
 }
 
 
