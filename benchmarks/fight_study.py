@@ -87,7 +87,6 @@ def main() -> None:
         options = ReplayOptions(damage_model=model, seed=args.seed)
         result = replay_round(round_, graph, options)
         truth = result.data_deaths
-        assert truth is not None
         replay = replay_deaths(result.events, round_.num_players)
         hit_at = {}
         for event in result.events:

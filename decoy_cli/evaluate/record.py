@@ -152,11 +152,6 @@ def build_record(
     hp_known = present & (hp_o >= 0)
 
     kills = result.kill_row(round_)
-    death_original = (
-        result.data_deaths.seconds
-        if result.data_deaths is not None
-        else [plan.death_seconds for plan in result.plan.plans]
-    )
     replay_died_at = replay_deaths(result.events, len(result.plan.plans)).seconds
     players = []
     for p, row in enumerate(metrics.to_dict("records")):
@@ -179,7 +174,7 @@ def build_record(
                 "died_original": bool(row["died_original"]),
                 "died_replay": bool(row["died_replay"]),
                 "death": row["death"],
-                "death_time_original_s": float(death_original[p]),
+                "death_time_original_s": float(result.data_deaths.seconds[p]),
                 "death_time_replay_s": replay_death,
                 "hp_frames": len(known),
                 "hp_rmse": float(np.sqrt(np.mean(diff**2))) if len(known) else np.nan,

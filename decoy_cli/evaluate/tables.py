@@ -283,7 +283,7 @@ def build_tables(acc: Accumulator) -> Tables:
         places=_places(acc),
         rounds_both_teams=both,
         rounds_with_winner=len(known),
-        rounds_with_warnings=int((rounds["warnings"] != "").sum()) if len(rounds) else 0,
+        rounds_with_warnings=_count_filled(rounds, "warnings"),
         rounds_with_contradictions=_count_filled(rounds, "contradictions"),
         rounds_with_inferred=_count_filled(rounds, "inferred"),
         bomb=bomb_metrics(rounds, seed=seed) if acc.settings.bomb else None,

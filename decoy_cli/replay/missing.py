@@ -58,6 +58,8 @@ DEFAULT_RIFLE: dict[Side, str] = {"T": "AK-47", "CT": "M4A1"}
 ECO_BUY_TYPES = ("Full Eco", "Semi Eco")
 """awpy buy types in which a side buys no primary weapon."""
 FULL_ARMOR = 100
+FIELD_NAMES = {"weapon": "weapon in hand", "armour": "armour, helmet and kit"}
+"""The fields `lacking` names, in full where its short name is not (an error line)."""
 
 
 @dataclass(frozen=True)
@@ -70,23 +72,27 @@ class Filled:
 
 def fill_missing(round_: Round, zones: SiteZones, rules: RulesConfig, missing: Missing) -> Filled:
     """The round with every absent field the game needs filled by the module's rules."""
+    absent = lacking(round_)
+    if missing == "error" and absent:
+        raise EstaError(
+            f"{round_.path}: round {round_.round_num}: the data lacks what the game needs "
+            f"({', '.join(FIELD_NAMES.get(a, a) for a in absent)}); --missing-fields infer "
+            "fills it by rule"
+        )
     notes: list[str] = []
     weapon = _weapons(round_, notes)
     armor, helmet, kit = _equipment(round_, weapon, notes)
     filled = replace(round_, weapon=weapon, armor=armor, helmet=helmet, has_defuser=kit)
-    filled = _bomb(filled, zones, rules.plant_s, notes)
-    filled = _defuse(filled, rules, notes)
-    if missing == "error" and notes:
-        raise EstaError(
-            f"{round_.path}: round {round_.round_num}: the data lacks what the game needs "
-            f"({'; '.join(notes)}); --missing-fields infer fills it by rule"
-        )
+    if "bomb carrier" in absent:
+        filled = _bomb(filled, zones, rules.plant_s, notes)
+    if "defuser" in absent:
+        filled = _defuse(filled, rules, notes)
     return Filled(filled, tuple(notes))
 
 
 def lacking(round_: Round) -> tuple[str, ...]:
-    """The fields the game needs that the round's data lacks (what `fill_missing` fills), by
-    name, without filling them (what `decoy info` shows)."""
+    """The fields the game needs that the round's data lacks, by name: what `fill_missing`
+    fills (weapon and armour player by player) and `decoy info` shows."""
     weapon = np.asarray(round_.weapon, dtype=object) != ""
     armor = np.asarray(round_.armor) >= 0
     names = []
@@ -118,11 +124,11 @@ def _is_pistol(name: str) -> bool:
     return WEAPONS.get(name, ("", 0.0))[0] == "Pistols"
 
 
-def _kills_by(round_: Round, name: str, column: str = "attackerName") -> pd.DataFrame:
+def _kills_by(round_: Round, name: str) -> pd.DataFrame:
     kills = round_.kills
-    if len(kills) == 0 or column not in kills or "weapon" not in kills:
+    if len(kills) == 0 or "attackerName" not in kills or "weapon" not in kills:
         return kills.iloc[0:0]
-    mine = kills[(kills[column] == name) & kills["weapon"].map(_firearm)]
+    mine = kills[(kills["attackerName"] == name) & kills["weapon"].map(_firearm)]
     return mine.sort_values("tick", kind="stable")
 
 
@@ -217,14 +223,18 @@ def _names_planter(plants: pd.DataFrame) -> bool:
     return (isinstance(name, str) and bool(name)) or not pd.isna(steam_id)
 
 
+def _frame_at(ticks: np.ndarray, tick: float) -> int:
+    """The last frame at or before `tick` (the first if none is)."""
+    return int(np.clip(np.searchsorted(ticks, tick, side="right") - 1, 0, len(ticks) - 1))
+
+
 def _bomb(round_: Round, zones: SiteZones, plant_s: float, notes: list[str]) -> Round:
-    if np.asarray(round_.has_bomb, bool).any() or round_.clock is None:
-        return round_
+    """The planter (module docstring); called when `lacking` names the bomb carrier."""
     tick = _plant_tick(round_)
-    if tick is None or _names_planter(_plants(round_)):
+    if tick is None or round_.clock is None:
         return round_
     ticks = np.asarray(round_.frame_ticks, dtype=np.float64)
-    at = int(np.clip(np.searchsorted(ticks, tick, side="right") - 1, 0, len(ticks) - 1))
+    at = _frame_at(ticks, tick)
     alive = np.asarray(round_.alive, bool)[:, at]
     t_rows = [p for p, player in enumerate(round_.players) if player.side == "T" and alive[p]]
     if not t_rows:
@@ -277,11 +287,9 @@ def _plant_site(round_: Round) -> str:
 
 
 def _defuse(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
+    """The defuser (module docstring); called when `lacking` names the defuser."""
     events = round_.bomb_events
-    has_events = len(events) and "bombAction" in events
-    if round_.end_reason != "BombDefused" or round_.clock is None or round_.end_tick is None:
-        return round_
-    if has_events and (events["bombAction"] == "defuse").any():
+    if round_.clock is None or round_.end_tick is None:
         return round_
     planted = np.flatnonzero(np.asarray(round_.bomb_planted, bool))
     if not len(planted):
@@ -305,7 +313,7 @@ def _defuse(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
         ]
     )
     rows["seconds"] = round_.clock.seconds(rows["tick"].to_numpy(np.float64))
-    table = rows if not has_events else pd.concat([events, rows], ignore_index=True)
+    table = pd.concat([events, rows], ignore_index=True) if len(events) else rows
     notes.append(
         f"defuse ({name}): the CT alive at the end nearest the bomb, from {seconds:g} s "
         f"before the round's end ({'with' if kit else 'without'} a kit)"
@@ -335,7 +343,7 @@ def contradictions(round_: Round) -> tuple[str, ...]:
                     dead_after.add(victim)
     plant = _plant_tick(round_)
     if plant is not None and len(ticks):
-        at = int(np.clip(np.searchsorted(ticks, plant, side="right") - 1, 0, len(ticks) - 1))
+        at = _frame_at(ticks, plant)
         if not any(alive[p, at] for p, pl in enumerate(round_.players) if pl.side == "T"):
             found.append("the bomb is planted with no T alive")
     if round_.end_reason == "BombDefused" and plant is None:

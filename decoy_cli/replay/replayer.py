@@ -72,6 +72,7 @@ class ReplayResult:
     scripted_death: np.ndarray  # (P,) bool: removed at its data death time, not by combat
     logs: list[AgentLog]
     outcome: RoundOutcome | None
+    data_deaths: RoundDeaths  # the data's death times and killers (replay/deaths.py)
     events: list[SimEvent] = field(default_factory=list)
     stuck: np.ndarray | None = None  # (P,) stuck episodes
     recoveries: np.ndarray | None = None  # (P,) recoveries (teleports) by the mover
@@ -79,7 +80,6 @@ class ReplayResult:
     warnings: tuple[str, ...] = ()  # implausible data replayed anyway (ReplayOptions.implausible)
     inferred: tuple[str, ...] = ()  # fields the data lacked, filled by rule (replay/missing.py)
     contradictions: tuple[str, ...] = ()  # what the data's frames and events say against each other
-    data_deaths: RoundDeaths | None = None  # the data's death times and killers (replay/deaths.py)
     bomb: DataBomb | None = None  # the data's bomb, when the replay followed it
 
     def bomb_row(self) -> dict[str, object] | None:
@@ -88,9 +88,8 @@ class ReplayResult:
 
     def kill_row(self, round_: Round) -> dict[str, object]:
         """The kill-level fidelity of this replay of `round_` (`KILL_COLUMNS`)."""
-        truth = self.data_deaths or data_deaths(round_, self.plan.plans)
-        count = len(self.plan.plans)
-        replay = replay_deaths(self.events, count)
+        truth = self.data_deaths
+        replay = replay_deaths(self.events, len(self.plan.plans))
         alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
         return kill_row(
             [p.name for p in self.plan.players],
