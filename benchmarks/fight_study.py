@@ -6,13 +6,16 @@ For every real firearm kill of the rounds (both teams in the frames):
 
 * line of sight between the two players' eyes at the kill (the kill event's x/y, the frame's z)
   in the map's nav-mesh world, and in `--mesh` (e.g. the brush mesh of ../shared/data/meshes);
+  and at any of the real frames in the 3 s before it: what a replay on the real paths, which
+  passes through the frames, can see at best between frames as sparse as these;
 * the DIP's decision for the pair there, with the attacker's yaw along its motion (as the replay
   has it) and aimed at the victim;
 * what the replay (`--deaths simulated`) did: the victim killed by the fight within 3 s,
   earlier, later or never, and whether the real killer was dead by then or never hit him.
 
 Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
-frames) against those in which the replay's fight damaged one. Nothing here is timed.
+frames) against those in which the replay's fight damaged one, and the HP real victims had one
+frame before they died (how fast real fights end). Nothing here is timed.
 """
 
 from __future__ import annotations
@@ -76,6 +79,8 @@ def main() -> None:
     if args.mesh:
         worlds[args.mesh.name] = PhysicsWorld(read_mesh(args.mesh))
     seen = collections.Counter()
+    seen_frames = collections.Counter()
+    hp_before_death = []
     dip = collections.Counter()
     fates = collections.Counter()
     kills = real_seconds = replay_seconds = 0
@@ -103,8 +108,15 @@ def main() -> None:
             v_pos = np.array([kill.victimX_m, kill.victimY_m, round_.position[v, j, 2]])
             if not (np.isfinite(a_pos).all() and np.isfinite(v_pos).all()):
                 a_pos, v_pos = round_.position[a, j], round_.position[v, j]
+            before_kill = np.flatnonzero(
+                (round_.frame_seconds >= kill.seconds - DEATH_WINDOW_S)
+                & (round_.frame_seconds <= kill.seconds)
+            )
+            a_eyes, v_eyes = (round_.position[i, before_kill] + EYE for i in (a, v))
+            known = np.isfinite(a_eyes).all(axis=1) & np.isfinite(v_eyes).all(axis=1)
             for name, world in worlds.items():
                 seen[name] += bool(world.line_of_sight((a_pos + EYE)[None], (v_pos + EYE)[None])[0])
+                seen_frames[name] += bool(world.line_of_sight(a_eyes[known], v_eyes[known]).any())
             before = round_.position[a, max(j - 1, 0)]
             step = round_.position[a, j] - before
             motion = float(np.degrees(np.arctan2(step[1], step[0])))
@@ -127,6 +139,10 @@ def main() -> None:
             else:
                 fates[f"{fate}; the real killer hit him first {hit_at[(a, v)] - t:+.0f} s off"] += 1
         hp = np.where(round_.hp >= 0, round_.hp, np.nan).astype(float)
+        for player in range(round_.num_players):
+            dead = np.flatnonzero(~np.asarray(round_.alive[player], bool))
+            if len(dead) and dead[0] > 0:
+                hp_before_death.append(hp[player, dead[0] - 1])
         real_seconds += int((np.diff(hp, axis=1) < 0).sum())
         replay_seconds += len(
             {(e.other, e.tick // 60) for e in result.events if e.kind == "damage"}
@@ -134,11 +150,16 @@ def main() -> None:
     print(f"{kills} real firearm kills")
     for name, count in seen.items():
         print(f"  line of sight at the kill, {name}: {count / max(kills, 1):.2f}")
+        share = seen_frames[name] / max(kills, 1)
+        window = f"{DEATH_WINDOW_S:g} s"
+        print(f"  line of sight at a real frame in the {window} before, {name}: {share:.2f}")
     for name, count in dip.items():
         print(f"  DIP says hit, attacker's yaw {name}: {count / max(kills, 1):.2f}")
     for fate, count in fates.most_common():
         print(f"  {count:3d} {fate}")
     print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
+    full = np.asarray(hp_before_death) >= 100
+    print(f"real deaths from full HP within one frame: {full.sum()} of {len(full)}")
 
 
 if __name__ == "__main__":
