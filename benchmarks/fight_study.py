@@ -7,7 +7,10 @@ For every real firearm kill of the rounds (both teams in the frames):
 * line of sight between the two players' eyes at the kill (the kill event's x/y, the frame's z)
   in the map's nav-mesh world, and in `--mesh` (e.g. the brush mesh of ../shared/data/meshes);
   and at any of the real frames in the 3 s before it: what a replay on the real paths, which
-  passes through the frames, can see at best between frames as sparse as these;
+  passes through the frames, can see at best between frames as sparse as these; and in a replay
+  whose deaths follow the data (`--deaths data`: everybody on his real path until his real
+  death), whether its combat steps ever found the victim in sight of the real killer, or of
+  any enemy, from 3 s before the kill to half a second after: no fight can kill him otherwise;
 * the DIP's decision for the pair there, with the attacker's yaw along its motion (as the replay
   has it) and aimed at the victim;
 * what the replay (`--deaths simulated`) did: the victim killed by the fight within 3 s,
@@ -22,11 +25,12 @@ from __future__ import annotations
 
 import argparse
 import collections
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M
+from decoy_cli.csgo import EYE_HEIGHT_M, TICK_RATE
 from decoy_cli.damage import load_damage_model
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
 from decoy_cli.metrics.kills import DEATH_WINDOW_S
@@ -35,6 +39,7 @@ from decoy_cli.replay.missing import fill_missing
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import CombatBatch
 from decoy_cli.sim.rules import RulesConfig, SiteZones
+from decoy_cli.sim.setup import open_round
 from decoy_cli.waypoints.build import builtin_graph, graph_world
 from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.meshfile import read_mesh
@@ -65,6 +70,35 @@ def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:
     return bool(model.decision.hit_probability(batch)[0] >= model.decision.threshold)
 
 
+def sightings(round_, graph, model) -> list[tuple[float, set[tuple[int, int]]]]:
+    """(seconds, visible ordered pairs) of every combat step of a replay of `round_` whose
+    deaths follow the data."""
+    steps: list[tuple[float, set[tuple[int, int]]]] = []
+
+    @contextmanager
+    def watching(*args, **kwargs):
+        with open_round(*args, **kwargs) as sim:
+            if sim.combat is not None:
+                step = sim.combat.run
+
+                def run(agents, tick, rng):
+                    pairs = sim.combat.los.visible_pairs(agents)
+                    steps.append(
+                        (
+                            tick / TICK_RATE,
+                            set(zip(pairs.attacker.tolist(), pairs.victim.tolist(), strict=True)),
+                        )
+                    )
+                    return step(agents, tick, rng)
+
+                sim.combat.run = run
+            yield sim
+
+    options = ReplayOptions(damage_model=model, deaths="data")
+    replay_round(round_, graph, options, open_sim=watching)
+    return steps
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("inputs", nargs="+", type=Path)
@@ -80,6 +114,7 @@ def main() -> None:
         worlds[args.mesh.name] = PhysicsWorld(read_mesh(args.mesh))
     seen = collections.Counter()
     seen_frames = collections.Counter()
+    in_sight = collections.Counter()
     hp_before_death = []
     dip = collections.Counter()
     fates = collections.Counter()
@@ -98,6 +133,7 @@ def main() -> None:
             if event.kind == "damage":
                 hit_at.setdefault((event.agent, event.other), event.tick / 60)
         rows = {p.name: i for i, p in enumerate(round_.players)}
+        steps = sightings(round_, graph, model)
         for kill in round_.kills.itertuples():
             a, v = rows.get(kill.attackerName, -1), rows.get(kill.victimName, -1)
             if a < 0 or v < 0 or kill.weapon not in FIREARMS:
@@ -108,6 +144,9 @@ def main() -> None:
             v_pos = np.array([kill.victimX_m, kill.victimY_m, round_.position[v, j, 2]])
             if not (np.isfinite(a_pos).all() and np.isfinite(v_pos).all()):
                 a_pos, v_pos = round_.position[a, j], round_.position[v, j]
+            near = [pairs for at, pairs in steps if -DEATH_WINDOW_S <= at - kill.seconds <= 0.5]
+            in_sight["by the real killer"] += any((a, v) in pairs for pairs in near)
+            in_sight["by any enemy"] += any(v in {w for _, w in pairs} for pairs in near)
             before_kill = np.flatnonzero(
                 (round_.frame_seconds >= kill.seconds - DEATH_WINDOW_S)
                 & (round_.frame_seconds <= kill.seconds)
@@ -153,6 +192,10 @@ def main() -> None:
         share = seen_frames[name] / max(kills, 1)
         window = f"{DEATH_WINDOW_S:g} s"
         print(f"  line of sight at a real frame in the {window} before, {name}: {share:.2f}")
+    for whom, count in in_sight.items():
+        share = count / max(kills, 1)
+        where = "in the replay on the real paths (--deaths data)"
+        print(f"  victim in sight {whom} {where}: {share:.2f}")
     for name, count in dip.items():
         print(f"  DIP says hit, attacker's yaw {name}: {count / max(kills, 1):.2f}")
     for fate, count in fates.most_common():
