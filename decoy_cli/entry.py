@@ -14,3 +14,7 @@ def main() -> None:
         sys.stderr.write("interrupted while starting: nothing was done\n")
         raise SystemExit(130) from None
     app()
+
+
+if __name__ == "__main__":
+    main()

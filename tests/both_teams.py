@@ -38,7 +38,6 @@ class Mate:
     nodes: list[int]  # one waypoint per frame (the last repeats to the end)
     dead_from: int | None = None  # first frame shown dead
     weapon: str | None = None  # written as activeWeapon when given (the export has none)
-    view: float | None = None  # written as viewX in every frame when given (the export has none)
 
     def node(self, frame: int) -> int:
         return self.nodes[min(frame, len(self.nodes) - 1)]
@@ -123,8 +122,6 @@ class BothTeams:
             }
             if p.weapon is not None:
                 player["activeWeapon"] = p.weapon if alive else ""
-            if p.view is not None:
-                player["viewX"] = p.view
             sides[p.side].append(player)
         planted = self.plant is not None and j >= self.plant[0]
         return {

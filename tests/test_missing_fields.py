@@ -377,9 +377,8 @@ def test_info_says_what_a_file_lacks(tmp_path: Path) -> None:
     doc = planting()
     doc.reason, doc.winner = "BombDefused", "CT"
     file = doc.write(tmp_path / "lacking.json")
-    lacks = ("weapon", "armour", "view", "bomb carrier", "defuser")
-    assert lacking(read_match(file).rounds[0]) == lacks
+    assert lacking(read_match(file).rounds[0]) == ("weapon", "armour", "bomb carrier", "defuser")
     result = CliRunner().invoke(app, ["info", str(file)], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
-    assert ", ".join(lacks) in result.stdout
+    assert "weapon, armour, bomb carrier, defuser" in result.stdout
     assert "a replay fills them by rule" in result.stdout

@@ -1,11 +1,10 @@
 """What the game needs and a round's data lacks, filled by stated rules; what the data contradicts.
 
 A replay needs every player's weapon in hand (its damage and running speed), armour, helmet and
-defuse kit, where he looks, and the bomb's carrier, planter and defuser. ESTA files record them
-all; other exports record none (the shared CS2 rounds: positions, HP, kills, the plant's tick
-and site). `fill_missing` returns the round with each absent field filled and one line per
-filled field naming the rule (`Filled.notes`); with `missing="error"` an absent field is an
-EstaError.
+defuse kit, and the bomb's carrier, planter and defuser. ESTA files record them all; other
+exports record none (the shared CS2 rounds: positions, HP, kills, the plant's tick and site).
+`fill_missing` returns the round with each absent field filled and one line per filled field
+naming the rule (`Filled.notes`); with `missing="error"` an absent field is an EstaError.
 
 Rules, the first that applies:
 
@@ -26,8 +25,6 @@ Rules, the first that applies:
   Without a plant nobody carries it (the replay plants only where the data did).
 * Defuse (the round ended `BombDefused` with no `defuse` event): it began 5 s (kit) or 10 s
   before the round's end (the rules' durations), by the CT alive at the end nearest the bomb.
-* View (no yaw in any frame): a player looks along his motion, the simulator's own yaw
-  (decoy_cli/replay/views.py takes the data's where it has one).
 
 `contradictions` names what the frames and the events say against each other (a victim alive
 after its kill, a killer or victim never in the frames, a plant with no T alive, a defuse of a
@@ -61,11 +58,7 @@ DEFAULT_RIFLE: dict[Side, str] = {"T": "AK-47", "CT": "M4A1"}
 ECO_BUY_TYPES = ("Full Eco", "Semi Eco")
 """awpy buy types in which a side buys no primary weapon."""
 FULL_ARMOR = 100
-FIELD_NAMES = {
-    "weapon": "weapon in hand",
-    "armour": "armour, helmet and kit",
-    "view": "view direction (viewX)",
-}
+FIELD_NAMES = {"weapon": "weapon in hand", "armour": "armour, helmet and kit"}
 """The fields `lacking` names, in full where its short name is not (an error line)."""
 
 
@@ -90,8 +83,6 @@ def fill_missing(round_: Round, zones: SiteZones, rules: RulesConfig, missing: M
     weapon = _weapons(round_, notes)
     armor, helmet, kit = _equipment(round_, weapon, notes)
     filled = replace(round_, weapon=weapon, armor=armor, helmet=helmet, has_defuser=kit)
-    if "view" in absent:
-        notes.append("view: along the player's motion (the data records none)")
     if "bomb carrier" in absent:
         filled = _bomb(filled, zones, rules.plant_s, notes)
     if "defuser" in absent:
@@ -109,8 +100,6 @@ def lacking(round_: Round) -> tuple[str, ...]:
         names.append("weapon")
     if not armor.any(axis=1).all():
         names.append("armour")
-    if not np.isfinite(np.asarray(round_.yaw, dtype=float)).any():
-        names.append("view")
     carried = np.asarray(round_.has_bomb, bool).any() or _names_planter(_plants(round_))
     if not carried and _plant_tick(round_) is not None:
         names.append("bomb carrier")

@@ -48,7 +48,6 @@ from decoy_cli.replay.pace import asks_more
 from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
-from decoy_cli.replay.views import data_views
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Recording
 from decoy_cli.sim.rules import RulesConfig
@@ -252,7 +251,6 @@ class ReplayOptions:
             bomb=self.bomb,
             damage_model=self.damage_model,
             combat_kills=self.deaths == "simulated",
-            views=data_views(_frame_ticks(round_), np.asarray(round_.yaw)),
             rules=rules,
         )
 

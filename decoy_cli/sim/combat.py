@@ -4,9 +4,7 @@ Every 0.5 s of game time (the engine decides when, by integer tick count) `Comba
 
 1. `LineOfSight.visible_pairs` finds the ordered (attacker, victim) pairs of alive enemies whose
    eyes see each other, with one batched ray per unordered pair;
-2. `make_batch` gathers everything a damage model needs about those pairs into a `CombatBatch`
-   (the attackers' view from a `ViewSource` where it knows one, e.g. a replay's data; else the
-   agents' yaw, the direction they last moved in);
+2. `make_batch` gathers everything a damage model needs about those pairs into a `CombatBatch`;
 3. a `DamageModel` (DIP and DOG in `decoy_cli.damage`) says, per pair, whether the attacker hits
    and for how much and where;
 4. `apply_damage` applies all damage of the step at once (two agents can kill each other) and
@@ -35,7 +33,6 @@ __all__ = [
     "DamageModel",
     "DamageResult",
     "LineOfSight",
-    "ViewSource",
     "VisiblePairs",
     "apply_damage",
     "make_batch",
@@ -80,17 +77,8 @@ class CombatBatch:
         return len(self.attacker)
 
 
-class ViewSource(Protocol):
-    """Where the agents look at a tick: (N,) yaws in degrees, NaN where it does not know."""
-
-    def __call__(self, tick: int) -> np.ndarray: ...
-
-
-def make_batch(
-    agents: Agents, pairs: VisiblePairs, map_name: str, view: np.ndarray | None = None
-) -> CombatBatch:
-    """Gather the state of both agents of every pair (copies: later state changes do not leak).
-    `view` (N,) yaws, where finite, stand for the agents' own yaw (a `ViewSource`'s)."""
+def make_batch(agents: Agents, pairs: VisiblePairs, map_name: str) -> CombatBatch:
+    """Gather the state of both agents of every pair (copies: later state changes do not leak)."""
     a = np.asarray(pairs.attacker, dtype=np.int64)
     v = np.asarray(pairs.victim, dtype=np.int64)
     if a.shape != v.shape or a.ndim != 1:
@@ -99,8 +87,6 @@ def make_batch(
         raise ValueError(f"pair indices outside 0..{agents.count - 1}")
     position = np.asarray(agents.position, dtype=np.float64)
     yaw = np.asarray(agents.yaw, dtype=np.float64)
-    if view is not None:
-        yaw = np.where(np.isfinite(view), view, yaw)
     delta = position[v] - position[a]
     ahead = np.arctan2(delta[:, 1], delta[:, 0]) - np.radians(yaw[a])
     bearing = np.where(np.hypot(delta[:, 0], delta[:, 1]) > 0, _wrap(ahead), 0.0)
@@ -251,23 +237,15 @@ def apply_damage(
 
 
 class CombatStep:
-    """One combat step: line of sight, the damage model on the visible pairs, damage applied.
-    `views` says where agents look where it knows (None: their yaw, along their motion)."""
+    """One combat step: line of sight, the damage model on the visible pairs, damage applied."""
 
     def __init__(
-        self,
-        los: LineOfSight,
-        model: DamageModel,
-        map_name: str,
-        *,
-        kills: bool = True,
-        views: ViewSource | None = None,
+        self, los: LineOfSight, model: DamageModel, map_name: str, *, kills: bool = True
     ) -> None:
         self.los = los
         self.model = model
         self.map_name = map_name
         self.kills = kills
-        self.views = views
 
     def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]:
         """Run the step on the agents (changed in place); the model is not called when no
@@ -275,6 +253,5 @@ class CombatStep:
         pairs = self.los.visible_pairs(agents)
         if len(pairs) == 0:
             return []
-        view = None if self.views is None else self.views(tick)
-        batch = make_batch(agents, pairs, self.map_name, view)
+        batch = make_batch(agents, pairs, self.map_name)
         return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)

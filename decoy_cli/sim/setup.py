@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight, ViewSource
+from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
 from decoy_cli.sim.engine import COMBAT_EVERY_TICKS, Policy, Simulator
 from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
 from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
@@ -68,8 +68,6 @@ class RoundSetup:
     combat_kills: bool = True
     """False: shooting wounds but never kills (HP stops at 1): deaths come from elsewhere, as
     in a replay whose deaths follow the data (`--deaths data`, the paper's protocol)."""
-    views: ViewSource | None = None
-    """Where the agents look, where known (a replay: the data's view); else along their motion."""
     world: World | None = None
     rules: RulesConfig | None = None
     zones: SiteZones | None = None
@@ -152,13 +150,7 @@ def open_round(
             assert physics is not None and setup.damage_model is not None
             los = LineOfSight(physics, agents.count)
             stack.callback(los.close)
-            combat = CombatStep(
-                los,
-                setup.damage_model,
-                setup.map_name,
-                kills=setup.combat_kills,
-                views=setup.views,
-            )
+            combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.combat_kills)
         rules = BombRules(setup.site_zones(), setup.rules_config())
         yield Simulator(
             setup.graph,
