@@ -21,7 +21,6 @@ from decoy_cli.metrics import metric_names, player_metrics
 from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
-from decoy_cli.replay.deaths import replay_deaths
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask
@@ -152,7 +151,7 @@ def build_record(
     hp_known = present & (hp_o >= 0)
 
     kills = result.kill_row(round_)
-    replay_died_at = replay_deaths(result.events, len(result.plan.plans)).seconds
+    replay_died_at = result.deaths.seconds
     players = []
     for p, row in enumerate(metrics.to_dict("records")):
         replay_death = np.nan

@@ -95,7 +95,7 @@ def read_data_bomb(round_: Round, zones: SiteZones, plant_s: float) -> DataBomb:
     carry the bomb), every other oddity an anomaly (module docstring)."""
     carriers = data_carriers(round_)
     anomalies: list[str] = []
-    events = _bomb_events(round_, anomalies)
+    events = bomb_events(round_, anomalies)
     plant = _plant(round_, events, carriers, zones, plant_s, anomalies)
     defuses = _defuses(round_, events, plant, anomalies)
     planted = np.asarray(round_.bomb_planted, bool)
@@ -196,7 +196,16 @@ def _player_row(round_: Round, name: object, steam_id: object) -> int:
     return -1
 
 
-def _bomb_events(round_: Round, anomalies: list[str]) -> pd.DataFrame:
+def data_plant_tick(events: pd.DataFrame, round_: Round) -> float | None:
+    """The tick of the data's plant: its first `plant` event's (of `bomb_events`), else the
+    round's `bombPlantTick`; None without a plant."""
+    plants = events.loc[events["bombAction"] == "plant", "tick"]
+    if len(plants):
+        return float(plants.iloc[0])
+    return None if round_.bomb_plant_tick is None else float(round_.bomb_plant_tick)
+
+
+def bomb_events(round_: Round, anomalies: list[str]) -> pd.DataFrame:
     """The bomb events with a tick and an action, in time order (an anomaly if the file's order
     was not)."""
     events = round_.bomb_events
@@ -220,14 +229,12 @@ def _plant(
 ) -> DataPlantRecord | None:
     clock = round_.clock
     plants = events[events["bombAction"] == "plant"]
-    if clock is None or (len(plants) == 0 and round_.bomb_plant_tick is None):
+    plant_tick = data_plant_tick(events, round_)
+    if clock is None or plant_tick is None:
         return None
     ticks = np.asarray(round_.frame_ticks)
     resolution = 0.0
-    if len(plants):
-        plant_tick = float(plants["tick"].iloc[0])
-    else:
-        plant_tick = float(round_.bomb_plant_tick)  # type: ignore[arg-type]  # checked above
+    if len(plants) == 0:
         k = int(np.searchsorted(ticks, plant_tick))
         if 0 < k < len(ticks) and ticks[k] == plant_tick:  # derived from the frames
             resolution = (plant_tick - ticks[k - 1]) / clock.tick_rate

@@ -43,6 +43,7 @@ import pandas as pd
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round
 from decoy_cli.esta.frames import Side
+from decoy_cli.replay.bomb import bomb_events, data_plant_tick
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.sites import SiteZones
 from decoy_cli.weapons import FIREARMS, WEAPONS
@@ -100,7 +101,7 @@ def lacking(round_: Round) -> tuple[str, ...]:
         names.append("weapon")
     if not armor.any(axis=1).all():
         names.append("armour")
-    carried = np.asarray(round_.has_bomb, bool).any() or _names_planter(_plants(round_))
+    carried = np.asarray(round_.has_bomb, bool).any() or _names_planter(round_)
     if not carried and _plant_tick(round_) is not None:
         names.append("bomb carrier")
     events = round_.bomb_events
@@ -200,22 +201,14 @@ def _equipment(
     return armor, helmet, kit
 
 
-def _plants(round_: Round) -> pd.DataFrame:
-    events = round_.bomb_events
-    if not len(events) or not {"bombAction", "tick"} <= set(events.columns):
-        return events.iloc[0:0]
-    return events[(events["bombAction"] == "plant") & events["tick"].notna()]
-
-
 def _plant_tick(round_: Round) -> float | None:
-    plants = _plants(round_)
-    if len(plants):
-        return float(plants["tick"].iloc[0])
-    return None if round_.bomb_plant_tick is None else float(round_.bomb_plant_tick)
+    return data_plant_tick(bomb_events(round_, []), round_)
 
 
-def _names_planter(plants: pd.DataFrame) -> bool:
+def _names_planter(round_: Round) -> bool:
     """Whether the data's plant event says who planted (then nothing is inferred)."""
+    events = bomb_events(round_, [])
+    plants = events[events["bombAction"] == "plant"]
     if not len(plants):
         return False
     row = plants.iloc[0]

@@ -23,6 +23,7 @@ S_t on the same clock.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -86,10 +87,15 @@ class ReplayResult:
         """The bomb fidelity of this replay (`BOMB_COLUMNS`), None when the bomb was off."""
         return None if self.bomb is None else bomb_fidelity(self.bomb, self.events)
 
+    @cached_property
+    def deaths(self) -> RoundDeaths:
+        """The replay's deaths, from its events (replay/deaths.py)."""
+        return replay_deaths(self.events, len(self.plan.plans))
+
     def kill_row(self, round_: Round) -> dict[str, object]:
         """The kill-level fidelity of this replay of `round_` (`KILL_COLUMNS`)."""
         truth = self.data_deaths
-        replay = replay_deaths(self.events, len(self.plan.plans))
+        replay = self.deaths
         alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
         return kill_row(
             [p.name for p in self.plan.players],
