@@ -26,8 +26,9 @@ import numpy as np
 from decoy_cli.bench.machine import machine_line
 from decoy_cli.bench.portable import _play
 from decoy_cli.damage import load_damage_model
-from decoy_cli.sim import DecoyParallelEnv, env_step
-from decoy_cli.sim.array_env import DecoyArrayEnv
+from decoy_cli.env import DecoyParallelEnv
+from decoy_cli.env import step as env_step
+from decoy_cli.env.array_env import DecoyArrayEnv
 from decoy_cli.sim.combat import CombatStep
 from decoy_cli.sim.engine import Simulator
 

@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
-from decoy_cli.sim import DecoyParallelEnv
+from decoy_cli.env import DecoyParallelEnv
 
 
 def main() -> None:

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from busy_rounds import Shots, count_quiet_steps, no_compiled_steps
 
-from decoy_cli.sim.array_env import ArrayStep, DecoyArrayEnv
+from decoy_cli.env.array_env import ArrayStep, DecoyArrayEnv
+from decoy_cli.env.parallel import DecoyParallelEnv
+from decoy_cli.env.step import LEFT_TO_RUN, PLAYED
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
-from decoy_cli.sim.env import DecoyParallelEnv
-from decoy_cli.sim.env_step import LEFT_TO_RUN, PLAYED
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.graph import STOP_ACTION
 
@@ -287,7 +287,7 @@ def test_the_environment_plays_with_numba_off() -> None:
     round's arrays), for debugging: a few steps in a fresh process."""
     script = (
         "import numpy as np\n"
-        "from decoy_cli.sim.array_env import DecoyArrayEnv\n"
+        "from decoy_cli.env.array_env import DecoyArrayEnv\n"
         "env = DecoyArrayEnv(combat=False)\n"
         "state = env.reset(0)\n"
         "rng = np.random.default_rng(0)\n"

@@ -22,9 +22,9 @@ from decoy_cli.damage.combat import LearnedDamage
 from decoy_cli.damage.features import PAPER_SPEC, WEAPONS, FeatureSpec, encode
 from decoy_cli.damage.model_folder import load_dip, load_dog, save_dip, save_dog
 from decoy_cli.damage.networks import DipNet, DogNet, tensors
+from decoy_cli.env.parallel import DecoyParallelEnv
 from decoy_cli.errors import ModelError
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, VisiblePairs, make_batch
-from decoy_cli.sim.env import DecoyParallelEnv
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import STOP_ACTION
 

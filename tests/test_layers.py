@@ -29,6 +29,7 @@ LAYERS = {
     "replay": 5,
     "damage": 5,
     "synth": 5,
+    "env": 5,
     "evaluate": 6,
     "bench": 6,
     "rl": 6,

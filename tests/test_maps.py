@@ -15,9 +15,9 @@ from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.csgo import MAP_NAMES
+from decoy_cli.env import DecoyParallelEnv
 from decoy_cli.errors import GraphError, WorldError
 from decoy_cli.esta import read_match
-from decoy_cli.sim import DecoyParallelEnv
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.world.nav_data import read_navmesh, read_patches
 from decoy_cli.world.navmesh import asset_dir, load_navmesh

@@ -12,9 +12,9 @@ import pytest
 from pettingzoo.test import api_test, parallel_api_test, parallel_seed_test
 from pettingzoo.utils.conversions import parallel_to_aec
 
+from decoy_cli.env.observation import BOMB_STATES, POSITION_MARGIN_M, observation_layout
+from decoy_cli.env.parallel import DecoyParallelEnv
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
-from decoy_cli.sim.env import DecoyParallelEnv
-from decoy_cli.sim.observation import BOMB_STATES, POSITION_MARGIN_M, observation_layout
 from decoy_cli.sim.rules import RulesConfig, SiteZones
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import STOP_ACTION

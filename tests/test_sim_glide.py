@@ -19,8 +19,8 @@ from busy_rounds import (
     site_agents,
 )
 
+from decoy_cli.env.step import LEFT_TO_RUN, PLAYED
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.env_step import LEFT_TO_RUN, PLAYED
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.world.navmesh import nav_world
@@ -87,7 +87,7 @@ def test_until_is_asked_whenever_more_than_motion_may_have_happened(physics) -> 
 def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypatch) -> None:
     """Its steps play quiet stretches in compiled code (`env_step`), stopping where an agent
     is due, as stepping every tick does."""
-    from decoy_cli.sim import DecoyParallelEnv
+    from decoy_cli.env import DecoyParallelEnv
 
     def play() -> list:
         env = DecoyParallelEnv(mover="kinematic", damage_model=Shots())

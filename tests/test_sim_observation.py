@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 from busy_rounds import Shots, Wanderers, site_agents
 
+from decoy_cli.env.observation import BOMB_SITES, NUM_ACTIONS, ObservationEncoder
+from decoy_cli.env.step import RoundSteps
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.env_step import RoundSteps
-from decoy_cli.sim.observation import BOMB_SITES, NUM_ACTIONS, ObservationEncoder
 from decoy_cli.sim.quiet_play import Choices
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import BombStatus

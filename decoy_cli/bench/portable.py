@@ -66,7 +66,11 @@ def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
 def env_section(config: dict[str, Any]) -> dict[str, Any]:
     """Random masked 5v5 rounds through `DecoyParallelEnv` (module docstring)."""
     from decoy_cli.bench.machine import peak_rss_mb
-    from decoy_cli.sim import DecoyParallelEnv
+
+    try:
+        from decoy_cli.env import DecoyParallelEnv
+    except ImportError:  # a version from before the environments left decoy_cli.sim
+        from decoy_cli.sim import DecoyParallelEnv  # type: ignore[no-redef]
 
     rounds = 1 if config.get("quick") else ENV_ROUNDS
     rng = np.random.default_rng(int(config.get("seed", 0)))
@@ -126,9 +130,14 @@ def _play(env: Any, rng: np.random.Generator, seed: int) -> dict[str, Any]:
 def _array_rounds(config: dict[str, Any], model: Callable | None, rounds: int) -> dict[str, Any]:
     """The environment section's rounds through `DecoyArrayEnv`, if this code has it."""
     try:
-        from decoy_cli.sim.array_env import DecoyArrayEnv
+        from decoy_cli.env.array_env import DecoyArrayEnv
     except ImportError:
-        return {}
+        try:  # a version from before the environments left decoy_cli.sim
+            from decoy_cli.sim.array_env import (  # type: ignore[no-redef]
+                DecoyArrayEnv,
+            )
+        except ImportError:  # a version without the array environment
+            return {}
     rng = np.random.default_rng(int(config.get("seed", 0)))
     env = DecoyArrayEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5, map=config.get("map"))
     try:

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from decoy_cli.damage import DEFAULT_MODELS
-from decoy_cli.sim.env import DecoyParallelEnv
+from decoy_cli.env.parallel import DecoyParallelEnv
 
 ENV_SETTINGS = ("map", "n_t", "n_ct", "mover", "models", "combat", "bomb", "stop_seconds")
 """The settings `env_from_config` reads; "models" names the damage models as `--models` does."""

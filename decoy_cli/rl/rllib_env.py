@@ -21,8 +21,8 @@ from gymnasium import spaces
 from ray.rllib.callbacks.callbacks import RLlibCallback
 from ray.rllib.env.multi_agent_env import MultiAgentEnv
 
+from decoy_cli.env.observation import NUM_ACTIONS
 from decoy_cli.rl.factory import env_from_config
-from decoy_cli.sim.observation import NUM_ACTIONS
 
 
 class DecoyRLlibEnv(MultiAgentEnv):

@@ -1,9 +1,7 @@
-"""The headless simulator: round state, movement, line of sight and combat, bomb rules, env.
+"""The headless simulator: round state, movement, line of sight and combat, bomb rules.
 
 Entry points: `RoundSetup` and `open_round` (decoy_cli/sim/setup.py) build a ready `Simulator`
-for a round; `DecoyArrayEnv` is the environment's game with one array per step for all agents,
-`DecoyParallelEnv` the PettingZoo environment over it. They are imported on
-first use, so importing one part of the simulator does not load PettingZoo or gymnasium.
+for a round. The environments over it live in `decoy_cli.env`. Names are imported on first use.
 """
 
 from __future__ import annotations
@@ -12,18 +10,14 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from decoy_cli.sim.array_env import DecoyArrayEnv
     from decoy_cli.sim.decisions import Decision
     from decoy_cli.sim.engine import Simulator
-    from decoy_cli.sim.env import DecoyParallelEnv
     from decoy_cli.sim.random_play import RandomPolicy
     from decoy_cli.sim.setup import RoundSetup, open_round
 
 _EXPORTS = {
-    "DecoyArrayEnv": "decoy_cli.sim.array_env",
     "Decision": "decoy_cli.sim.decisions",
     "Simulator": "decoy_cli.sim.engine",
-    "DecoyParallelEnv": "decoy_cli.sim.env",
     "RandomPolicy": "decoy_cli.sim.random_play",
     "RoundSetup": "decoy_cli.sim.setup",
     "open_round": "decoy_cli.sim.setup",
@@ -31,8 +25,6 @@ _EXPORTS = {
 
 __all__ = [
     "Decision",
-    "DecoyArrayEnv",
-    "DecoyParallelEnv",
     "RandomPolicy",
     "RoundSetup",
     "Simulator",

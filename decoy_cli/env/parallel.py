@@ -21,10 +21,10 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from decoy_cli.sim.array_env import DEFAULT_WEAPONS, ArrayStep, DecoyArrayEnv
+from decoy_cli.env.array_env import DEFAULT_WEAPONS, ArrayStep, DecoyArrayEnv
+from decoy_cli.env.observation import NUM_ACTIONS
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.observation import NUM_ACTIONS
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World

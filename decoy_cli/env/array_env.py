@@ -24,16 +24,16 @@ from typing import TypeGuard, cast
 import numpy as np
 
 from decoy_cli.csgo import BUILTIN_MAP, seconds_to_ticks
+from decoy_cli.env.observation import ObservationEncoder
+from decoy_cli.env.step import ArrayStep, RoundSteps
+from decoy_cli.env.viewer import TopDownView
 from decoy_cli.errors import GraphError
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.env_step import ArrayStep, RoundSteps
-from decoy_cli.sim.observation import ObservationEncoder
 from decoy_cli.sim.quiet_play import Choices
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents
-from decoy_cli.sim.view import TopDownView
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import is_known

@@ -29,9 +29,9 @@ from numba.core import types
 from numba.experimental import structref
 
 from decoy_cli.compiled import jit_enabled, njit_cached
+from decoy_cli.env.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.movement.base import MoverBase
-from decoy_cli.sim.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.quiet_play import AIRBORNE, DECIDED, DUE, Choices, _play, hands_back
 from decoy_cli.sim.schedule import NEVER
 
