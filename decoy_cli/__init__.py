@@ -1,4 +1,4 @@
-"""decoy: replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity."""
+"""decoy: replay real CS:GO rounds on waypoint graphs of eight maps and measure replay fidelity."""
 
 from importlib.metadata import PackageNotFoundError, version
 

@@ -85,7 +85,7 @@ def _bug(error: Exception) -> str:
 
 app = typer.Typer(
     cls=_Group,
-    help="Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity.",
+    help="Replay real CS:GO rounds on waypoint graphs of eight maps and measure replay fidelity.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -105,7 +105,7 @@ def main(
     ),
     debug: bool = typer.Option(False, "--debug", help="Show a traceback for errors."),
 ) -> None:
-    """Replay real CS:GO rounds on a de_dust2 waypoint graph and measure replay fidelity."""
+    """Replay real CS:GO rounds on waypoint graphs of eight maps and measure replay fidelity."""
     global _debug
     _debug = debug
 
