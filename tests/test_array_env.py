@@ -17,7 +17,7 @@ from busy_rounds import Shots, count_quiet_steps, no_compiled_steps
 
 from decoy_cli.env.array_env import ArrayStep, DecoyArrayEnv
 from decoy_cli.env.parallel import DecoyParallelEnv
-from decoy_cli.env.step import LEFT_TO_RUN, PLAYED
+from decoy_cli.env.step import StepEnd
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch, DamageResult
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.waypoints.graph import STOP_ACTION
@@ -243,7 +243,7 @@ def _compiled_against_stepping(
     events and round summaries. Returns the kinds of events seen."""
     ended = count_quiet_steps(monkeypatch)
     compiled, compiled_events = play()
-    assert ended.count(PLAYED) > played and ended.count(LEFT_TO_RUN) > left
+    assert ended.count(StepEnd.PLAYED) > played and ended.count(StepEnd.LEFT_TO_RUN) > left
     no_compiled_steps(monkeypatch)
     stepped, stepped_events = play()
     assert len(compiled) == len(stepped)

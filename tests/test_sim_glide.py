@@ -19,7 +19,7 @@ from busy_rounds import (
     site_agents,
 )
 
-from decoy_cli.env.step import LEFT_TO_RUN, PLAYED
+from decoy_cli.env.step import StepEnd
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.waypoints.build import builtin_graph
@@ -109,8 +109,8 @@ def test_the_environment_plays_the_same_episodes_as_stepping_every_tick(monkeypa
 
     ended = count_quiet_steps(monkeypatch)
     glided = play()
-    assert ended.count(PLAYED) > 1000  # most steps ended in compiled code
-    assert ended.count(LEFT_TO_RUN) > 50  # and others went on in Python
+    assert ended.count(StepEnd.PLAYED) > 1000  # most steps ended in compiled code
+    assert ended.count(StepEnd.LEFT_TO_RUN) > 50  # and others went on in Python
 
     no_compiled_steps(monkeypatch)
     assert play() == glided

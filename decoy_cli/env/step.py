@@ -22,6 +22,7 @@ quiet.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntEnum
 from types import SimpleNamespace
 
 import numpy as np
@@ -32,16 +33,28 @@ from decoy_cli.compiled import jit_enabled, njit_cached
 from decoy_cli.env.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.movement.base import MoverBase
-from decoy_cli.sim.quiet_play import AIRBORNE, DECIDED, DUE, Choices, _play, hands_back
+from decoy_cli.sim.quiet_play import Choices, StretchEnd, _play, hands_back
 from decoy_cli.sim.schedule import NEVER
 
-PLAYED, LEFT_TO_RUN, BAD_ACTION, IN_THE_AIR, NOT_TAKEN, HALF_PLAYED = range(6)
-"""How `_quiet_step` ended: it played the step to its end; it left the rest of the step to
-Python (at the stretch's horizon, or at once when an action may hand back: a STOP to plant or
-defuse by an agent the rules watch, a damaging drop, a move no edge makes); an action is not
-0..8 (nothing was played); an agent asked to move is in the air; an action handed in was not
-taken; the stretch handed back with its tick half played (none of the last three can happen on
-a state the environment left)."""
+
+class StepEnd(IntEnum):
+    """How `_quiet_step` ended (none of the last three can happen on a state the environment
+    left)."""
+
+    PLAYED = 0
+    """It played the step to its end."""
+    LEFT_TO_RUN = 1
+    """It left the rest of the step to Python (at the stretch's horizon, or at once when an
+    action may hand back: a STOP to plant or defuse by an agent the rules watch, a damaging
+    drop, a move no edge makes)."""
+    BAD_ACTION = 2
+    """An action is not 0..8 (nothing was played)."""
+    IN_THE_AIR = 3
+    """An agent asked to move is in the air."""
+    NOT_TAKEN = 4
+    """An action handed in was not taken."""
+    HALF_PLAYED = 5
+    """The stretch handed back with its tick half played."""
 
 
 # ---- the round's arrays as one struct ---------------------------------------------------------
@@ -200,19 +213,19 @@ class RoundSteps:
             status, agent, tick, made = _quiet_step(
                 self._arrays, chosen, hand_in, start, *quiet.arrays, *out
             )
-            if status == BAD_ACTION:
+            if status == StepEnd.BAD_ACTION:
                 self._check(agent, chosen)
             hand_in = False
             if tick > start:  # `_quiet_step` took the positions and the bomb over itself
                 sim.note_quiet_play(tick, made, 0, False)
-            if status == PLAYED:  # nothing ended
+            if status == StepEnd.PLAYED:  # nothing ended
                 quiet.tick = tick
                 return ArrayStep(*out, tick, None, None)
-            if status == IN_THE_AIR:
+            if status == StepEnd.IN_THE_AIR:
                 raise ValueError("an agent due for a decision is in the air")
-            if status == NOT_TAKEN:
+            if status == StepEnd.NOT_TAKEN:
                 raise _not_taken(agent)
-            if status == HALF_PLAYED:
+            if status == StepEnd.HALF_PLAYED:
                 raise RuntimeError("a compiled step handed back in the middle of a tick")
             if tick == start:  # handed back before its first tick: play that one whole
                 sim.step()
@@ -356,9 +369,9 @@ def _quiet_step(
     if hand_in:
         bad = _hand_in(r, chosen)
         if bad >= 0:
-            return BAD_ACTION, bad, tick, 0
+            return StepEnd.BAD_ACTION, bad, tick, 0
         if _hands_back(r, chosen, watch):
-            return LEFT_TO_RUN, -1, tick, 0
+            return StepEnd.LEFT_TO_RUN, -1, tick, 0
     reached, _, made, _, glide_end, status = _play(
         tick, horizon, r.given, r.draws, 0, r.first, r.actions, r.hold_ticks, r.plant,
         r.defuse, NEVER, watch, r.top, r.out_edges, r.edge_target, r.edge_kind, r.edge_fall,
@@ -370,16 +383,17 @@ def _quiet_step(
         r.pos[:] = r.mpos
         if carrier >= 0:
             bomb_pos[:] = r.pos[carrier]
-    if status == AIRBORNE:
-        return IN_THE_AIR, -1, reached, made
-    if status == DECIDED:  # `_hands_back` missed a way back: the tick is half played
-        return HALF_PLAYED, -1, reached, made
-    if status != DUE or reached == tick:  # (an agent due with no action: Python says whom)
-        return LEFT_TO_RUN, -1, reached, made
+    if status == StretchEnd.AIRBORNE:
+        return StepEnd.IN_THE_AIR, -1, reached, made
+    if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played
+        return StepEnd.HALF_PLAYED, -1, reached, made
+    # (an agent due with no action: Python says whom)
+    if status != StretchEnd.DUE or reached == tick:
+        return StepEnd.LEFT_TO_RUN, -1, reached, made
     unused = _finish(
         r, -1, bomb_state, carrier, bomb_pos, round_inputs, False, reached, obs, masks, due,
         rewards, terminated, active,
     )  # fmt: skip
     if unused >= 0:
-        return NOT_TAKEN, unused, reached, made
-    return PLAYED, -1, reached, made
+        return StepEnd.NOT_TAKEN, unused, reached, made
+    return StepEnd.PLAYED, -1, reached, made

@@ -29,7 +29,7 @@ from decoy_cli.csgo import TICK_RATE, fall_damage
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.movement import KinematicMover, Mover, MoveStep
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.quiet_play import DECIDED
+from decoy_cli.sim.quiet_play import StretchEnd
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
@@ -250,7 +250,7 @@ class Simulator:
                 if horizon > self.tick:
                     before = (self.tick, self.decision_count)
                     watched = self.rules.watched(self.agents, self.bomb)
-                    if quiet_player(self, horizon, limit, watched) == DECIDED:
+                    if quiet_player(self, horizon, limit, watched) == StretchEnd.DECIDED:
                         self._after_decisions(end, stop)
                         continue
                     if (self.tick, self.decision_count) != before:

@@ -19,6 +19,7 @@ everyone once the bomb is planted). The engine takes over what the loop did
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import IntEnum
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
@@ -35,12 +36,22 @@ from decoy_cli.weapons import max_speed_m_s
 if TYPE_CHECKING:
     from decoy_cli.sim.engine import Simulator
 
-QUIET_END, NEED_DRAWS, DECIDED, DUE, AIRBORNE = range(5)
-"""How `_play` ended: it reached the stretch's end, or an agent due next was handed a move no
-edge makes (the next tick is Python's to play, which records the impossible move); it has too
-few draws left for the agents due next; it made decisions after which Python goes on with the
-tick; an agent is due with no action handed in (the tick is not begun); an agent asked to move
-is in the air."""
+
+class StretchEnd(IntEnum):
+    """How `_play` ended."""
+
+    QUIET_END = 0
+    """It reached the stretch's end, or an agent due next was handed a move no edge makes (the
+    next tick is Python's to play, which records the impossible move)."""
+    NEED_DRAWS = 1
+    """It has too few draws left for the agents due next."""
+    DECIDED = 2
+    """It made decisions after which Python goes on with the tick."""
+    DUE = 3
+    """An agent is due with no action handed in (the tick is not begun)."""
+    AIRBORNE = 4
+    """An agent asked to move is in the air."""
+
 
 DRAW = -2
 """In `Choices.given`: the agent's action is drawn (-1: none handed in; 0..8: this action)."""
@@ -121,7 +132,7 @@ def play_stretch(
     )  # fmt: skip
     choices.next_draw = used
     sim.note_quiet_play(tick, made, falls, glide_end >= 0)
-    if status == AIRBORNE:
+    if status == StretchEnd.AIRBORNE:
         raise ValueError("an agent due for a decision is in the air")
     return status
 
@@ -155,18 +166,18 @@ def _play(
     one = np.empty(1, np.int64)
     while True:
         if tick + 1 > horizon:
-            return tick, next_draw, made, falls, glide_end, QUIET_END
+            return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
         drawn = 0
         for i in range(n):
             if is_due(i, waiting, alive, hold_until, tick + 1):
                 if given[i] == -1:
-                    return tick, next_draw, made, falls, glide_end, DUE
+                    return tick, next_draw, made, falls, glide_end, StretchEnd.DUE
                 if given[i] == DRAW:
                     drawn += 1
                 elif given[i] != STOP_ACTION and out_edges[node[i], given[i]] < 0:
-                    return tick, next_draw, made, falls, glide_end, QUIET_END
+                    return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
         if drawn > draws.shape[0] - next_draw:
-            return tick, next_draw, made, falls, glide_end, NEED_DRAWS
+            return tick, next_draw, made, falls, glide_end, StretchEnd.NEED_DRAWS
         tick += 1
         hand_back = False
         for a in range(n):
@@ -203,13 +214,13 @@ def _play(
                 a, positions[goal, 0], positions[goal, 1], positions[goal, 2], edge_kind[edge],
                 top[a], top[a], jump_speed, gravity, pos, target, fv, iv,
             ):  # fmt: skip
-                return tick, next_draw, made, falls, glide_end, AIRBORNE
+                return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
-            return tick, next_draw, made, falls, glide_end, DECIDED
+            return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
         due_at = next_due(waiting, alive, hold_until, tick - 1)
         last = min(horizon, due_at - 1)
         if due_at == tick or last < tick:
-            return tick, next_draw, made, falls, glide_end, DECIDED
+            return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
         flags[:] = False
         ticks, _ = kinematic_glide(pos, start, target, fv, iv, flags, prm, last - tick + 1)
         tick += ticks - 1

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.quiet_play import DRAW, NEED_DRAWS, Choices, play_stretch
+from decoy_cli.sim.quiet_play import DRAW, Choices, StretchEnd, play_stretch
 
 if TYPE_CHECKING:
     from decoy_cli.sim.engine import Simulator
@@ -55,7 +55,7 @@ class RandomPolicy:
         choices = self._sized(sim.agents.count)
         while True:
             status = play_stretch(sim, horizon, max_decisions, watch, choices)
-            if status != NEED_DRAWS:
+            if status != StretchEnd.NEED_DRAWS:
                 return status
             self._refill()
 
