@@ -1,7 +1,12 @@
-"""Help of the options shared by `replay` and `evaluate`: who decides deaths, and what to do
-with the fields the data lacks (their choices are `Literal` types, which Typer lists)."""
+"""Help of options shared by several commands: the maps, who decides deaths, and what to do
+with the fields the data lacks (the last two are `Literal` types, which Typer lists)."""
 
 from __future__ import annotations
+
+from decoy_cli.csgo import MAP_NAMES
+
+MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
+"""The built-in maps, for the help of every `--map`."""
 
 DEATHS_HELP = (
     "Who decides deaths when shooting: simulated (the fight; a player the data shows dead whom "

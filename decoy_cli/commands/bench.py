@@ -24,6 +24,7 @@ from decoy_cli.bench import (
 )
 from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage import CHOICES_HELP, SHIPPED_CHOICES
 from decoy_cli.errors import DecoyError, OutputError
@@ -82,8 +83,8 @@ def bench(
     map_name: str = typer.Option(
         "dust2",
         "--map",
-        help="Built-in map of Table 1, the kinematic, env and combat-step sections (replay and "
-        "reader use the data's files).",
+        help=f"Built-in map of Table 1, the kinematic, env and combat-step sections ({MAPS_HELP}; "
+        "replay and reader use the data's files).",
     ),
     sections: str = typer.Option(
         ",".join(SECTIONS), "--sections", help="Comma-separated sections to run."

@@ -12,6 +12,7 @@ from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedCo
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.errors import GraphError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.files import check_writable
@@ -40,7 +41,9 @@ def _parse_point(text: str, option: str) -> list[float]:
 
 
 def build_waypoints(
-    map_name: str = typer.Option("dust2", "--map", help="Map whose places and spawns to use."),
+    map_name: str = typer.Option(
+        "dust2", "--map", help=f"Map whose places and spawns to use: {MAPS_HELP}."
+    ),
     mesh: Path | None = typer.Option(
         None, "--mesh", help="A user mesh (.obj or awpy .tri) instead of the built-in nav world."
     ),

@@ -16,6 +16,7 @@ from rich.progress import (
 )
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.errors import DecoyError, DownloadError
 from decoy_cli.esta.download import (
     DEFAULT_DEST,
@@ -58,7 +59,9 @@ def download(
         60.0, "--timeout", min=0.1, help="Seconds to wait for a connection or for more data."
     ),
     map_name: str = typer.Option(
-        "dust2", "--map", help="The map the matches must be on (a match of another is not kept)."
+        "dust2",
+        "--map",
+        help=f"The map the matches must be on ({MAPS_HELP}); a match of another is not kept.",
     ),
 ) -> None:
     """Download ESTA match files of one map by id, verified, into a folder.

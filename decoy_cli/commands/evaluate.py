@@ -23,7 +23,7 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MISSING_HELP
+from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
@@ -68,7 +68,9 @@ def evaluate(
         "sample shipped in examples/sample.",
     ),
     map_name: str = typer.Option(
-        "dust2", "--map", help="The map to evaluate; files of other maps are skipped."
+        "dust2",
+        "--map",
+        help=f"The map to evaluate ({MAPS_HELP}); files of other maps are skipped.",
     ),
     graph: Path | None = typer.Option(
         None,

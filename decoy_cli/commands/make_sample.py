@@ -11,6 +11,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
@@ -28,7 +29,7 @@ def make_sample(
     models: str = typer.Option(
         DEFAULT_MODELS, "--models", help=f"Damage models for combat: {CHOICES_HELP}."
     ),
-    map_name: str = typer.Option("dust2", "--map", help="The map to play on."),
+    map_name: str = typer.Option("dust2", "--map", help=f"The map to play on: {MAPS_HELP}."),
 ) -> None:
     """Write a synthetic ESTA match: scripted 5v5 rounds played in the simulator.
 

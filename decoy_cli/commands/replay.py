@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MISSING_HELP
+from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
@@ -34,7 +34,9 @@ def replay(
         help="kinematic (default: measured the more faithful) or physics (capsules that collide).",
     ),
     map_name: str | None = typer.Option(
-        None, "--map", help="The round's map (default: the one the file names); a check."
+        None,
+        "--map",
+        help=f"The round's map ({MAPS_HELP}; default: the one the file names); a check.",
     ),
     graph_file: Path | None = typer.Option(
         None,

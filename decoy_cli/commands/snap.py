@@ -9,6 +9,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.commands._snap_output import (
     show_actions,
     show_places,
@@ -46,7 +47,9 @@ def snap(
         help="One round (match.json.xz:3), every round of a match file, or of a folder of them.",
     ),
     map_name: str = typer.Option(
-        "dust2", "--map", help="The map whose built-in graph to snap to (other maps' files fail)."
+        "dust2",
+        "--map",
+        help=f"The map whose built-in graph to snap to ({MAPS_HELP}); other maps' files fail.",
     ),
     graph_file: Path | None = typer.Option(
         None, "--graph", help="Waypoint graph (.npz from build-waypoints; overrides --map)."
