@@ -33,13 +33,21 @@ class _Group(TyperGroup):
     """The one error boundary of every command: a `DecoyError` (bad input) or an `OSError` (a
     path the system refuses, a full disk) is one `error:` line on stderr and exit code 1; any
     other exception is a bug, reported in one line as such with exit code 2. `--debug` shows
-    the traceback instead. Typer's own exits and usage errors pass through."""
+    the traceback instead. A usage error (an unknown option, a value not among an option's
+    choices) is one `error:` line too, with exit code 2 as Click gives it; Typer's own exits
+    pass through."""
 
     def invoke(self, ctx: typer.Context):  # type: ignore[override]
         try:
             return super().invoke(ctx)
-        except (typer.Exit, typer.Abort, TyperException):
-            raise  # Typer's own exits, aborts and usage errors
+        except (typer.Exit, typer.Abort):
+            raise  # Typer's own exits and aborts
+        except TyperException as error:
+            if getattr(error, "exit_code", None) != 2:  # not a usage error (Typer's own class)
+                raise
+            context = getattr(error, "ctx", None)
+            command = f"{context.command_path} --help" if context is not None else "--help"
+            _fail(f"{error.format_message()} (see {command})", 2)
         except DecoyError as error:
             _fail(str(error), 1)
         except BrokenPipeError:

@@ -422,13 +422,17 @@ def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path
         ([str(tmp_path / "nowhere")], "no such file or folder"),
         ([str(tmp_path), "--combat"], "no .json.xz or .json match files"),
         ([str(clean), "--map", "cache"], "unknown map 'cache'"),
-        ([str(clean), "--no-combat", "--no-bomb", "--mover", "teleport"], "unknown mover"),
         ([str(clean), "--combat", "--models", str(tmp_path / "no-models")], "no such model"),
     ):
         result = _invoke(*args, "--out", str(tmp_path / "out"))
         assert result.exit_code == 1, args
         assert result.output.startswith("error: ") and expected in result.output, result.output
         assert len(result.output.strip().splitlines()) == 1
+    # a choice the option does not have is a usage error: one line too, exit code 2
+    result = _invoke(str(clean), "--mover", "teleport", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1
+    assert result.output.startswith("error: Invalid value for '--mover'"), result.output
+    assert "'kinematic', 'physics'" in result.output and "evaluate --help" in result.output
 
 
 def test_a_copy_of_the_shipped_graph_gives_the_shipped_results(

@@ -34,7 +34,7 @@ from decoy_cli.bench.simspeed import (
 )
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.errors import DecoyError
-from decoy_cli.sim.setup import check_mover
+from decoy_cli.sim.setup import MoverName
 from decoy_cli.waypoints.build import canonical_map
 
 REPORT_FORMAT = 1
@@ -61,7 +61,7 @@ class BenchConfig:
 
     quick: bool
     models: str
-    mover: str = "physics"
+    mover: MoverName = "physics"
     combat: bool = True
     bomb: bool = True
     seed: int = 0
@@ -79,7 +79,7 @@ class BenchConfig:
         *,
         quick: bool,
         models: str,
-        mover: str = "physics",
+        mover: MoverName = "physics",
         combat: bool = True,
         bomb: bool = True,
         seed: int = 0,
@@ -87,7 +87,6 @@ class BenchConfig:
     ) -> BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
         round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
-        check_mover(mover)
         switches = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
         map_id = canonical_map(map_name)
         if not quick:

@@ -22,7 +22,7 @@ import numpy as np
 from decoy_cli.csgo import BUILTIN_MAP, TICK_RATE
 from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
 from decoy_cli.sim.random_play import RandomPolicy
-from decoy_cli.sim.setup import RoundSetup, open_round
+from decoy_cli.sim.setup import MoverName, RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -50,7 +50,7 @@ class NeverHits:
 class Switches(TypedDict):
     """The mechanics a Table 1 run switches (keyword arguments of `run_agents`)."""
 
-    mover: str
+    mover: MoverName
     combat: bool
     bomb: bool
     seed: int
@@ -61,7 +61,7 @@ class SpeedRow:
     """One Table 1 row: totals over the restarted rounds of one agent count."""
 
     agents: int
-    mover: str
+    mover: MoverName
     rounds: int
     ticks: int
     decisions: int
@@ -99,7 +99,7 @@ def run_agents(
     decisions: int,
     model: DamageModel,
     *,
-    mover: str = "physics",
+    mover: MoverName = "physics",
     combat: bool = True,
     bomb: bool = True,
     seed: int = 0,
@@ -153,7 +153,7 @@ def speed_table(
     decisions: int = PAPER_DECISIONS,
     model: DamageModel | None = None,
     *,
-    mover: str = "physics",
+    mover: MoverName = "physics",
     combat: bool = True,
     bomb: bool = True,
     seed: int = 0,

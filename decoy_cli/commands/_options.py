@@ -19,3 +19,8 @@ MISSING_HELP = (
     "defuser): infer (filled by the rules of decoy_cli/replay/missing.py and named per round "
     "in the outputs) or error (the round fails)."
 )
+MOVER_HELP = (
+    "kinematic (compiled motion along the graph's edges, agents pass through each other; "
+    "measured the more faithful in replays) or physics (pybullet capsules that block each "
+    "other, as the paper's engine)"
+)

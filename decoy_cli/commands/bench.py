@@ -24,11 +24,12 @@ from decoy_cli.bench import (
 )
 from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import MAPS_HELP
+from decoy_cli.commands._options import MAPS_HELP, MOVER_HELP
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage import CHOICES_HELP, SHIPPED_CHOICES
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
+from decoy_cli.sim.setup import MoverName
 
 DEFAULT_OUT = Path("decoy-out") / "bench" / "bench.json"
 
@@ -64,10 +65,8 @@ def bench(
         help="Folder of ESTA match files for the replay and reader sections (default: "
         "../shared/data/esta_dust2_tside when present, else the sample in examples/sample/).",
     ),
-    mover: str = typer.Option(
-        "physics",
-        "--mover",
-        help="Mover of Table 1: physics (capsules, as the paper) or kinematic.",
+    mover: MoverName = typer.Option(
+        "physics", "--mover", help=f"Mover of Table 1 (physics, as the paper): {MOVER_HELP}."
     ),
     combat: bool = typer.Option(
         True,

@@ -23,7 +23,7 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP
+from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
@@ -52,6 +52,7 @@ from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
+from decoy_cli.sim.setup import MoverName
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -94,9 +95,7 @@ def evaluate(
     models: str = typer.Option(
         DEFAULT_MODELS, "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
     ),
-    mover: str = typer.Option(
-        "kinematic", "--mover", help="kinematic (default) or physics (capsules that collide)."
-    ),
+    mover: MoverName = typer.Option("kinematic", "--mover", help=f"The mover: {MOVER_HELP}."),
     deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
     missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
     out: Path = typer.Option(

@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP
+from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
@@ -19,7 +19,7 @@ from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
-from decoy_cli.sim.setup import check_mover
+from decoy_cli.sim.setup import MoverName
 
 
 def replay(
@@ -28,11 +28,7 @@ def replay(
         True, "--combat/--no-combat", help="Shooting, with the damage models of --models."
     ),
     bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
-    mover: str = typer.Option(
-        "kinematic",
-        "--mover",
-        help="kinematic (default: measured the more faithful) or physics (capsules that collide).",
-    ),
+    mover: MoverName = typer.Option("kinematic", "--mover", help=f"The mover: {MOVER_HELP}."),
     map_name: str | None = typer.Option(
         None,
         "--map",
@@ -67,7 +63,6 @@ def replay(
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
     console = make_console()
-    check_mover(mover)
     policy = check_policy(implausible)
     damage_model = load_damage_model(models) if combat else None
     if combat and damage_model is None:

@@ -32,7 +32,7 @@ from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.quiet_play import Choices
-from decoy_cli.sim.setup import RoundSetup, open_round
+from decoy_cli.sim.setup import MoverName, RoundSetup, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -98,7 +98,7 @@ class DecoyArrayEnv:
         map: str | None = None,
         graph: WaypointGraph | None = None,
         world: World | None = None,
-        mover: str = "kinematic",
+        mover: MoverName = "kinematic",
         damage_model: DamageModel | Callable[[], DamageModel | None] | None = None,
         combat: bool = True,
         bomb: bool = True,

@@ -25,6 +25,7 @@ from decoy_cli.env.array_env import DEFAULT_WEAPONS, ArrayStep, DecoyArrayEnv
 from decoy_cli.env.observation import NUM_ACTIONS
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Simulator
+from decoy_cli.sim.setup import MoverName
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
@@ -125,7 +126,7 @@ class DecoyParallelEnv(ParallelEnv):
         map: str | None = None,
         graph: WaypointGraph | None = None,
         world: World | None = None,
-        mover: str = "kinematic",
+        mover: MoverName = "kinematic",
         damage_model: DamageModel | Callable[[], DamageModel | None] | None = None,
         combat: bool = True,
         bomb: bool = True,

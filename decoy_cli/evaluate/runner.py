@@ -53,6 +53,7 @@ from decoy_cli.evaluate.settings import (
 from decoy_cli.evaluate.tables import Accumulator
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
+from decoy_cli.sim.setup import MoverName
 from decoy_cli.waypoints.graph import WaypointGraph
 
 
@@ -109,7 +110,7 @@ def make_settings(
     combat: bool,
     bomb: bool,
     models: str,
-    mover: str,
+    mover: MoverName,
     seed: int,
     implausible: Implausible = "fail",
     deaths: DeathProtocol = "simulated",
@@ -120,11 +121,9 @@ def make_settings(
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round. `fastdtw` None
     means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise."""
-    from decoy_cli.sim.setup import check_mover
     from decoy_cli.waypoints.build import canonical_map
 
     name = canonical_map(map_name)
-    check_mover(mover)
     graph_path, graph_sha = "", ""
     if graph is not None:  # absolute, for workers elsewhere; its map must be the run's
         graph_path = str(graph.expanduser().resolve())

@@ -23,6 +23,7 @@ from decoy_cli.world.navmesh import asset_dir, load_navmesh
 if TYPE_CHECKING:
     from decoy_cli.replay.deaths import DeathProtocol
     from decoy_cli.replay.missing import Missing
+    from decoy_cli.sim.setup import MoverName
 
 RECORD_VERSION = 6
 """Format of the cached per-round records and file indexes; bump when it changes."""
@@ -104,7 +105,7 @@ class EvalSettings:
     combat: bool
     bomb: bool
     models: str
-    mover: str
+    mover: MoverName
     seed: int
     grid: HeatGrid
     code: str

@@ -52,7 +52,7 @@ from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Recording
 from decoy_cli.sim.rules import RulesConfig
-from decoy_cli.sim.setup import OpenRound, RoundSetup, check_mover, open_round
+from decoy_cli.sim.setup import MoverName, OpenRound, RoundSetup, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import FIREARMS, max_speed_m_s
@@ -222,7 +222,7 @@ class ReplayOptions:
 
     combat: bool = True
     bomb: bool = True
-    mover: str = "kinematic"
+    mover: MoverName = "kinematic"
     damage_model: DamageModel | None = None
     # With shooting, a round still undecided when the data ends (the replay's fights went
     # otherwise than the real ones) is played on, every agent holding its last waypoint and
@@ -237,9 +237,6 @@ class ReplayOptions:
     implausible: Implausible = "fail"
     """Whether a player far off the map fails the round or is a warning (as the reader's
     policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
-
-    def __post_init__(self) -> None:
-        check_mover(self.mover)
 
     def setup(self, graph: WaypointGraph, round_: Round) -> RoundSetup:
         """The simulator setup of a replay of `round_` on `graph`."""

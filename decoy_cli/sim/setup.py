@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import AbstractContextManager, ExitStack, contextmanager
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal, get_args
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
@@ -33,20 +33,14 @@ if TYPE_CHECKING:
     from decoy_cli.world.physics import PhysicsWorld
     from decoy_cli.world.world import World
 
-MOVERS = ("kinematic", "physics")
+MoverName = Literal["kinematic", "physics"]
 """The movers: "kinematic" (compiled motion along the edges, agents pass through each other)
 and "physics" (pybullet capsules that block each other)."""
+MOVERS: tuple[MoverName, ...] = get_args(MoverName)
 
 
 class SetupError(DecoyError, ValueError):
     """A round setup that cannot be played (an unknown mover, a combat cadence below one tick)."""
-
-
-def check_mover(mover: str) -> str:
-    """The mover's name if it is one of `MOVERS`, else a SetupError naming them."""
-    if mover not in MOVERS:
-        raise SetupError(f"unknown mover {mover!r} (use {' or '.join(MOVERS)})")
-    return mover
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -60,7 +54,7 @@ class RoundSetup:
     """
 
     graph: WaypointGraph
-    mover: str = "kinematic"
+    mover: MoverName = "kinematic"
     combat: bool = True
     bomb: bool = True
     damage_model: DamageModel | None = None
@@ -73,7 +67,8 @@ class RoundSetup:
     zones: SiteZones | None = None
 
     def __post_init__(self) -> None:
-        check_mover(self.mover)
+        if self.mover not in MOVERS:
+            raise SetupError(f"unknown mover {self.mover!r} (use {' or '.join(MOVERS)})")
         if self.combat_every_ticks < 1:
             raise SetupError(f"combat_every_ticks must be >= 1, got {self.combat_every_ticks}")
 
