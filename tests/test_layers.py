@@ -29,6 +29,7 @@ LAYERS = {
     "replay": 5,
     "damage": 5,
     "synth": 5,
+    "view": 5,  # the view page: reads what replay and evaluate write
     "evaluate": 6,
     "bench": 6,
     "rl": 6,

@@ -268,6 +268,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
                 for row in tables.rounds.itertuples()
                 if row.inferred
             },
+            "cache_keys": dict(sorted(evaluation.cache_keys.items())),
         }
     )
 

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from decoy_cli.replay.deaths import DeathProtocol
     from decoy_cli.replay.missing import Missing
 
-RECORD_VERSION = 6
+RECORD_VERSION = 7
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HEAT_CELL_M = 0.5
@@ -49,6 +49,7 @@ _CODE_PARTS = (
     "evaluate/job.py",
     "evaluate/record.py",
     "evaluate/settings.py",
+    "view/trace.py",
 )
 """The package's modules that decide a round's result (presentation code is left out)."""
 
