@@ -133,6 +133,12 @@ def evaluate(
         show_default=False,
         help="Local worker processes (default: the number of cores).",
     ),
+    view: bool = typer.Option(
+        True,
+        "--view/--no-view",
+        help="Write view.html beside report.md: one page to look at any round, real against "
+        "replay (`decoy view`).",
+    ),
     scheduler: str | None = typer.Option(
         None,
         "--scheduler",
@@ -194,7 +200,7 @@ def evaluate(
                 )
             started = time.perf_counter()
             tables = build_tables(evaluation.accumulator)
-            write_outputs(evaluation, tables, out, info)
+            write_outputs(evaluation, tables, out, info, view=view)
         except KeyboardInterrupt:
             console.print(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "
