@@ -10,6 +10,7 @@ google-chrome on the PATH; Debian's /usr/bin/chromium is a shell wrapper, so its
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import os
 import shutil
@@ -85,20 +86,16 @@ class Browser:
         self.close()
 
     def close(self) -> None:
-        try:
+        with contextlib.suppress(OSError, RuntimeError):
             self.call("Browser.close")
-        except (OSError, RuntimeError):
-            pass
         try:
             self.process.wait(10)
         except subprocess.TimeoutExpired:
             self.process.kill()
             self.process.wait()
         for fd in (self._in, self._out):
-            try:
+            with contextlib.suppress(OSError):
                 os.close(fd)
-            except OSError:
-                pass
         shutil.rmtree(self.profile, ignore_errors=True)
 
     def call(self, method: str, params: dict[str, Any] | None = None, session: bool = False) -> Any:
@@ -163,7 +160,8 @@ class Browser:
         """PNG of the element `selector`."""
         box = self.evaluate(
             f"(() => {{ const r = document.querySelector({json.dumps(selector)})"
-            ".getBoundingClientRect(); return [r.x + scrollX, r.y + scrollY, r.width, r.height]; })()"
+            ".getBoundingClientRect();"
+            " return [r.x + scrollX, r.y + scrollY, r.width, r.height]; })()"
         )
         clip = {"x": box[0], "y": box[1], "width": box[2], "height": box[3], "scale": 1}
         data = self.call(
