@@ -5,7 +5,7 @@ counts of original and replayed positions on the fixed `HeatGrid` and the replay
 error by original position, sample counts and errors by nav place, and HP as integer sums
 (pooled, per data frame and per time bin): integers only, so the aggregates are exact and do
 not depend on the order in which rounds finish; and the thinned paths and events the view
-page draws (`decoy_cli.view.trace`). `build_record` makes it from a replay.
+page draws (`decoy_cli.replay.view_trace`). `build_record` makes it from a replay.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
 from decoy_cli.replay.deaths import replay_deaths
-from decoy_cli.view.trace import RoundTrace, round_trace
+from decoy_cli.replay.view_trace import RoundTrace, round_trace
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask

@@ -49,7 +49,6 @@ _CODE_PARTS = (
     "evaluate/job.py",
     "evaluate/record.py",
     "evaluate/settings.py",
-    "view/trace.py",
 )
 """The package's modules that decide a round's result (presentation code is left out)."""
 

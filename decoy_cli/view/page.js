@@ -270,7 +270,7 @@
       const w = where[i];
       const error = errorOf(w);
       let text = error === null ? "–" : error.toFixed(2);
-      if (error === null && (w.real || w.replay)) text = w.real ? "replay dead" : "real dead";
+      if (error === null && (w.real || w.replay)) text = w.real ? "dead in replay" : "dead in data";
       rows[i].cells[3].textContent = text;
     });
     for (const li of $("events").children) {

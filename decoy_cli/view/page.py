@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from decoy_cli.errors import DecoyError
 from decoy_cli.files import json_ready, write_atomic
 
 PageData = dict[str, Any]
@@ -98,3 +99,13 @@ def _cell(value: Any, digits: int) -> Any:
             return None
         return float(f"{value:.{digits}g}")
     return str(value)
+
+
+def round_index(data: PageData, label: str) -> int:
+    """The index of the round labelled `label` ("MATCH:ROUND"); a DecoyError naming a few of
+    the labels when there is none."""
+    labels = [r["label"] for r in data["rounds"]]
+    if label in labels:
+        return labels.index(label)
+    shown = ", ".join(labels[:3]) + (", ..." if len(labels) > 3 else "")
+    raise DecoyError(f"no round {label} in this page's {len(labels)} rounds ({shown or 'none'})")
