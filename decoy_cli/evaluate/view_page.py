@@ -11,7 +11,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-import msgspec
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
@@ -19,7 +18,8 @@ from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.compare import read_run
 from decoy_cli.evaluate.runner import round_id
 from decoy_cli.metrics import ALL_METRIC_NAMES
-from decoy_cli.view.page import PageData, map_floor, table_spec
+from decoy_cli.text import visible
+from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
 
 TABLES = (
     ("trajectory", "Trajectory fidelity (metres): both protocols, by side"),
@@ -54,7 +54,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     cache = RunCache(cache_root or folder)
     rounds: list[dict[str, Any]] = []
     for row in run.rounds.itertuples():
-        label = f"{row.match}:{row.round}"
+        label = f"{visible(str(row.match))}:{row.round}"
         key = keys.get(round_id(str(row.file_sha), int(row.round)))
         record = cache.load_round(key) if isinstance(key, str) else None
         if record is None:
@@ -67,7 +67,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
             f"{row.winner_replay} ({row.reason_replay}) · {row.frames} frames, "
             f"{float(row.seconds):.0f} s"
         )
-        rounds.append({"label": label, "info": info, **msgspec.to_builtins(record.trace)})
+        rounds.append(round_entry(f"{record.match_id}:{record.round_num}", info, record.trace))
     metrics = [m for m in ALL_METRIC_NAMES if m in run.players.columns]
     columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
     missing = [c for c in columns if c not in run.players.columns]
@@ -75,6 +75,9 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
         raise DecoyError(f"{folder / 'players.csv'}: lacks the columns {', '.join(missing)}")
     players = table_spec("", run.players[columns])
     players["round"], players["player"] = _player_rows(folder, run.players, rounds)
+    for row, r, p in zip(players["rows"], players["round"], players["player"], strict=True):
+        row[0] = rounds[r]["label"].rsplit(":", 1)[0]  # as recorded, not as the CSV made it inert
+        row[2] = rounds[r]["players"][p]["name"]
     options = summary.get("options", {})
     return {
         "title": f"decoy evaluate: {folder.resolve().name}",
@@ -116,12 +119,8 @@ def _player_rows(
         for p in range(len(round_["players"])):
             round_of.append(index)
             player_of.append(p)
-    names = [(r["label"], p["name"]) for r in rounds for p in r["players"]]
-    found = [
-        (f"{m}:{n}", str(p))
-        for m, n, p in players[["match", "round", "player"]].itertuples(index=False)
-    ]
-    if found != names:
+    numbers = [int(rounds[r]["label"].rsplit(":", 1)[1]) for r in round_of]
+    if pd.to_numeric(players["round"], errors="coerce").tolist() != numbers:
         raise DecoyError(
             f"{folder / 'players.csv'}: its rows are not the players of the cached rounds "
             "(an edited file, or a folder of two runs); run `decoy evaluate` into it again"

@@ -19,11 +19,14 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import json_ready, write_atomic
+from decoy_cli.replay.view_trace import RoundTrace
+from decoy_cli.text import visible
 
 PageData = dict[str, Any]
 
@@ -76,6 +79,16 @@ def map_floor(map_name: str) -> dict[str, Any]:
     rows = np.column_stack([nav.x_min, nav.y_min, nav.x_max, nav.y_max, z]) * HAMMER_TO_M * 10
     rows = rows[np.argsort(rows[:, 4], kind="stable")]
     return {"name": map_name, "areas": np.rint(rows).astype(np.int64).reshape(-1).tolist()}
+
+
+def round_entry(label: str, info: str, trace: RoundTrace) -> dict[str, Any]:
+    """One round of the page: its label, a line about it and its trace, the players' names
+    with their control characters written as escapes (`decoy_cli.text.visible`)."""
+    entry: dict[str, Any] = {"label": visible(label), "info": visible(info)}
+    entry.update(msgspec.to_builtins(trace))
+    for player in entry["players"]:
+        player["name"] = visible(player["name"])
+    return entry
 
 
 def table_spec(title: str, frame: pd.DataFrame, digits: int = 4) -> dict[str, Any]:

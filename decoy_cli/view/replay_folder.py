@@ -18,7 +18,8 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
-from decoy_cli.view.page import PageData, map_floor, table_spec
+from decoy_cli.text import visible
+from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
 
 REPLAY_MARKER = "replay.csv"
 """The file that tells a replay's folder from an evaluate run's."""
@@ -61,6 +62,8 @@ def replay_page(folder: Path) -> PageData:
         f"{replay.get('winner')} ({replay.get('reason')}) · {summary.get('frames', '?')} frames"
     )
     table = table_spec("", players[columns])
+    for row, player in zip(table["rows"], trace.players, strict=True):
+        row[0] = visible(player.name)  # as recorded, not as the CSV made it inert
     table["round"] = [0] * len(players)
     table["player"] = list(range(len(players)))
     return {
@@ -69,7 +72,7 @@ def replay_page(folder: Path) -> PageData:
         "map": map_floor(trace.map_name),
         "tables": [table_spec("The replay", _summary_rows(summary))],
         "players": table,
-        "rounds": [{"label": label, "info": info, **msgspec.to_builtins(trace)}],
+        "rounds": [round_entry(label, info, trace)],
         "initial": 0,
     }
 
