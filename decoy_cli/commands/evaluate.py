@@ -212,8 +212,9 @@ def evaluate(
     try:
         _show(console, evaluation, tables)
         console.print(
-            f"outputs written to {out} (report: {out / 'report.md'}) in "
-            f"{time.perf_counter() - started:.1f} s",
+            f"outputs written to {out} (report: {out / 'report.md'}"
+            + (f", rounds to look at: {out / 'view.html'}" if view else "")
+            + f") in {time.perf_counter() - started:.1f} s",
             highlight=False,
         )
     except KeyboardInterrupt:  # the outputs are complete: only the summary is cut short
