@@ -51,6 +51,8 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
             f"{folder}: written by an older decoy (its summary.json names no cached rounds); "
             "run the same `decoy evaluate` into it again"
         )
+    if not pd.api.types.is_integer_dtype(run.rounds["round"]):
+        raise DecoyError(f"{folder / 'rounds.csv'}: a row without a round number")
     cache = RunCache(cache_root or folder)
     rounds: list[dict[str, Any]] = []
     for row in run.rounds.itertuples():
@@ -76,11 +78,13 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     players = table_spec("", run.players[columns])
     players["round"], players["player"] = _player_rows(folder, run.players, rounds)
     for row, r, p in zip(players["rows"], players["round"], players["player"], strict=True):
-        row[0] = rounds[r]["label"].rsplit(":", 1)[0]  # as recorded, not as the CSV made it inert
+        # match and player (PLAYER_COLUMNS) as recorded, not as the CSV made them inert
+        row[0] = rounds[r]["label"].rsplit(":", 1)[0]
         row[2] = rounds[r]["players"][p]["name"]
-    options = summary.get("options", {})
+    options = summary.get("options")
+    options = options if isinstance(options, dict) else {}
     return {
-        "title": f"decoy evaluate: {folder.resolve().name}",
+        "title": f"decoy evaluate: {(cache_root or folder).resolve().name}",
         "subtitle": f"{summary.get('data', '?')} data · {summary.get('mechanics', '')} · "
         f"{len(rounds)} rounds · map {options.get('map', '?')}",
         "map": map_floor(str(options.get("map") or _map_of(rounds))),
