@@ -64,9 +64,11 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
                 f"{folder}: the cached result of round {label} is missing or was written by "
                 "another decoy version; run the same `decoy evaluate` into it again"
             )
+        said = {k: _said(getattr(row, k)) for k in ("winner_original", "reason_original")}
+        said |= {k: _said(getattr(row, k)) for k in ("winner_replay", "reason_replay")}
         info = (
-            f"winner: data {row.winner_original} ({row.reason_original}), replay "
-            f"{row.winner_replay} ({row.reason_replay}) · {row.frames} frames, "
+            f"winner: data {said['winner_original']} ({said['reason_original']}), replay "
+            f"{said['winner_replay']} ({said['reason_replay']}) · {row.frames} frames, "
             f"{float(row.seconds):.0f} s"
         )
         rounds.append(round_entry(f"{record.match_id}:{record.round_num}", info, record.trace))
@@ -107,6 +109,11 @@ def _summary(path: Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise DecoyError(f"{path}: not a summary of a `decoy evaluate` run")
     return data
+
+
+def _said(value: object) -> str:
+    """A cell of rounds.csv as text; an empty one as "–"."""
+    return "–" if pd.isna(value) else str(value)
 
 
 def _map_of(rounds: list[dict[str, Any]]) -> str:
