@@ -101,6 +101,19 @@ def test_the_page_holds_every_player_round_of_players_csv(run: Path) -> None:
         assert player["name"] == players["player"][row]
         # the moment a row opens on is the largest error the metrics measured
         assert player["worst_m"] == pytest.approx(players["max_dist"][row], abs=1e-9)
+        # and its deaths are the kills drawn, it the victim: at its death time, or (a death
+        # the frames did not record) not before the round's last frame
+        shown_round = data["rounds"][r]
+        for source, name in (("data", "original"), ("replay", "replay")):
+            kills = [
+                e[0] / 100
+                for e in shown_round["events"]
+                if e[1:3] == [source, "kill"] and e[4] == p
+            ]
+            if players[f"died_{name}"][row]:
+                assert kills == [pytest.approx(players[f"death_time_{name}_s"][row], abs=0.01)]
+            else:
+                assert all(t >= shown_round["end"] / 100 - 1e-9 for t in kills), (row, source)
 
 
 def test_the_page_holds_the_cached_trace_of_every_round(run: Path) -> None:

@@ -48,15 +48,15 @@ class PlayerTrace(msgspec.Struct, frozen=True):
 class RoundEvent(msgspec.Struct, frozen=True, array_like=True):
     """Something that happened in the data or in the replay: `kind` is "kill" (player: the
     attacker, -1 unknown; other: the victim), "carry" (the bomb's carrier from then on),
-    "drop", "plant", "defuse" or "explode"; (x, y) where, in decimetres."""
+    "drop", "plant", "defuse" or "explode"; (x, y) where, in decimetres (None: not known)."""
 
     t: int
     source: str
     kind: str
     player: int
     other: int
-    x: int
-    y: int
+    x: int | None
+    y: int | None
 
 
 class RoundTrace(msgspec.Struct, frozen=True):
@@ -154,8 +154,9 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
 
 def _event(t: float, source: str, kind: str, player: int, other: int, where: object) -> RoundEvent:
     x, y = (np.asarray(where, np.float64).reshape(-1)[:2] * DM).tolist()
-    x, y = (round(v) if math.isfinite(v) else 0 for v in (x, y))
-    return RoundEvent(round(float(t) * CS), source, kind, int(player), int(other), x, y)
+    known = math.isfinite(x) and math.isfinite(y)
+    at = (round(x), round(y)) if known else (None, None)
+    return RoundEvent(round(float(t) * CS), source, kind, int(player), int(other), *at)
 
 
 def _last_position(positions: np.ndarray, seconds: np.ndarray, t: float) -> np.ndarray:

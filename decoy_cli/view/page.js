@@ -51,7 +51,8 @@
       real: p.original.map(decodeSegment), replay: p.replay.map(decodeSegment),
     }));
     const events = round.events.map((e) => ({
-      t: e[0] / 100, source: e[1], kind: e[2], player: e[3], other: e[4], x: e[5] / 10, y: e[6] / 10,
+      t: e[0] / 100, source: e[1], kind: e[2], player: e[3], other: e[4],
+      x: e[5] === null ? null : e[5] / 10, y: e[6] === null ? null : e[6] / 10,
     }));
     let end = round.end / 100;
     for (const e of events) end = Math.max(end, e.t);
@@ -168,6 +169,7 @@
     for (const e of r.events) {
       if (e.source !== source || e.t > t + 1e-6) continue;
       if (e.kind === "carry") bomb = { carrier: e.player };
+      else if (e.x === null) bomb = null; // where is not known
       else if (e.kind === "drop") bomb = { x: e.x, y: e.y, label: "dropped" };
       else if (e.kind === "plant") bomb = { x: e.x, y: e.y, label: "planted", planted: true };
       else if (e.kind === "defuse") bomb = { x: e.x, y: e.y, label: "defused", defused: true };
@@ -215,6 +217,7 @@
       const victim = r.players[e.other];
       const isReal = e.source === "data";
       if (!victim || !visible(e.other, victim) || (isReal ? !showReal : !showReplay)) continue;
+      if (e.x === null) continue; // where is not known
       cross(e.x, e.y, isReal ? "#888" : (SIDE_COLOUR[victim.side] || "#555"), 5);
       if (t - e.t <= KILL_SHOWN_S && e.player >= 0 && where[e.player]) {
         const from = isReal ? at(r.players[e.player].real, e.t) : at(r.players[e.player].replay, e.t);
