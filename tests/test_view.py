@@ -251,6 +251,32 @@ def test_a_replay_folder_gets_its_page(tmp_path: Path) -> None:
     assert "older decoy" in one_error(runner.invoke(app, ["view", str(out)]))
 
 
+@pytest.fixture(scope="module")
+def empty_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A run whose every round failed: its page has no round."""
+    folder = tmp_path_factory.mktemp("empty")
+    (folder / "in").mkdir()
+    (folder / "in" / "broken.json").write_text("{")
+    out = folder / "evaluate"
+    result = runner.invoke(app, ["evaluate", str(folder / "in"), "--out", str(out)])
+    assert result.exit_code == 1, result.output  # the failure is recorded
+    return out
+
+
+def test_a_run_without_a_round_still_gets_its_page(empty_run: Path) -> None:
+    data = page_data(empty_run / "view.html")
+    assert data["rounds"] == [] and data["players"]["rows"] == []
+
+
+@needs_browser
+def test_a_page_without_a_round_opens(browser: Browser, empty_run: Path) -> None:
+    browser.open(empty_run / "view.html")
+    assert browser.console_errors() == []
+    assert browser.evaluate("document.getElementById('round-info').textContent") == (
+        "no round to show"
+    )
+
+
 # ---- hostile names ----------------------------------------------------------------------------
 
 

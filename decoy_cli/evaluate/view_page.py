@@ -51,7 +51,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
             f"{folder}: written by an older decoy (its summary.json names no cached rounds); "
             "run the same `decoy evaluate` into it again"
         )
-    if not pd.api.types.is_integer_dtype(run.rounds["round"]):
+    if len(run.rounds) and not pd.api.types.is_integer_dtype(run.rounds["round"]):
         raise DecoyError(f"{folder / 'rounds.csv'}: a row without a round number")
     cache = RunCache(cache_root or folder)
     rounds: list[dict[str, Any]] = []
