@@ -401,6 +401,11 @@ def test_keys_play_pause_and_step(browser: Browser, run: Path) -> None:
     browser.wait_for("parseFloat(document.getElementById('clock').textContent) > 15.2")
     browser.key(" ", "Space", 32)
     assert browser.evaluate("document.getElementById('play').textContent") == "play"
+    # on a check box Space is the box's: it hides the player, and nothing plays
+    browser.evaluate("document.querySelector('#at-cursor input').focus()")
+    browser.key(" ", "Space", 32)
+    assert browser.evaluate("document.querySelector('#at-cursor input').checked") is False
+    assert browser.evaluate("document.getElementById('play').textContent") == "play"
     assert browser.console_errors() == []
 
 

@@ -378,7 +378,10 @@
   document.addEventListener("keydown", (e) => {
     const target = e.target;
     const typing = target instanceof HTMLSelectElement || (target instanceof HTMLInputElement && target.type === "range");
-    if (e.key === " " && !(target instanceof HTMLButtonElement) && !(target instanceof HTMLSelectElement)) {
+    // Space plays and pauses, except on a control that Space works itself (a button, a box)
+    const control = target instanceof HTMLButtonElement || target instanceof HTMLSelectElement ||
+      (target instanceof HTMLInputElement && target.type !== "range");
+    if (e.key === " " && !control) {
       e.preventDefault(); setPlaying(!state.playing);
     } else if (typing || e.altKey || e.ctrlKey || e.metaKey) {
       return;
