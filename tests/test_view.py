@@ -236,11 +236,18 @@ def test_not_a_run_is_one_error_line(tmp_path: Path) -> None:
     assert "summary.json: not found" in one_error(runner.invoke(app, ["view", str(tmp_path)]))
 
 
-def test_a_replay_folder_gets_its_page(tmp_path: Path) -> None:
-    out = tmp_path / "replay"
+@pytest.fixture(scope="module")
+def replay_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("replay") / "replay"
     file = next(SAMPLE.glob("*.json.xz"))
     result = runner.invoke(app, ["replay", f"{file}:2", "--models", "none", "--out", str(out)])
     assert result.exit_code == 0, result.output
+    return out
+
+
+def test_a_replay_folder_gets_its_page(replay_folder: Path, tmp_path: Path) -> None:
+    out = tmp_path / "replay"
+    shutil.copytree(replay_folder, out)
     result = runner.invoke(app, ["view", str(out)])
     assert result.exit_code == 0, result.output
     data = page_data(out / "view.html")
@@ -275,6 +282,17 @@ def test_a_page_without_a_round_opens(browser: Browser, empty_run: Path) -> None
     assert browser.evaluate("document.getElementById('round-info').textContent") == (
         "no round to show"
     )
+
+
+@needs_browser
+def test_a_replay_folder_s_page_opens(browser: Browser, replay_folder: Path) -> None:
+    result = runner.invoke(app, ["view", str(replay_folder)])
+    assert result.exit_code == 0, result.output
+    browser.open(replay_folder / "view.html")
+    _set_slider(browser, 30)
+    assert browser.console_errors() == []
+    rows = browser.evaluate("document.querySelectorAll('#at-cursor tbody tr').length")
+    assert rows == len(pd.read_csv(replay_folder / "players.csv"))
 
 
 # ---- hostile names ----------------------------------------------------------------------------

@@ -86,7 +86,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     options = summary.get("options")
     options = options if isinstance(options, dict) else {}
     return {
-        "title": f"decoy evaluate: {(cache_root or folder).resolve().name}",
+        "title": visible(f"decoy evaluate: {(cache_root or folder).resolve().name}"),
         "subtitle": f"{summary.get('data', '?')} data · {summary.get('mechanics', '')} · "
         f"{len(rounds)} rounds · map {options.get('map', '?')}",
         "map": map_floor(str(options.get("map") or _map_of(rounds))),

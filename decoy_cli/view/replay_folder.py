@@ -55,7 +55,7 @@ def replay_page(folder: Path) -> PageData:
     missing = [c for c in columns if c not in players.columns]
     if missing or len(players) != len(trace.players):
         raise DecoyError(f"{folder / 'players.csv'}: not the players of {trace_path.name}")
-    label = f"{summary.get('match_id', '?')}:{summary.get('round_num', '?')}"
+    label = visible(f"{summary.get('match_id', '?')}:{summary.get('round_num', '?')}")
     original, replay = summary.get("outcome_original") or {}, summary.get("outcome_replay") or {}
     info = (
         f"winner: data {original.get('winner')} ({original.get('reason')}), replay "
@@ -68,7 +68,7 @@ def replay_page(folder: Path) -> PageData:
     table["player"] = list(range(len(players)))
     return {
         "title": f"decoy replay: {label}",
-        "subtitle": f"{folder.resolve().name} · map {trace.map_name}",
+        "subtitle": visible(f"{folder.resolve().name} · map {trace.map_name}"),
         "map": map_floor(trace.map_name),
         "tables": [table_spec("The replay", _summary_rows(summary))],
         "players": table,
