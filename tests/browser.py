@@ -2,9 +2,9 @@
 JSON messages ended by a NUL byte on file descriptors 3 and 4), with nothing but the standard
 library: open a page, run script in it, press keys, take screenshots, collect console errors.
 
-`find_chromium` names the browser (the `DECOY_CHROMIUM` variable, else chromium or
-google-chrome on the PATH; Debian's /usr/bin/chromium is a shell wrapper, so its binary in
-/usr/lib/chromium is taken when present).
+`find_chromium` names the browser (the `DECOY_CHROMIUM` variable, only that one when set, else
+chromium or google-chrome on the PATH; Debian's /usr/bin/chromium is a shell wrapper, so its
+binary in /usr/lib/chromium is taken when present).
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ TIMEOUT_S = 60.0
 def find_chromium() -> str | None:
     """The Chromium executable to drive, or None when there is none."""
     named = os.environ.get("DECOY_CHROMIUM")
-    if named:
-        return named
+    if named:  # as named, or nothing
+        return named if Path(named).is_file() else shutil.which(named)
     if Path("/usr/lib/chromium/chromium").is_file():
         return "/usr/lib/chromium/chromium"
     for name in ("chromium", "chromium-browser", "google-chrome", "chrome"):

@@ -38,7 +38,7 @@ HOSTILE = "</script><img src=x onerror=alert(1)>"
 CHROMIUM = find_chromium()
 needs_browser = pytest.mark.skipif(
     CHROMIUM is None,
-    reason="no Chromium to drive (install Debian's `chromium`, or set DECOY_CHROMIUM)",
+    reason="no Chromium to drive (install Debian's `chromium`, or name one in DECOY_CHROMIUM)",
 )
 
 
