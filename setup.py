@@ -22,5 +22,8 @@ setup(
         *shipped,
     ],
     package_dir=SHIPPED_DATA,
-    package_data={package: DATA_FILES for package in shipped},
+    package_data={
+        **{package: DATA_FILES for package in shipped},
+        "decoy_cli.view": ["page.html", "page.js", "page.css"],
+    },
 )

@@ -21,6 +21,7 @@ from decoy_cli.commands import (
     replay,
     snap,
     train,
+    view,
 )
 from decoy_cli.commands.help_text import reflow_help
 from decoy_cli.errors import DecoyError, describe_bug
@@ -127,6 +128,7 @@ app.command("info")(info.info)
 app.command("make-sample")(make_sample.make_sample)
 app.command("replay")(replay.replay)
 app.command("snap")(snap.snap)
+app.command("view")(view.view)
 app.add_typer(models.app, name="models")
 app.add_typer(train.app, name="train")
 reflow_help(app)  # last: help reflows to the terminal's width instead of keeping docstring wraps

@@ -30,6 +30,7 @@ LAYERS = {
     "damage": 5,
     "synth": 5,
     "env": 5,
+    "view": 5,  # the view page: reads what replay and evaluate write
     "evaluate": 6,
     "bench": 6,
     "rl": 6,

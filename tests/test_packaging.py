@@ -36,6 +36,9 @@ REQUIRED = (
     "decoy_cli/models/dog.json",
     "decoy_cli/models/DOG_CARD.md",
     "decoy_cli/cli.py",
+    "decoy_cli/view/page.html",
+    "decoy_cli/view/page.js",
+    "decoy_cli/view/page.css",
 )
 
 # Run in the install: every path must come from it, and the data must load.

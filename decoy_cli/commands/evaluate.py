@@ -134,6 +134,12 @@ def evaluate(
         show_default=False,
         help="Local worker processes (default: the number of cores).",
     ),
+    view: bool = typer.Option(
+        True,
+        "--view/--no-view",
+        help="Write view.html beside report.md: one page to look at any round, real against "
+        "replay (`decoy view`).",
+    ),
     scheduler: str | None = typer.Option(
         None,
         "--scheduler",
@@ -195,7 +201,7 @@ def evaluate(
                 )
             started = time.perf_counter()
             tables = build_tables(evaluation.accumulator)
-            write_outputs(evaluation, tables, out, info)
+            write_outputs(evaluation, tables, out, info, view=view)
         except KeyboardInterrupt:
             console.print(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "
@@ -207,8 +213,9 @@ def evaluate(
     try:
         _show(console, evaluation, tables)
         console.print(
-            f"outputs written to {out} (report: {out / 'report.md'}) in "
-            f"{time.perf_counter() - started:.1f} s",
+            f"outputs written to {out} (report: {out / 'report.md'}"
+            + (f", rounds to look at: {out / 'view.html'}" if view else "")
+            + f") in {time.perf_counter() - started:.1f} s",
             highlight=False,
         )
     except KeyboardInterrupt:  # the outputs are complete: only the summary is cut short

@@ -14,6 +14,7 @@ Layout of the output folder:
 * `summary.json`: what was run and every aggregate table;
 * `figures/`: see decoy_cli/evaluate/figures.py; `report.md` (decoy_cli/evaluate/report.py)
   shows them all;
+* `view.html`: the page to look at any round, real against replay (decoy_cli/view/page.py);
 * `cache/`: the per-round results (decoy_cli/evaluate/cache.py).
 """
 
@@ -39,10 +40,15 @@ from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
+from decoy_cli.evaluate.view_page import run_page
 from decoy_cli.files import json_ready, write_atomic, write_csv, write_json
 from decoy_cli.text import visible
+from decoy_cli.view.page import write_page
 
 FAILURE_COLUMNS = ("file", "round", "kind", "message")
+
+VIEW_PAGE = "view.html"
+"""The run's view page (decoy_cli/view/page.py), beside report.md."""
 
 
 LOCK_FILE = ".decoy-evaluate.lock"
@@ -97,15 +103,18 @@ def clear_leftovers(out: Path) -> None:
             temporary.unlink(missing_ok=True)
 
 
-def write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
-    """Write every output (see the module docstring) as one set: into a staging folder first,
+def write_outputs(
+    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, *, view: bool = True
+) -> list[Path]:
+    """Write every output (see the module docstring; `view.html` unless `view` is off, and an
+    earlier run's is removed then) as one set: into a staging folder first,
     then moved into `out` together, so a failure never leaves new tables beside an old report.
     A Ctrl-C takes effect once the set is in place (`ctrl_c_deferred`: stopped in the middle,
     matplotlib can fail with an error of its own). Only a SIGKILL or a power cut during the
     moves can leave a mix; the next run (every round cached) writes the set again. Returns the
     paths written."""
     with ctrl_c_deferred():
-        return _write_and_publish(evaluation, tables, out, info)
+        return _write_and_publish(evaluation, tables, out, info, view)
 
 
 @contextmanager
@@ -126,12 +135,14 @@ def ctrl_c_deferred() -> Iterator[None]:
 
 
 def _write_and_publish(
-    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo
+    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, view: bool
 ) -> list[Path]:
     stage = out / f".staging-{os.getpid()}"
     shutil.rmtree(stage, ignore_errors=True)
     try:
         written = _write_outputs(evaluation, tables, stage, info)
+        if view:
+            written.append(write_page(stage / VIEW_PAGE, run_page(stage, cache_root=out)))
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
@@ -142,6 +153,8 @@ def _write_and_publish(
                 shutil.rmtree(target)
             os.replace(entry, target)
         stage.rmdir()
+        if not view:
+            (out / VIEW_PAGE).unlink(missing_ok=True)
     except OSError as error:
         raise OutputError(
             f"cannot move the outputs into {out}: {error.strerror or error}"
@@ -268,6 +281,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
                 for row in tables.rounds.itertuples()
                 if row.inferred
             },
+            "cache_keys": dict(sorted(evaluation.cache_keys.items())),
         }
     )
 

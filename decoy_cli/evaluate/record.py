@@ -4,7 +4,8 @@ A `RoundRecord` holds, for one round: the per-player and per-round table rows, 2
 counts of original and replayed positions on the fixed `HeatGrid` and the replay's distance
 error by original position, sample counts and errors by nav place, and HP as integer sums
 (pooled, per data frame and per time bin): integers only, so the aggregates are exact and do
-not depend on the order in which rounds finish. `build_record` makes it from a replay.
+not depend on the order in which rounds finish; and the thinned paths and events the view
+page draws (`decoy_cli.replay.view_trace`). `build_record` makes it from a replay.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from decoy_cli.metrics import metric_names, player_metrics
 from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
+from decoy_cli.replay.view_trace import RoundTrace, round_trace
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask
@@ -76,6 +78,8 @@ class RoundRecord(msgspec.Struct, frozen=True):
     """Samples alive in both by the original position's place, and their summed distance (mm)."""
     places_error_mm: list[int]
     hp: HpStats
+    trace: RoundTrace
+    """The players' paths, thinned, and the round's events, for the view page."""
 
 
 PLAYER_COLUMNS = (
@@ -243,6 +247,7 @@ def build_record(
             settings.hp_bin_s,
             settings.hp_bins,
         ),
+        trace=round_trace(round_, result),
     )
 
 

@@ -102,6 +102,13 @@ class Evaluation:
     cached: int = 0
     compute_seconds: float = 0.0
     wall_seconds: float = 0.0
+    cache_keys: dict[str, str] = field(default_factory=dict)
+    """The cache key of each round evaluated, by "file_sha:round" (`round_id`)."""
+
+
+def round_id(file_sha: str, round_num: int) -> str:
+    """A round of a run: its file's content hash and its number ("sha:round")."""
+    return f"{file_sha}:{round_num}"
 
 
 def make_settings(
@@ -230,6 +237,7 @@ def run_evaluation(
             pending.append(task)
         else:
             evaluation.accumulator.add(record, task.file)
+            evaluation.cache_keys[round_id(task.file_sha, task.round_num)] = task.key
             evaluation.cached += 1
 
     compute_started = time.perf_counter()
@@ -239,6 +247,7 @@ def run_evaluation(
         if isinstance(outcome, RoundRecord):
             cache.store_round(outcome)
             evaluation.accumulator.add(outcome, task.file)
+            evaluation.cache_keys[round_id(task.file_sha, task.round_num)] = task.key
             evaluation.computed += 1
         else:
             failed += 1

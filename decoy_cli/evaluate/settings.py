@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from decoy_cli.replay.missing import Missing
     from decoy_cli.sim.setup import MoverName
 
-RECORD_VERSION = 6
+RECORD_VERSION = 7
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HEAT_CELL_M = 0.5

@@ -2,8 +2,9 @@
 
 * `write_replay`: the replay as open files in a folder: `replay.csv` (one row per data frame
   and player: time, position, yaw, HP, alive, and the original position beside it),
-  `events.csv` (every simulator event), `players.csv` (the per-player table) and
-  `summary.json` (outcome, options, counts).
+  `events.csv` (every simulator event), `players.csv` (the per-player table),
+  `summary.json` (outcome, options, counts) and `trace.json` (the thinned paths and events
+  `decoy view` draws: decoy_cli/replay/view_trace.py).
 * `plot_paths`: original versus replayed paths over the map; `animate`: an optional GIF.
 """
 
@@ -13,6 +14,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 import pandas as pd
 
@@ -22,7 +24,10 @@ from decoy_cli.esta import Round
 from decoy_cli.figures import draw_nav_areas, save_figure
 from decoy_cli.files import json_text, write_atomic, write_csv
 from decoy_cli.replay.replayer import ReplayResult
+from decoy_cli.replay.view_trace import round_trace
 from decoy_cli.world.navmesh import NavMesh
+
+TRACE_FILE = "trace.json"
 
 
 def write_replay(
@@ -81,6 +86,8 @@ def write_replay(
         for name, frame in (("replay.csv", table), ("events.csv", events), ("players.csv", players))
     ]
     written.append(write_atomic(folder / "summary.json", json_text(summary).encode()))
+    trace = msgspec.json.encode(round_trace(round_, result))
+    written.append(write_atomic(folder / TRACE_FILE, trace))
     return written
 
 

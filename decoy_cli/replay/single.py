@@ -1,8 +1,9 @@
 """One round replayed for a person: from a round address to the files `decoy replay` writes.
 
 `replay_address` reads the round, checks its map, replays it, measures every player and
-writes `replay.csv`, `events.csv`, `players.csv`, `summary.json`, `paths.png` (and `round.gif`)
-into the output folder; the command only parses options and prints what this returns.
+writes `replay.csv`, `events.csv`, `players.csv`, `summary.json`, `trace.json`, `paths.png`
+(and `round.gif`) into the output folder; the command only parses options and prints what
+this returns.
 """
 
 from __future__ import annotations

@@ -1,0 +1,124 @@
+"""The view page: one HTML file holding its data, script and style (no server, no network).
+
+`write_page` fills the slots of page.html with page.css, page.js and the page's data as JSON.
+The JSON is written so that no text from the data can end its script element or start markup
+(`<`, `>`, `&` and the line separators as `\\u` escapes), and the script shows every text
+through `textContent` or the canvas, never as markup.
+
+The data (`PageData`) is a dict: `title`, `subtitle`, `map` (`map_floor`), `tables` (each
+`title`, `columns`, `rows`), `players` (the player-round list: `columns`, `rows`, and per row
+the index of its `round` and of its `player` in that round), `rounds` (each `label`, `info`
+and a `RoundTrace` as a dict) and `initial` (the round shown first).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import msgspec
+import numpy as np
+import pandas as pd
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.files import json_ready, write_atomic
+from decoy_cli.replay.view_trace import RoundTrace
+from decoy_cli.text import visible
+
+PageData = dict[str, Any]
+
+_HERE = Path(__file__).resolve().parent
+_ESCAPES = {
+    "<": "\\u003c",
+    ">": "\\u003e",
+    "&": "\\u0026",
+    "\u2028": "\\u2028",
+    "\u2029": "\\u2029",
+}
+
+
+def embedded_json(data: Any) -> str:
+    """`data` as strict JSON that is inert inside an HTML script element."""
+    text = json.dumps(json_ready(data), separators=(",", ":"), allow_nan=False)
+    for char, escape in _ESCAPES.items():
+        text = text.replace(char, escape)
+    return text
+
+
+def page_html(data: PageData) -> str:
+    """The page's HTML with everything inline."""
+    html = (_HERE / "page.html").read_text(encoding="utf-8")
+    parts = {
+        "/*STYLE*/": (_HERE / "page.css").read_text(encoding="utf-8"),
+        "/*SCRIPT*/": (_HERE / "page.js").read_text(encoding="utf-8"),
+        "/*DATA*/": embedded_json(data),
+    }
+    for slot, text in parts.items():  # each slot once, in the order of the page
+        head, _, tail = html.partition(slot)
+        html = head + text + tail
+    return html
+
+
+def write_page(path: str | Path, data: PageData) -> Path:
+    """Write the page atomically; a full disk or a refused path raises OutputError."""
+    return write_atomic(path, page_html(data).encode("utf-8"))
+
+
+@cache
+def map_floor(map_name: str) -> dict[str, Any]:
+    """The map's floor for the page: its nav areas as one flat list of (x_min, y_min, x_max,
+    y_max, mean height) in decimetres, lowest first (an upper floor is drawn over a lower)."""
+    from decoy_cli.csgo import HAMMER_TO_M
+    from decoy_cli.world.navmesh import load_navmesh
+
+    nav = load_navmesh(map_name)
+    z = (nav.z_at_min + nav.z_at_max) / 2
+    rows = np.column_stack([nav.x_min, nav.y_min, nav.x_max, nav.y_max, z]) * HAMMER_TO_M * 10
+    rows = rows[np.argsort(rows[:, 4], kind="stable")]
+    return {"name": map_name, "areas": np.rint(rows).astype(np.int64).reshape(-1).tolist()}
+
+
+def round_entry(label: str, info: str, trace: RoundTrace) -> dict[str, Any]:
+    """One round of the page: its label, a line about it and its trace, the players' names
+    with their control characters written as escapes (`decoy_cli.text.visible`)."""
+    entry: dict[str, Any] = {"label": visible(label), "info": visible(info)}
+    entry.update(msgspec.to_builtins(trace))
+    for player in entry["players"]:
+        player["name"] = visible(player["name"])
+    return entry
+
+
+def table_spec(title: str, frame: pd.DataFrame, digits: int = 4) -> dict[str, Any]:
+    """A table of the page: its columns and rows, numbers rounded to `digits` significant
+    digits, missing values as null."""
+    rows = [[_cell(v, digits) for v in row] for row in frame.itertuples(index=False)]
+    return {"title": title, "columns": [str(c) for c in frame.columns], "rows": rows}
+
+
+def _cell(value: Any, digits: int) -> Any:
+    if isinstance(value, np.generic):
+        value = value.item()
+    if value is None or value is pd.NA:
+        return None
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int):
+        return value
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return None
+        return float(f"{value:.{digits}g}")
+    return str(value)
+
+
+def round_index(data: PageData, label: str) -> int:
+    """The index of the round labelled `label` ("MATCH:ROUND"); a DecoyError naming a few of
+    the labels when there is none."""
+    labels = [r["label"] for r in data["rounds"]]
+    if label in labels:
+        return labels.index(label)
+    shown = ", ".join(labels[:3]) + (", ..." if len(labels) > 3 else "")
+    raise DecoyError(f"no round {label} in this page's {len(labels)} rounds ({shown or 'none'})")

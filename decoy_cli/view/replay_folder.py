@@ -1,0 +1,100 @@
+"""The view page of a `decoy replay` output folder (decoy_cli/view/page.py): its summary as a
+table, its players and the round's paths and events (`trace.json`).
+
+A folder that is not a replay, lacks a file, or was written by a decoy that wrote no
+`trace.json` is a DecoyError with one line.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import msgspec
+import pandas as pd
+
+from decoy_cli.errors import DecoyError
+from decoy_cli.metrics import ALL_METRIC_NAMES
+from decoy_cli.replay.output import TRACE_FILE
+from decoy_cli.replay.view_trace import RoundTrace
+from decoy_cli.text import visible
+from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
+
+REPLAY_MARKER = "replay.csv"
+"""The file that tells a replay's folder from an evaluate run's."""
+
+PLAYER_COLUMNS = ("player", "side", "death")
+
+
+def is_replay_folder(folder: Path) -> bool:
+    return (folder / REPLAY_MARKER).is_file()
+
+
+def replay_page(folder: Path) -> PageData:
+    """The page's data of the replay in `folder`."""
+    summary = _read_json(folder / "summary.json")
+    trace_path = folder / TRACE_FILE
+    if not trace_path.is_file():
+        raise DecoyError(
+            f"{folder}: written by an older decoy (no {TRACE_FILE}); run the same "
+            "`decoy replay` again"
+        )
+    try:
+        trace = msgspec.json.decode(trace_path.read_bytes(), type=RoundTrace)
+    except (OSError, msgspec.DecodeError) as error:
+        raise DecoyError(f"{trace_path}: not a round's trace ({error})") from None
+    try:
+        players = pd.read_csv(folder / "players.csv")
+    except FileNotFoundError:
+        raise DecoyError(f"{folder / 'players.csv'}: not found") from None
+    except (OSError, pd.errors.ParserError, UnicodeDecodeError, ValueError):
+        raise DecoyError(f"{folder / 'players.csv'}: not a readable CSV") from None
+    metrics = [m for m in ALL_METRIC_NAMES if m in players.columns]
+    columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
+    missing = [c for c in columns if c not in players.columns]
+    if missing or len(players) != len(trace.players):
+        raise DecoyError(f"{folder / 'players.csv'}: not the players of {trace_path.name}")
+    label = visible(f"{summary.get('match_id', '?')}:{summary.get('round_num', '?')}")
+    original, replay = summary.get("outcome_original") or {}, summary.get("outcome_replay") or {}
+    info = (
+        f"winner: data {original.get('winner')} ({original.get('reason')}), replay "
+        f"{replay.get('winner')} ({replay.get('reason')}) · {summary.get('frames', '?')} frames"
+    )
+    table = table_spec("", players[columns])
+    for row, player in zip(table["rows"], trace.players, strict=True):
+        row[0] = visible(player.name)  # as recorded, not as the CSV made it inert
+    table["round"] = [0] * len(players)
+    table["player"] = list(range(len(players)))
+    return {
+        "title": f"decoy replay: {label}",
+        "subtitle": visible(f"{folder.resolve().name} · map {trace.map_name}"),
+        "map": map_floor(trace.map_name),
+        "tables": [table_spec("The replay", _summary_rows(summary))],
+        "players": table,
+        "rounds": [round_entry(label, info, trace)],
+        "initial": 0,
+    }
+
+
+def _read_json(path: Path) -> dict[str, Any]:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DecoyError(f"{path}: not found (is {path.parent} a `decoy replay` output?)") from None
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise DecoyError(f"{path}: not readable JSON ({str(error).splitlines()[0]})") from None
+    if not isinstance(data, dict):
+        raise DecoyError(f"{path}: not the summary of a `decoy replay`")
+    return data
+
+
+def _summary_rows(summary: dict[str, Any]) -> pd.DataFrame:
+    """The summary's values, one row each (a dict's values as `name.key`)."""
+    rows = []
+    for name, value in summary.items():
+        items = value.items() if isinstance(value, dict) else [("", value)]
+        for key, item in items:
+            text = ", ".join(map(str, item)) if isinstance(item, list) else item
+            rows.append((f"{name}.{key}" if key else name, text))
+    return pd.DataFrame(rows, columns=["what", "value"])
