@@ -177,9 +177,10 @@ def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, 
     usable = np.flatnonzero(damages.usable)
     frame = events.frame(np.nan_to_num(damages.tick))
     rows = []
-    for (k, attacker, victim), (total, code, first) in aggregate(
+    for (k, attacker, victim), step in aggregate(
         frame, damages.attacker, damages.victim, damages, usable
     ).items():
+        first = step.first
         a_pos = np.array([table[f"attacker{axis}_m"].iloc[first] for axis in "XYZ"])
         v_pos = np.array([table[f"victim{axis}_m"].iloc[first] for axis in "XYZ"])
         a_yaw = float(table["attackerViewX"].iloc[first])
@@ -201,8 +202,9 @@ def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, 
                 "victim_armor": armor,
                 "victim_helmet": helmet,
                 "hit": True,
-                "damage": total,
-                "hit_group": code,
+                "damage": step.damage,
+                "hp_lost": step.hp_lost,
+                "hit_group": step.group,
                 "tick": events.frame_tick(k),
             }
         )
@@ -260,6 +262,7 @@ def _event_negatives(events: _EventRound, window: float) -> list[dict[str, objec
                         "victim_helmet": helmet,
                         "hit": False,
                         "damage": 0.0,
+                        "hp_lost": 0.0,
                         "hit_group": NO_HIT,
                         "tick": int(anchor),
                     }

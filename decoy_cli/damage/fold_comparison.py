@@ -154,7 +154,7 @@ def compare_on_folds(
     from decoy_cli.damage.evaluation import dog_generate
     from decoy_cli.damage.model_folder import load_dog
 
-    positives = samples.take(np.flatnonzero(samples.hit))
+    positives = samples.take(np.flatnonzero(samples.outcome_known))
     fold_of_group = deal_folds(positives.group.tolist(), np.random.default_rng(seed))
     fold = np.array([fold_of_group[g] for g in positives.group])
     round_of_group = {group_id(r): r for r in rounds}
