@@ -17,17 +17,22 @@ from decoy_cli.errors import ModelError
 runner = CliRunner()
 ROOT = Path(__file__).resolve().parents[1]
 EVENTS = ROOT.parent / "shared" / "data" / "esta_dust2_events"
+ANCIENT = ROOT.parent / "shared" / "data" / "events_ancient"
 
 
-@pytest.mark.skipif(not EVENTS.is_dir(), reason="needs ../shared/data/esta_dust2_events")
+@pytest.mark.skipif(
+    not (EVENTS.is_dir() and ANCIENT.is_dir()),
+    reason="needs ../shared/data/esta_dust2_events and ../shared/data/events_ancient",
+)
 def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     folder = tmp_path / "rules"
     folder.mkdir()
     for name in ("dip.pt", "dip.json"):
         shutil.copy(ROOT / "models" / name, folder / name)
-    result = runner.invoke(app, ["models", "fit-rules", str(folder), str(EVENTS)])
+    result = runner.invoke(app, ["models", "fit-rules", str(folder), str(EVENTS), str(ANCIENT)])
     assert result.exit_code == 0, result.output
-    assert "396 firearm hits of 18 rounds" in result.output
+    # hit groups from de_dust2's 396 hits; bullets per step from the steps of both maps
+    assert "396 firearm hits" in result.output and "1536 damaging steps" in result.output
     data = json.loads((folder / "rules.json").read_text())
     assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
     # the shipped rules.json is this very fit
@@ -35,6 +40,7 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     assert data["bullets"] == shipped["bullets"]
     assert data["penetration"] == shipped["penetration"]
     assert data["penetration"]["hits"] == 396 and 0 < len(data["penetration"]["shares"]) < 396 / 5
+    assert data["provenance"]["maps"] == ["de_ancient", "de_dust2"]
     assert isinstance(load_damage_model(str(folder)), RulesDamage)  # a DIP and rules, no DOG
 
 

@@ -189,7 +189,7 @@ def cells_table(cells: list[dict[str, Any]]) -> Table:
     for cell in cells:
         table.add_row(
             cell["weapon"],
-            cell["hit_group"],
+            cell["part"],
             f"{cell['real']:,}",
             f"{cell['generated']:,}",
             f"{cell['wasserstein_hp']:.2f}",

@@ -123,7 +123,7 @@ def fit_rules_command(
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
 ) -> None:
     """Learn the parts of the rules-grounded damage model from real hits (where shots land, by
-    weapon and distance; how many land in one 0.5 s step, by weapon class) and write rules.json
+    weapon and distance; how many land in one 0.5 s step, by weapon) and write rules.json
     into a folder that holds a DIP and no DOG: `--models FOLDER` then damages by the game's
     rules. (A folder with a DOG keeps damaging by its DOG: copy its dip.* to a new folder.)"""
     from decoy_cli.damage.rules_model import fit_rules
@@ -143,8 +143,10 @@ def fit_rules_command(
     rules.provenance["data"] = [f.name for f in files]
     path = rules.save(model_folder)
     make_console().print(
-        f"rules fitted on {rules.provenance['hits']} firearm hits of "
-        f"{rules.provenance['rounds']} rounds; written to {path}",
+        f"rules fitted on {rules.provenance['rounds']} rounds of "
+        f"{', '.join(sorted({r.map_name for r in rounds}))}: hit groups and penetration from "
+        f"{rules.provenance['hits']} firearm hits with their hit group and raw damage, bullets "
+        f"per step from {rules.provenance['steps']} damaging steps; written to {path}",
         highlight=False,
     )
 

@@ -50,13 +50,17 @@ PRIOR_STEPS = 5.0
 
 @dataclass
 class BulletCounts:
-    """How many bullets of one pair land in one damaging step, by weapon class (module doc)."""
+    """How many bullets of one pair land in one damaging step, by weapon, pulled toward its
+    class's counts and those toward all steps' (module doc)."""
 
     by_class: dict[str, list[float]] = field(default_factory=dict)
     every: list[float] = field(default_factory=lambda: [0.0] * MAX_BULLETS)
+    by_weapon: dict[str, list[float]] = field(default_factory=dict)
+    """Empty in a `rules.json` written before weapons were counted: the class's counts."""
 
     def add(self, weapon: str, bullets: int) -> None:
         n = min(max(bullets, 1), MAX_BULLETS) - 1
+        self.by_weapon.setdefault(weapon, [0.0] * MAX_BULLETS)[n] += 1
         self.by_class.setdefault(weapon_class(weapon), [0.0] * MAX_BULLETS)[n] += 1
         self.every[n] += 1
 
@@ -68,8 +72,29 @@ class BulletCounts:
             p[0] = 1.0
             return p
         p = every / every.sum()
-        counts = np.asarray(self.by_class.get(weapon_class(weapon), [0.0] * MAX_BULLETS))
-        return (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
+        for table in (self.by_class.get(weapon_class(weapon)), self.by_weapon.get(weapon)):
+            if table is not None:
+                counts = np.asarray(table, np.float64)
+                p = (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
+        return p
+
+    def to_dict(self) -> dict[str, object]:
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> BulletCounts:
+        """Counts written by `to_dict` (older files lack the weapon table)."""
+
+        def tables(name: str) -> dict[str, list[float]]:
+            return {str(k): [float(v) for v in c] for k, c in data.get(name, {}).items()}
+
+        return cls(tables("by_class"), [float(v) for v in data["every"]], tables("by_weapon"))
+
+    def check(self) -> None:
+        """A ValueError unless every table holds `MAX_BULLETS` counts, none negative."""
+        for counts in (self.every, *self.by_class.values(), *self.by_weapon.values()):
+            if len(counts) != MAX_BULLETS or min(counts) < 0:
+                raise ValueError(f"bullet counts must be {MAX_BULLETS} counts, none negative")
 
 
 PENETRATED_BELOW = 0.9
@@ -129,7 +154,7 @@ class RulesFile:
         """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
         data = {
             "hit_groups": self.hit_groups.to_dict(),
-            "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
+            "bullets": self.bullets.to_dict(),
             "penetration": {"hits": self.penetration.hits, "shares": self.penetration.shares},
             "provenance": self.provenance,
         }
@@ -142,10 +167,8 @@ class RulesFile:
         try:
             data = json.loads(path.read_text())
             hit_groups = HitGroupModel.from_dict(data["hit_groups"])
-            bullets = BulletCounts(
-                {str(k): [float(v) for v in c] for k, c in data["bullets"]["by_class"].items()},
-                [float(v) for v in data["bullets"]["every"]],
-            )
+            bullets = BulletCounts.from_dict(data["bullets"])
+            bullets.check()
             provenance = dict(data.get("provenance", {}))
             through = data.get("penetration", {"hits": 0, "shares": []})
             penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
@@ -153,10 +176,6 @@ class RulesFile:
             raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
         except (ValueError, KeyError, TypeError, AttributeError) as error:
             raise ModelError(f"{path}: not a rules file ({error})") from None
-        if len(bullets.every) != MAX_BULLETS or any(
-            len(c) != MAX_BULLETS for c in bullets.by_class.values()
-        ):
-            raise ModelError(f"{path}: bullet counts of another length than {MAX_BULLETS}")
         if not (0 <= len(penetration.shares) <= penetration.hits) or not all(
             0.0 <= v <= 1.0 for v in penetration.shares
         ):
@@ -165,10 +184,12 @@ class RulesFile:
 
 
 def fit_rules(rounds: Sequence[Round]) -> RulesFile:
-    """Learn the hit groups and the bullets per step from the rounds' firearm hits: the damage
-    rows the DOG's samples use (`damage_rows`), counted per (attacker, victim) and virtual 2 Hz
-    step exactly as the events mode aggregates them, so a step here is a sample's step."""
-    from decoy_cli.damage.damage_rows import damage_rows, step_clock
+    """Learn the hit groups, the penetration and the bullets per step from the rounds' firearm
+    hits: the damage rows the DOG's samples use (`damage_rows`). Bullets are counted per
+    (attacker, victim) and virtual 2 Hz step exactly as the events mode aggregates them, so a
+    step here is a sample's step, from every hit (also those whose data records only the HP
+    lost); hit groups and penetration from the hits whose raw damage and hit group are known."""
+    from decoy_cli.damage.damage_rows import aggregate, damage_rows, step_clock
     from decoy_cli.damage.sample_set import SampleStats
 
     stats = SampleStats()
@@ -178,33 +199,42 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     health: list[float] = []
     bullets = BulletCounts()
     used_rounds = 0
+    maps: set[str] = set()
     for round_ in rounds:
         rows = damage_rows(round_, stats)
-        usable = np.flatnonzero(rows.usable & np.isfinite(round_.damages["distance"].to_numpy()))
-        if not len(usable):
+        distance = round_.damages["distance"].to_numpy(np.float64, na_value=np.nan)
+        usable = rows.usable & np.isfinite(distance)
+        if not usable.any():
             continue
         used_rounds += 1
-        table = round_.damages.iloc[usable]
+        maps.add(round_.map_name)
+        known = np.flatnonzero(usable & rows.outcome_known)
+        table = round_.damages.iloc[known]
         weapons += [str(w) for w in table["weapon"]]
         distances += [float(d) for d in table["distance"]]
         groups += [str(g) for g in table["hitGroup"]]
         health += [float(h) for h in table["hpDamage"]]
         origin, step_ticks = step_clock(round_)
-        steps: dict[tuple[int, object, object], list[str]] = {}
-        for r in usable:
-            step = int(np.rint((rows.tick[r] - origin) / step_ticks))
-            steps.setdefault((step, rows.attacker[r], rows.victim[r]), []).append(rows.weapon[r])
-        for hits in steps.values():
-            bullets.add(hits[0], len(hits))
-    if not weapons:
+        step = np.rint((np.nan_to_num(rows.tick) - origin) / step_ticks)
+        steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
+        for hit in steps.values():
+            bullets.add(str(rows.weapon[hit.first]), hit.hits)
+    if not sum(bullets.every):
         raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
+    if not weapons:
+        raise ModelError(
+            "no firearm hit in the data records its hit group and raw damage: the hit groups "
+            "and penetration cannot be learned"
+        )
     model = HitGroupModel.fit(weapons, distances, groups)
     penetration = Penetration.learn(weapons, groups, distances, health)
     provenance = {
         "hits": len(weapons),
         "steps": int(sum(bullets.every)),
         "rounds": used_rounds,
+        "maps": sorted(maps),
         "left_out": dict(stats.excluded),
+        "hp_lost_only": dict(stats.partial),
     }
     return RulesFile(model, bullets, provenance, penetration)
 
