@@ -23,9 +23,11 @@ from decoy_cli.commands._damage_output import (
     cells_table,
     dip_table,
     dog_table,
+    hp_lost_table,
     print_samples,
     progress_bars,
 )
+from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
@@ -41,7 +43,7 @@ from decoy_cli.damage.split import (
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 
-DEFAULT_IMPORT_OUT = Path("decoy-out") / "models" / "paper"
+DEFAULT_IMPORT_OUT = PAPER_FOLDER
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
 
 app = typer.Typer(
@@ -227,9 +229,7 @@ def calibrate(
 
 @app.command("evaluate")
 def evaluate(
-    model_folder: Path = typer.Argument(
-        ..., help="A model folder: dip.pt/json and/or dog.pt/json (trained or imported)."
-    ),
+    models: str = typer.Argument(..., help=f"The models to score: {CHOICES_HELP}."),
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
     out: Path = typer.Option(
         DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
@@ -253,12 +253,14 @@ def evaluate(
     draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
     min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),
 ) -> None:
-    """Evaluate a damage-model folder (trained or imported) on ESTA data.
+    """Evaluate any --models choice (rules, shipped, paper or a folder) on ESTA data.
 
-    Prints DIP's and DOG's metrics beside the paper's and writes metrics.json with the figures:
-    ROC and precision-recall curves, reconstructed vs real damage, the error histogram, the
-    hit-group confusion matrix, generated vs real damage per weapon and hit group. Exits
-    non-zero, after writing them, when a file or round failed."""
+    Prints DIP's and DOG's metrics beside the paper's, and the HP lost drawn by whatever decides
+    the damage (DOG or rules) against the real per 0.5 s step and, for the rules, per hit, by
+    map and (weapon, distance band) cell with the sampling floor; writes metrics.json with the
+    figures: ROC and precision-recall curves, reconstructed vs real damage, the error
+    histogram, the hit-group confusion matrix, generated vs real damage per weapon and hit
+    group. Exits non-zero, after writing them, when a file or round failed."""
     choice = SampleChoice(
         data=data,
         mode=mode,
@@ -272,7 +274,7 @@ def evaluate(
     bars, on_file, _ = progress_bars()
     with bars:
         result = evaluate_model_folder(
-            folder=model_folder,
+            models=models,
             choice=choice,
             out=out,
             subset=subset,
@@ -290,6 +292,9 @@ def evaluate(
         console.print(dog_table(result.dog.metrics, f"DOG of {result.name} ({subset} samples)"))
         if result.dog.metrics["cells"]:
             console.print(cells_table(result.dog.metrics["cells"]))
+    console.print(hp_lost_table(result.hp_lost, f"HP lost, {result.name} against real"))
+    for note in result.notes:
+        console.print(note, highlight=False)
     console.print(f"metrics and {len(result.figures)} figures written to {result.out}")
     failed = len(result.stats.failures)
     if failed:

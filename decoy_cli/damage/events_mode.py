@@ -170,12 +170,28 @@ def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples
     return samples_from_rows([{**common, **row} for row in rows])
 
 
-def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, object]]:
-    """One sample per (virtual frame, attacker, victim) with usable damage; the state of the
-    group's first damage row."""
+def hit_samples(round_: Round, stats: SampleStats) -> Samples:
+    """One damaging sample per usable damage row (a hit, not a step): the unit of a model that
+    draws one bullet, as `event_samples` builds its positives."""
+    events = _EventRound(round_, damage_rows(round_, stats))
+    common = {
+        "map_name": round_.map_name,
+        "group": group_id(round_),
+        "match": round_.match_id,
+        "mode": "events",
+    }
+    rows = _event_positives(events, stats, per_hit=True)
+    return samples_from_rows([{**common, **row} for row in rows])
+
+
+def _event_positives(
+    events: _EventRound, stats: SampleStats, per_hit: bool = False
+) -> list[dict[str, object]]:
+    """One sample per (virtual frame, attacker, victim) with usable damage, or per usable row
+    with `per_hit`; the state of the group's first damage row."""
     damages, table = events.damages, events.round.damages
     usable = np.flatnonzero(damages.usable)
-    frame = events.frame(np.nan_to_num(damages.tick))
+    frame = np.arange(len(damages.tick)) if per_hit else events.frame(np.nan_to_num(damages.tick))
     rows = []
     for (k, attacker, victim), step in aggregate(
         frame, damages.attacker, damages.victim, damages, usable
@@ -205,7 +221,7 @@ def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, 
                 "damage": step.damage,
                 "hp_lost": step.hp_lost,
                 "hit_group": step.group,
-                "tick": events.frame_tick(k),
+                "tick": int(tick) if per_hit else events.frame_tick(k),
             }
         )
     return rows
