@@ -286,6 +286,8 @@ def evaluate(
         )
     console = make_console()
     print_samples(console, result.samples, result.stats)
+    for line in result.warnings:
+        console.print(f"warning: {line}", style="yellow", markup=False)
     if result.dip is not None:
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
     if result.dog is not None:

@@ -48,6 +48,8 @@ class FolderEvaluation:
     dog: DogEvaluation | None
     hp_lost: dict[str, dict[str, HpLostScores]]
     notes: list[str]
+    warnings: list[str]
+    """Model parts not trained on every map of the data (`model_maps.map_warnings`)."""
     report: dict[str, Any]
     out: Path
     figures: list[Path]
@@ -88,6 +90,7 @@ def evaluate_model_folder(
     from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
     from decoy_cli.damage.hp_lost import draw_outcomes, score_by_map
     from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.model_maps import map_warnings
     from decoy_cli.damage.rules_model import RulesFile
 
     report: dict[str, Any] = {
@@ -147,6 +150,8 @@ def evaluate_model_folder(
         for unit, of_map in hp_lost.items()
     }
     report["notes"] = notes
+    warnings = map_warnings(models, [str(m) for m in samples.map_name[index]])
+    report["warnings"] = warnings
     write_json(out / "metrics.json", report)
     return FolderEvaluation(
         name,
@@ -157,6 +162,7 @@ def evaluate_model_folder(
         dog_result,
         hp_lost,
         notes,
+        warnings,
         report,
         out,
         figures,

@@ -78,9 +78,15 @@ def mechanics(settings: EvalSettings) -> str:
 def model_lines(settings: EvalSettings) -> dict[str, str]:
     """ "hits decided by" and "damage decided by", in words (`damage.model_roles`)."""
     from decoy_cli.damage import model_roles
+    from decoy_cli.damage.model_maps import map_warnings
 
-    roles = model_roles(settings.models if settings.combat else "none")
-    return {"hits decided by": roles["hits"], "damage decided by": roles["damage"]}
+    models = settings.models if settings.combat else "none"
+    roles = model_roles(models)
+    lines = {"hits decided by": roles["hits"], "damage decided by": roles["damage"]}
+    warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
+    if warnings:
+        lines["model warnings"] = "; ".join(warnings)
+    return lines
 
 
 def command_line(

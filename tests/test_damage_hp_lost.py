@@ -1,0 +1,164 @@
+"""Hits whose data records only the HP lost (no hit group, no raw damage), the HP-lost scores
+by (weapon, distance band) cell, bullets per step by weapon, leave-matches-out folds, and the
+maps a model knows. Expected values are derived by hand in each test."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from esta_fixtures import make_match, write_match
+from scipy.stats import wasserstein_distance
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.damage.hp_lost import band_labels, drawn_hp_lost, score_hp_lost
+from decoy_cli.damage.model_maps import map_warnings, trained_maps
+from decoy_cli.damage.rules_model import BulletCounts
+from decoy_cli.damage.samples import build_samples
+from decoy_cli.damage.split import leave_matches_out
+
+ROOT = Path(__file__).resolve().parents[1]
+ANCIENT = ROOT.parent / "shared" / "data" / "events_ancient"
+WIDE = {"COLUMNS": "200"}
+
+
+def hp_lost_only(document: dict[str, Any]) -> dict[str, Any]:
+    """The match with every damage row's hit group and raw damage removed, as events_ancient
+    records them."""
+    for round_ in document["gameRounds"]:
+        for row in round_["damages"]:
+            row["hitGroup"] = None
+            row["hpDamage"] = None
+    return document
+
+
+def test_hits_without_hit_group_are_kept_on_their_hp_lost(tmp_path: Path) -> None:
+    """Round 2's two firearm hits (27 and 120 HP raw, 27 and 100 HP lost) stay hits without
+    hit group and raw damage; the world damage of round 3 is still left out."""
+    path = write_match(tmp_path / "m.json.xz", hp_lost_only(make_match()))
+    samples, stats = build_samples([path], mode="events")
+    hits = samples.take(samples.hit)
+    assert sorted(hits.hp_lost.tolist()) == [27.0, 100.0]
+    assert np.isnan(hits.damage).all() and (hits.hit_group == -1).all()
+    assert not samples.outcome_known.any()
+    assert stats.partial == {"no hit group (scored on HP lost, over all hit groups)": 2}
+    assert "unknown hit group" not in stats.excluded
+    assert stats.excluded["world damage (no attacker)"] == 1
+
+
+def test_hp_lost_cells_by_hand() -> None:
+    """Twelve AK-47 steps at 300 u (band 0-500 u) lose 20 HP each; the model draws 30 HP on a
+    victim of 25 HP (capped to 25) and 10 HP on the others: the cell's Wasserstein is the
+    distance between twelve 20s and the drawn values; a cell of 3 M4A4 steps is below the
+    10-sample minimum and stays out."""
+    weapon = np.array(["AK-47"] * 12 + ["M4A4"] * 3, dtype=object)
+    distance = np.array([300.0] * 12 + [1200.0] * 3)
+    real = np.array([20.0] * 12 + [50.0] * 3)
+    victim_hp = np.array([25] + [100] * 14)
+    damage = np.tile(np.array([30.0] + [10.0] * 14), (2, 1))
+    drawn = drawn_hp_lost(damage, victim_hp)
+    assert drawn[0, 0] == 25.0 and drawn[0, 1] == 10.0
+    scores = score_hp_lost(weapon, distance, real, drawn, min_cell=10)
+    assert [(c["weapon"], c["part"], c["real"], c["generated"]) for c in scores.cells] == [
+        ("AK-47", "0-500 u", 12, 24)
+    ]
+    expected = wasserstein_distance(real[:12], drawn[:, :12].ravel())
+    assert scores.mean_wasserstein_hp == pytest.approx(expected)
+    # both draws are identical: were the real steps drawn from the model, each draw matches
+    assert scores.cells[0]["floor_hp"] == pytest.approx(0.0)
+    assert scores.real_mean_hp == pytest.approx((12 * 20 + 3 * 50) / 15)
+    assert scores.drawn_mean_hp == pytest.approx((25 + 14 * 10) / 15)
+    assert band_labels(np.array([0.0, 499.9, 500.0, 1499.0, 1500.0])).tolist() == [
+        "0-500 u", "0-500 u", "500-1000 u", "1000-1500 u", "1500+ u"
+    ]  # fmt: skip
+
+
+def test_bullets_per_step_by_weapon_pulled_toward_the_class() -> None:
+    """Four rifle steps: AK-47 one bullet twice, M4A4 one and two. All steps: (3, 1) / 4; the
+    Rifle class is its counts (3, 1) pulled toward that with 5 pseudo-steps; the AK-47 its
+    counts (2, 0) pulled toward the class's with 5 more."""
+    counts = BulletCounts()
+    for weapon, bullets in (("AK-47", 1), ("AK-47", 1), ("M4A4", 1), ("M4A4", 2)):
+        counts.add(weapon, bullets)
+    every = np.array([3, 1] + [0] * 8) / 4
+    rifle = (np.array([3, 1] + [0] * 8) + 5 * every) / (4 + 5)
+    ak = (np.array([2, 0] + [0] * 8) + 5 * rifle) / (2 + 5)
+    np.testing.assert_allclose(counts.probabilities("AK-47"), ak)
+    assert counts.probabilities("AK-47")[0] > counts.probabilities("M4A4")[0]
+    again = BulletCounts.from_dict(json.loads(json.dumps(counts.to_dict())))
+    np.testing.assert_allclose(again.probabilities("M4A4"), counts.probabilities("M4A4"))
+    old = {"by_class": counts.by_class, "every": counts.every}  # a rules.json before weapons
+    np.testing.assert_allclose(BulletCounts.from_dict(old).probabilities("AK-47"), rifle)
+
+
+def test_leave_matches_out_folds() -> None:
+    """Map A has two matches: one fold each. Map B has one match of 5 rounds: its rounds are
+    dealt into folds of their own, every round in one fold."""
+    from test_damage_samples import synthetic
+
+    base = synthetic(groups=7, per_group=2, matches=1)
+    maps = np.array(["de_a"] * 4 + ["de_b"] * 10, dtype=object)
+    match = np.array(["m1"] * 2 + ["m2"] * 2 + ["m3"] * 10, dtype=object)
+    group = np.array([f"g{k // 2}" for k in range(14)], dtype=object)
+    samples = dataclasses.replace(base, map_name=maps, match=match, group=group)
+    fold = leave_matches_out(samples, np.random.default_rng(0))
+    assert fold[:4].tolist() == [0, 0, 1, 1]
+    b = fold[4:]
+    assert sorted(set(b.tolist())) == [2, 3, 4, 5, 6]  # 5 rounds in 5 folds of their own
+    assert all(len(set(b[2 * k : 2 * k + 2].tolist())) == 1 for k in range(5))
+
+
+def folder_with(tmp_path: Path, maps: list[str] | None) -> Path:
+    """A copy of the shipped DIP and DOG whose metadata names `maps` (None: no maps key)."""
+    folder = tmp_path / "models"
+    folder.mkdir(parents=True)
+    for kind in ("dip", "dog"):
+        shutil.copy(ROOT / "models" / f"{kind}.pt", folder / f"{kind}.pt")
+        data = json.loads((ROOT / "models" / f"{kind}.json").read_text())
+        data["metadata"].pop("maps", None)
+        if maps is not None:
+            data["metadata"]["maps"] = maps
+        (folder / f"{kind}.json").write_text(json.dumps(data))
+    return folder
+
+
+def test_a_model_used_on_other_maps_warns_naming_them(tmp_path: Path) -> None:
+    folder = folder_with(tmp_path, ["de_dust2"])
+    assert trained_maps(folder, "dip") == ["de_dust2"]
+    assert map_warnings(str(folder), ["de_dust2"]) == []
+    lines = map_warnings(str(folder), ["de_ancient", "de_dust2"])
+    assert len(lines) == 2 and all("trained on de_dust2 only" in line for line in lines)
+    assert all("not on de_ancient:" in line for line in lines)
+    assert "DIP" in lines[0] and "DOG" in lines[1]
+    silent = folder_with(tmp_path / "b", None)
+    assert all("does not say which maps" in line for line in map_warnings(str(silent), ["x"]))
+    assert map_warnings("none", ["de_ancient"]) == []
+    # the shipped folder: DIP and DOG of de_dust2, rules of de_ancient and de_dust2
+    assert trained_maps(ROOT / "models", "rules") == ["de_ancient", "de_dust2"]
+    (rules_line,) = map_warnings("rules", ["de_ancient"])
+    assert rules_line.startswith("the DIP (who hits) of --models rules was trained on de_dust2")
+    assert len(map_warnings("shipped", ["de_ancient"])) == 2
+
+
+@pytest.mark.skipif(not ANCIENT.is_dir(), reason="needs ../shared/data/events_ancient")
+def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
+    """The default model is evaluable on data without hit groups: per step and per hit, the
+    partial rows counted, the DIP's map named."""
+    out = tmp_path / "out"
+    result = CliRunner().invoke(
+        app, ["models", "evaluate", "rules", str(ANCIENT), "--out", str(out)], env=WIDE
+    )
+    assert result.exit_code == 0, result.output
+    assert "no hit group (scored on HP lost, over all hit groups)" in result.output
+    assert "trained on de_dust2 only, not on de_ancient" in result.output
+    report = json.loads((out / "metrics.json").read_text())
+    assert report["damage_by"] == "rules" and set(report["hp_lost"]) == {"step", "hit"}
+    step = report["hp_lost"]["step"]["de_ancient"]
+    assert step["steps"] == report["dip"]["positives"]  # every damaging step scored
+    assert 0 < step["mean_floor_hp"] < step["mean_wasserstein_hp"]
