@@ -162,3 +162,19 @@ def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
     step = report["hp_lost"]["step"]["de_ancient"]
     assert step["steps"] == report["dip"]["positives"]  # every damaging step scored
     assert 0 < step["mean_floor_hp"] < step["mean_wasserstein_hp"]
+
+
+def test_fold_comparison_labels_what_the_model_saw() -> None:
+    """A model trained on rounds g0, g1 and validated on g2 has seen 3 of 7 rounds; on rounds it
+    never saw it says so, naming its maps."""
+    from test_damage_samples import synthetic
+
+    from decoy_cli.damage.fold_comparison import training_overlap
+
+    samples = synthetic(groups=7, per_group=2)
+    groups = sorted(set(samples.group.tolist()))
+    metadata = {"split": {"by": "round", "units": {"train": groups[:2], "val": groups[2:3]}}}
+    assert training_overlap(metadata, samples) == "trained or validated on 3 of these 7 rounds"
+    metadata = {"maps": ["de_dust2"], "split": {"by": "round", "units": {"train": ["other"]}}}
+    assert training_overlap(metadata, samples) == "trained on none of these rounds (de_dust2)"
+    assert training_overlap({}, samples) == "its training data unrecorded"

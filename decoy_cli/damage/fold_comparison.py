@@ -24,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -160,6 +161,23 @@ def rules_out_of_fold(
             rules, positives.take(test), seed + int(k), draws
         )
     return damage, group
+
+
+def training_overlap(metadata: dict[str, Any], samples: Samples) -> str:
+    """What share of the samples' rounds a model saw while it was trained (its training or
+    validation part, as its metadata's split records them), in words for a label."""
+    split = metadata.get("split") or {}
+    units = split.get("units") or {}
+    seen = set(units.get("train", [])) | set(units.get("val", []))
+    key = samples.match if split.get("by") == "match" else samples.group
+    rounds = {str(g): str(k) for g, k in zip(samples.group, key, strict=True)}
+    overlap = sum(1 for unit in rounds.values() if unit in seen)
+    if not split:
+        return "its training data unrecorded"
+    if overlap == 0:
+        maps = metadata.get("maps")
+        return "trained on none of these rounds" + (f" ({', '.join(maps)})" if maps else "")
+    return f"trained or validated on {overlap} of these {len(rounds)} rounds"
 
 
 def compare_on_folds(
