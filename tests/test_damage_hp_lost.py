@@ -178,3 +178,42 @@ def test_fold_comparison_labels_what_the_model_saw() -> None:
     metadata = {"maps": ["de_dust2"], "split": {"by": "round", "units": {"train": ["other"]}}}
     assert training_overlap(metadata, samples) == "trained on none of these rounds (de_dust2)"
     assert training_overlap({}, samples) == "its training data unrecorded"
+
+
+def test_hit_group_from_hp_lost_by_the_rules() -> None:
+    """An AK-47 at 0 u on a victim without armour does 144 (head), 36 (neck, chest, arm), 45
+    (stomach) or 27 (leg). A hit that left the victim alive after 45 HP was a stomach hit; one
+    of 36 HP a neck, chest or arm hit in the prior's proportions; a kill of a 30-HP victim any
+    group doing at least 30 (all but the leg); 10 HP no group (a shot through something)."""
+    from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
+
+    prior = HitGroupModel.fit(["AK-47"] * 4, [0.0] * 4, ["Head", "Chest", "Chest", "Leg"])
+    p = prior.probabilities("AK-47", 0.0)
+    stomach = group_posterior(prior, "AK-47", 0.0, 45, 100, armored=False)
+    assert stomach is not None and stomach.tolist() == [0, 0, 0, 1, 0, 0]
+    body = group_posterior(prior, "AK-47", 0.0, 36, 100, armored=False)
+    neck, chest, arm = (GROUPS.index(g) for g in ("Neck", "Chest", "Arm"))
+    expected = np.zeros(6)
+    expected[[neck, chest, arm]] = p[[neck, chest, arm]] / p[[neck, chest, arm]].sum()
+    np.testing.assert_allclose(body, expected)
+    kill = group_posterior(prior, "AK-47", 0.0, 30, 30, armored=False)
+    assert kill is not None and kill[GROUPS.index("Leg")] == 0
+    np.testing.assert_allclose(kill[:5], p[:5] / p[:5].sum())
+    assert group_posterior(prior, "AK-47", 0.0, 10, 100, armored=False) is None
+
+
+def test_rules_file_keeps_bullets_of_hurt_victims(tmp_path: Path) -> None:
+    """Steps on hurt victims draw from their own counts; a file without them uses `bullets`."""
+    from decoy_cli.damage.hit_groups import HitGroupModel
+    from decoy_cli.damage.rules_model import RulesFile
+
+    unhurt, hurt = BulletCounts(), BulletCounts()
+    unhurt.add("AK-47", 3)
+    hurt.add("AK-47", 1)
+    rules = RulesFile(HitGroupModel(), unhurt, {}, bullets_hurt=hurt)
+    rules.save(tmp_path)
+    again = RulesFile.load(tmp_path)
+    assert again.bullet_counts(100).probabilities("AK-47")[2] == 1.0
+    assert again.bullet_counts(99).probabilities("AK-47")[0] == 1.0
+    old = dataclasses.replace(rules, bullets_hurt=None)
+    assert old.bullet_counts(40) is old.bullets

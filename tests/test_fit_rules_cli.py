@@ -29,10 +29,16 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     folder.mkdir()
     for name in ("dip.pt", "dip.json"):
         shutil.copy(ROOT / "models" / name, folder / name)
-    result = runner.invoke(app, ["models", "fit-rules", str(folder), str(EVENTS), str(ANCIENT)])
+    result = runner.invoke(
+        app, ["models", "fit-rules", str(folder), str(EVENTS), str(ANCIENT)], env={"COLUMNS": "300"}
+    )
     assert result.exit_code == 0, result.output
-    # hit groups from de_dust2's 396 hits; bullets per step from the steps of both maps
+    # hit groups from de_dust2's 396 hits and the de_ancient hits the rules explain; bullets
+    # per step from the steps of both maps
     assert "396 firearm hits" in result.output and "1536 damaging steps" in result.output
+    data = json.loads((folder / "rules.json").read_text())
+    explained, left = data["provenance"]["hits_by_hp_lost"], data["provenance"]["hits_unexplained"]
+    assert explained + left == 1835 and explained > 4 * left
     data = json.loads((folder / "rules.json").read_text())
     assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
     # the shipped rules.json is this very fit

@@ -146,9 +146,11 @@ def fit_rules_command(
     path = rules.save(model_folder)
     make_console().print(
         f"rules fitted on {rules.provenance['rounds']} rounds of "
-        f"{', '.join(sorted({r.map_name for r in rounds}))}: hit groups and penetration from "
-        f"{rules.provenance['hits']} firearm hits with their hit group and raw damage, bullets "
-        f"per step from {rules.provenance['steps']} damaging steps; written to {path}",
+        f"{', '.join(sorted({r.map_name for r in rounds}))}: hit groups from "
+        f"{rules.provenance['hits']} firearm hits with their hit group and raw damage and "
+        f"{rules.provenance['hits_by_hp_lost']} whose HP lost the rules explain (left out: "
+        f"{rules.provenance['hits_unexplained']} they do not), penetration from the former, "
+        f"bullets per step from {rules.provenance['steps']} damaging steps; written to {path}",
         highlight=False,
     )
 

@@ -140,7 +140,8 @@ def evaluate_model_folder(
     if rules is not None:
         per_hit = _hit_samples(choice, samples, subset, index)
         if len(per_hit):
-            one_bullet = replace(rules, bullets=BulletCounts(every=[1.0] + [0.0] * 9))
+            one = BulletCounts(every=[1.0] + [0.0] * 9)
+            one_bullet = replace(rules, bullets=one, bullets_hurt=None)
             drawn, _ = draw_outcomes(one_bullet, per_hit, choice.seed, draws)
             hp_lost["hit"] = score_by_map(per_hit, drawn, min_cell)
     else:

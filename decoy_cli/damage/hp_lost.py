@@ -66,6 +66,7 @@ def draw_outcomes(
             distance_u(samples) * HAMMER_TO_M,
             samples.victim_armor,
             samples.victim_helmet,
+            samples.victim_hp,
             seed,
             draws,
         )

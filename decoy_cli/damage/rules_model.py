@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior, weapon_class
 from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
@@ -39,9 +39,12 @@ from decoy_cli.files import write_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
+    from decoy_cli.damage.damage_rows import DamageRows
     from decoy_cli.damage.model_folder import LoadedDip
 
 RULES_FILE = "rules.json"
+FULL_HP = 100
+"""A victim at this HP at a step's start is unhurt (`RulesFile.bullets`)."""
 MAX_BULLETS = 10
 """Bullet counts above this are counted as this many."""
 PRIOR_STEPS = 5.0
@@ -149,12 +152,21 @@ class RulesFile:
     provenance: dict[str, object] = field(default_factory=dict)
     penetration: Penetration = field(default_factory=Penetration)
     """Empty in a `rules.json` written before it was learned: every path is clear."""
+    bullets_hurt: BulletCounts | None = None
+    """The bullets of steps on a victim already hurt (below 100 HP at the step's start), and
+    `bullets` those on a victim unhurt; None in a `rules.json` written before: `bullets`."""
+
+    def bullet_counts(self, victim_hp: int) -> BulletCounts:
+        """The bullet counts of a step on a victim with `victim_hp` at its start."""
+        hurt = victim_hp < FULL_HP and self.bullets_hurt is not None
+        return self.bullets_hurt if hurt and self.bullets_hurt is not None else self.bullets
 
     def save(self, folder: Path) -> Path:
         """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
         data = {
             "hit_groups": self.hit_groups.to_dict(),
             "bullets": self.bullets.to_dict(),
+            "bullets_hurt": None if self.bullets_hurt is None else self.bullets_hurt.to_dict(),
             "penetration": {"hits": self.penetration.hits, "shares": self.penetration.shares},
             "provenance": self.provenance,
         }
@@ -168,7 +180,11 @@ class RulesFile:
             data = json.loads(path.read_text())
             hit_groups = HitGroupModel.from_dict(data["hit_groups"])
             bullets = BulletCounts.from_dict(data["bullets"])
-            bullets.check()
+            hurt = data.get("bullets_hurt")
+            bullets_hurt = None if hurt is None else BulletCounts.from_dict(hurt)
+            for counts in (bullets, bullets_hurt):
+                if counts is not None:
+                    counts.check()
             provenance = dict(data.get("provenance", {}))
             through = data.get("penetration", {"hits": 0, "shares": []})
             penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
@@ -180,7 +196,7 @@ class RulesFile:
             0.0 <= v <= 1.0 for v in penetration.shares
         ):
             raise ModelError(f"{path}: penetration shares must be in [0, 1], at most one per hit")
-        return cls(hit_groups, bullets, provenance, penetration)
+        return cls(hit_groups, bullets, provenance, penetration, bullets_hurt)
 
 
 def fit_rules(rounds: Sequence[Round]) -> RulesFile:
@@ -197,7 +213,8 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     distances: list[float] = []
     groups: list[str] = []
     health: list[float] = []
-    bullets = BulletCounts()
+    bullets, bullets_hurt = BulletCounts(), BulletCounts()
+    unknown: list[tuple[str, float, float, float, bool]] = []
     used_rounds = 0
     maps: set[str] = set()
     for round_ in rounds:
@@ -209,6 +226,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         used_rounds += 1
         maps.add(round_.map_name)
         known = np.flatnonzero(usable & rows.outcome_known)
+        unknown += _hp_lost_hits(round_, rows, usable & ~rows.outcome_known, distance)
         table = round_.damages.iloc[known]
         weapons += [str(w) for w in table["weapon"]]
         distances += [float(d) for d in table["distance"]]
@@ -218,8 +236,10 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         step = np.rint((np.nan_to_num(rows.tick) - origin) / step_ticks)
         steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
         for hit in steps.values():
-            bullets.add(str(rows.weapon[hit.first]), hit.hits)
-    if not sum(bullets.every):
+            earlier = (rows.victim == rows.victim[hit.first]) & (rows.tick < rows.tick[hit.first])
+            hurt = float(rows.hp_taken[earlier].sum()) > 0
+            (bullets_hurt if hurt else bullets).add(str(rows.weapon[hit.first]), hit.hits)
+    if not sum(bullets.every) + sum(bullets_hurt.every):
         raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
     if not weapons:
         raise ModelError(
@@ -227,16 +247,40 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
             "and penetration cannot be learned"
         )
     model = HitGroupModel.fit(weapons, distances, groups)
+    prior = HitGroupModel.from_dict(model.to_dict())
+    explained = 0
+    for weapon, distance, lost, before, armored in unknown:
+        weights = group_posterior(prior, weapon, distance, lost, before, armored)
+        if weights is not None:
+            model.add(weapon, distance, weights)
+            explained += 1
     penetration = Penetration.learn(weapons, groups, distances, health)
     provenance = {
         "hits": len(weapons),
-        "steps": int(sum(bullets.every)),
+        "hits_by_hp_lost": explained,
+        "hits_unexplained": len(unknown) - explained,
+        "steps": int(sum(bullets.every) + sum(bullets_hurt.every)),
         "rounds": used_rounds,
         "maps": sorted(maps),
         "left_out": dict(stats.excluded),
         "hp_lost_only": dict(stats.partial),
     }
-    return RulesFile(model, bullets, provenance, penetration)
+    return RulesFile(model, bullets, provenance, penetration, bullets_hurt)
+
+
+def _hp_lost_hits(
+    round_: Round, rows: DamageRows, chosen: np.ndarray, distance: np.ndarray
+) -> list[tuple[str, float, float, float, bool]]:
+    """(weapon, distance, HP lost, victim's HP before, armour took part) of the `chosen` rows,
+    hits whose data records only the HP lost."""
+    out = []
+    for r in np.flatnonzero(chosen):
+        earlier = (rows.victim == rows.victim[r]) & (rows.tick < rows.tick[r])
+        before = 100.0 - float(rows.hp_taken[earlier].sum())
+        armored = bool(rows.armor_damage[r] > 0)
+        lost = float(rows.hp_taken[r])
+        out.append((str(rows.weapon[r]), float(distance[r]), lost, before, armored))
+    return out
 
 
 def pair_outcome(
@@ -246,10 +290,12 @@ def pair_outcome(
     armor: int,
     helmet: bool,
     draw: np.random.Generator,
+    victim_hp: int = FULL_HP,
 ) -> tuple[int, int, str]:
-    """One damaging step of one pair (module doc, step 2): (health damage summed over the
-    bullets, armour they took, the hit group of the bullet that did the most)."""
-    p = rules.bullets.probabilities(weapon)
+    """One damaging step of one pair (module doc, step 2) on a victim with `victim_hp` at the
+    step's start: (health damage summed over the bullets, armour they took, the hit group of
+    the bullet that did the most)."""
+    p = rules.bullet_counts(victim_hp).probabilities(weapon)
     count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
     groups = rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
     health, taken, largest, largest_group = 0, 0, -1, groups[0]
@@ -270,10 +316,12 @@ def rules_generate(
     distances_m: np.ndarray,
     armor: np.ndarray,
     helmet: np.ndarray,
+    victim_hp: np.ndarray,
     seed: int,
     draws: int,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """`draws` outcomes of K damaging pair-steps, as the DOG's generative mode gives them:
+    """`draws` outcomes of K damaging pair-steps (victims with `victim_hp` at its start), as
+    the DOG's generative mode gives them:
     (draws, K) damage in HP (summed, in [1, 100]) and hit-group codes. A weapon the rules lack
     raises `UnknownWeaponError`."""
     draw = np.random.default_rng(seed)
@@ -288,6 +336,7 @@ def rules_generate(
                 int(armor[k]),
                 bool(helmet[k]),
                 draw,
+                int(victim_hp[k]),
             )
             damage[d, k] = min(max(health, 1), 100)
             group[d, k] = GROUPS.index(name)
@@ -332,6 +381,7 @@ class RulesDamage:
                 int(batch.victim_armor[row]),
                 bool(batch.victim_helmet[row]),
                 draw,
+                int(batch.victim_hp[row]),
             )
             damage[row] = min(max(health, 1), max(int(batch.victim_hp[row]), 1))
             armor_damage[row] = taken
