@@ -161,6 +161,8 @@ def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
     assert report["damage_by"] == "rules" and set(report["hp_lost"]) == {"step", "hit"}
     step = report["hp_lost"]["step"]["de_ancient"]
     assert step["steps"] == report["dip"]["positives"]  # every damaging step scored
+    assert report["dip_by_map"]["de_ancient"]["positives"] == step["steps"]
+    assert "DIP on de_ancient: recall" in result.output
     assert 0 < step["mean_floor_hp"] < step["mean_wasserstein_hp"]
 
 

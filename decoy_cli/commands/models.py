@@ -292,6 +292,13 @@ def evaluate(
         console.print(f"warning: {line}", style="yellow", markup=False)
     if result.dip is not None:
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
+        for where, m in result.report["dip_by_map"].items():
+            console.print(
+                f"DIP on {where}: recall {m['recall']:.3f}, precision {m['precision']:.3f}, "
+                f"ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} damaging, "
+                f"{m['negatives']:,} not)",
+                highlight=False,
+            )
     if result.dog is not None:
         console.print(dog_table(result.dog.metrics, f"DOG of {result.name} ({subset} samples)"))
         if result.dog.metrics["cells"]:

@@ -115,6 +115,7 @@ def evaluate_model_folder(
             raise ModelError(f"no damaging samples in the {subset} samples: DIP cannot be scored")
         dip_result = evaluate_dip(dip, samples.take(chosen), threshold)
         report["dip"] = {"balanced": balanced, **dip_result.metrics}
+        report["dip_by_map"] = dip_by_map(dip_result, samples.map_name[chosen])
         figures += write_dip_figures(dip_result, out, f"DIP of {name}")
     hits = index[samples.hit[index]]
     if len(hits) == 0:
@@ -168,6 +169,19 @@ def evaluate_model_folder(
         out,
         figures,
     )
+
+
+def dip_by_map(result: DipEvaluation, maps: np.ndarray) -> dict[str, dict[str, float]]:
+    """DIP's classification metrics (at the same threshold) on each map's samples."""
+    from decoy_cli.damage.scores import classification_metrics
+
+    threshold = result.metrics["threshold"]
+    return {
+        str(name): classification_metrics(
+            result.labels[maps == name], result.probabilities[maps == name], threshold
+        )
+        for name in sorted({str(m) for m in maps})
+    }
 
 
 def _hit_samples(choice: SampleChoice, samples: Samples, subset: str, index: np.ndarray) -> Samples:
