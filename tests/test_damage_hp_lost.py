@@ -17,9 +17,9 @@ from scipy.stats import wasserstein_distance
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
+from decoy_cli.damage.bullet_counts import BulletCounts
 from decoy_cli.damage.hp_lost import band_labels, drawn_hp_lost, score_hp_lost
 from decoy_cli.damage.model_maps import map_warnings, trained_maps
-from decoy_cli.damage.rules_model import BulletCounts
 from decoy_cli.damage.samples import build_samples
 from decoy_cli.damage.split import leave_matches_out
 
@@ -80,21 +80,44 @@ def test_hp_lost_cells_by_hand() -> None:
 
 
 def test_bullets_per_step_by_weapon_pulled_toward_the_class() -> None:
-    """Four rifle steps: AK-47 one bullet twice, M4A4 one and two. All steps: (3, 1) / 4; the
-    Rifle class is its counts (3, 1) pulled toward that with 5 pseudo-steps; the AK-47 its
-    counts (2, 0) pulled toward the class's with 5 more."""
+    """Four rifle steps at 300 u: AK-47 one bullet twice, M4A4 one and two. All steps: (3, 1) /
+    4; the Rifle class its counts (3, 1) pulled toward that with 5 pseudo-steps; the AK-47 its
+    counts (2, 0) pulled toward the class's, and the AK-47 at 0-500 u the same counts toward
+    the AK-47's."""
     counts = BulletCounts()
     for weapon, bullets in (("AK-47", 1), ("AK-47", 1), ("M4A4", 1), ("M4A4", 2)):
-        counts.add(weapon, bullets)
+        counts.add(weapon, 300.0, bullets)
     every = np.array([3, 1] + [0] * 8) / 4
     rifle = (np.array([3, 1] + [0] * 8) + 5 * every) / (4 + 5)
     ak = (np.array([2, 0] + [0] * 8) + 5 * rifle) / (2 + 5)
-    np.testing.assert_allclose(counts.probabilities("AK-47"), ak)
-    assert counts.probabilities("AK-47")[0] > counts.probabilities("M4A4")[0]
+    ak_near = (np.array([2, 0] + [0] * 8) + 5 * ak) / (2 + 5)
+    np.testing.assert_allclose(counts.probabilities("AK-47", 300.0), ak_near)
+    np.testing.assert_allclose(counts.probabilities("AK-47", 2000.0), ak)  # no far steps
     again = BulletCounts.from_dict(json.loads(json.dumps(counts.to_dict())))
-    np.testing.assert_allclose(again.probabilities("M4A4"), counts.probabilities("M4A4"))
-    old = {"by_class": counts.by_class, "every": counts.every}  # a rules.json before weapons
-    np.testing.assert_allclose(BulletCounts.from_dict(old).probabilities("AK-47"), rifle)
+    np.testing.assert_allclose(
+        again.probabilities("M4A4", 300.0), counts.probabilities("M4A4", 300.0)
+    )
+    old = {"by_class": {"Rifle": [3.0, 1.0] + [0.0] * 8}, "every": [3.0, 1.0] + [0.0] * 8}
+    np.testing.assert_allclose(BulletCounts.from_dict(old).probabilities("AK-47", 300.0), rifle)
+
+
+def test_censored_bullet_counts_by_hand() -> None:
+    """Two AK-47 steps at 300 u: one bullet that left the victim alive, two that killed it. All
+    levels hold the same counts, so each pulls the hazard of "no further bullet" toward the one
+    above with 5 pseudo-steps. At one bullet: 1 ended of 2 at risk; at two: 0 ended (the kill
+    is censored) of 1; the AK-47 was seen landing at most 2, so the rest ends there."""
+    counts = BulletCounts(censored=True)
+    counts.add("AK-47", 300.0, 1, killed=False)
+    counts.add("AK-47", 300.0, 2, killed=True)
+    hazard = np.ones(10)
+    at_risk = np.array([2.0, 1.0] + [0.0] * 8)
+    ended = np.array([1.0] + [0.0] * 9)
+    for _ in range(4):  # all steps, the Rifle class, the AK-47, the AK-47 at 0-500 u
+        hazard = (ended + 5 * hazard) / (at_risk + 5)
+    p_one = hazard[0]
+    expected = np.array([p_one, 1 - p_one] + [0.0] * 8)
+    np.testing.assert_allclose(counts.probabilities("AK-47", 300.0), expected)
+    assert p_one < 1.0 and counts.probabilities("AK-47", 300.0)[1] > 0
 
 
 def test_leave_matches_out_folds() -> None:
@@ -210,12 +233,12 @@ def test_rules_file_keeps_bullets_of_hurt_victims(tmp_path: Path) -> None:
     from decoy_cli.damage.rules_model import RulesFile
 
     unhurt, hurt = BulletCounts(), BulletCounts()
-    unhurt.add("AK-47", 3)
-    hurt.add("AK-47", 1)
+    unhurt.add("AK-47", 300.0, 3)
+    hurt.add("AK-47", 300.0, 1)
     rules = RulesFile(HitGroupModel(), unhurt, {}, bullets_hurt=hurt)
     rules.save(tmp_path)
     again = RulesFile.load(tmp_path)
-    assert again.bullet_counts(100).probabilities("AK-47")[2] == 1.0
-    assert again.bullet_counts(99).probabilities("AK-47")[0] == 1.0
+    assert again.bullet_counts(100).probabilities("AK-47", 300.0)[2] == 1.0
+    assert again.bullet_counts(99).probabilities("AK-47", 300.0)[0] == 1.0
     old = dataclasses.replace(rules, bullets_hurt=None)
     assert old.bullet_counts(40) is old.bullets

@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model
-from decoy_cli.damage.rules_model import MAX_BULLETS, RulesDamage
+from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS
+from decoy_cli.damage.rules_model import RulesDamage
 from decoy_cli.errors import ModelError
 
 runner = CliRunner()
@@ -40,7 +41,8 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     explained, left = data["provenance"]["hits_by_hp_lost"], data["provenance"]["hits_unexplained"]
     assert explained + left == 1835 and explained > 4 * left
     data = json.loads((folder / "rules.json").read_text())
-    assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
+    every = data["bullets"]["counts"][ALL]
+    assert sum(every) > 0 and len(every) == MAX_BULLETS and data["bullets"]["censored"]
     # the shipped rules.json is this very fit
     shipped = json.loads((ROOT / "models" / "rules.json").read_text())
     assert data["bullets"] == shipped["bullets"]

@@ -16,11 +16,11 @@ from typing import Any
 
 import numpy as np
 
+from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS, BulletCounts
 from decoy_cli.damage.damage_rows import group_id
 from decoy_cli.damage.evaluation import DRAWS, DipEvaluation, DogEvaluation
 from decoy_cli.damage.hp_lost import HpLostScores
 from decoy_cli.damage.provenance import FileCallback, SampleChoice, write_json
-from decoy_cli.damage.rules_model import BulletCounts
 from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.damage.split import balance
@@ -141,7 +141,7 @@ def evaluate_model_folder(
     if rules is not None:
         per_hit = _hit_samples(choice, samples, subset, index)
         if len(per_hit):
-            one = BulletCounts(every=[1.0] + [0.0] * 9)
+            one = BulletCounts({ALL: [1.0] + [0.0] * (MAX_BULLETS - 1)})
             one_bullet = replace(rules, bullets=one, bullets_hurt=None)
             drawn, _ = draw_outcomes(one_bullet, per_hit, choice.seed, draws)
             hp_lost["hit"] = score_by_map(per_hit, drawn, min_cell)

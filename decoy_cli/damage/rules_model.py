@@ -31,7 +31,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior, weapon_class
+from decoy_cli.damage.bullet_counts import ALL, BulletCounts
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
 from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
@@ -45,59 +46,6 @@ if TYPE_CHECKING:
 RULES_FILE = "rules.json"
 FULL_HP = 100
 """A victim at this HP at a step's start is unhurt (`RulesFile.bullets`)."""
-MAX_BULLETS = 10
-"""Bullet counts above this are counted as this many."""
-PRIOR_STEPS = 5.0
-"""Pseudo-steps pulling a class's bullet counts toward all classes'."""
-
-
-@dataclass
-class BulletCounts:
-    """How many bullets of one pair land in one damaging step, by weapon, pulled toward its
-    class's counts and those toward all steps' (module doc)."""
-
-    by_class: dict[str, list[float]] = field(default_factory=dict)
-    every: list[float] = field(default_factory=lambda: [0.0] * MAX_BULLETS)
-    by_weapon: dict[str, list[float]] = field(default_factory=dict)
-    """Empty in a `rules.json` written before weapons were counted: the class's counts."""
-
-    def add(self, weapon: str, bullets: int) -> None:
-        n = min(max(bullets, 1), MAX_BULLETS) - 1
-        self.by_weapon.setdefault(weapon, [0.0] * MAX_BULLETS)[n] += 1
-        self.by_class.setdefault(weapon_class(weapon), [0.0] * MAX_BULLETS)[n] += 1
-        self.every[n] += 1
-
-    def probabilities(self, weapon: str) -> np.ndarray:
-        """(MAX_BULLETS,) P(1..MAX_BULLETS bullets); one bullet when nothing was counted."""
-        every = np.asarray(self.every, np.float64)
-        if every.sum() == 0:
-            p = np.zeros(MAX_BULLETS)
-            p[0] = 1.0
-            return p
-        p = every / every.sum()
-        for table in (self.by_class.get(weapon_class(weapon)), self.by_weapon.get(weapon)):
-            if table is not None:
-                counts = np.asarray(table, np.float64)
-                p = (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
-        return p
-
-    def to_dict(self) -> dict[str, object]:
-        return {name: getattr(self, name) for name in self.__dataclass_fields__}
-
-    @classmethod
-    def from_dict(cls, data: dict) -> BulletCounts:
-        """Counts written by `to_dict` (older files lack the weapon table)."""
-
-        def tables(name: str) -> dict[str, list[float]]:
-            return {str(k): [float(v) for v in c] for k, c in data.get(name, {}).items()}
-
-        return cls(tables("by_class"), [float(v) for v in data["every"]], tables("by_weapon"))
-
-    def check(self) -> None:
-        """A ValueError unless every table holds `MAX_BULLETS` counts, none negative."""
-        for counts in (self.every, *self.by_class.values(), *self.by_weapon.values()):
-            if len(counts) != MAX_BULLETS or min(counts) < 0:
-                raise ValueError(f"bullet counts must be {MAX_BULLETS} counts, none negative")
 
 
 PENETRATED_BELOW = 0.9
@@ -213,7 +161,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     distances: list[float] = []
     groups: list[str] = []
     health: list[float] = []
-    bullets, bullets_hurt = BulletCounts(), BulletCounts()
+    bullets, bullets_hurt = BulletCounts(censored=True), BulletCounts()
     unknown: list[tuple[str, float, float, float, bool]] = []
     used_rounds = 0
     maps: set[str] = set()
@@ -237,9 +185,12 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
         for hit in steps.values():
             earlier = (rows.victim == rows.victim[hit.first]) & (rows.tick < rows.tick[hit.first])
-            hurt = float(rows.hp_taken[earlier].sum()) > 0
-            (bullets_hurt if hurt else bullets).add(str(rows.weapon[hit.first]), hit.hits)
-    if not sum(bullets.every) + sum(bullets_hurt.every):
+            lost = float(rows.hp_taken[earlier].sum())
+            killed = lost + hit.hp_lost >= FULL_HP - 0.5
+            counts = bullets_hurt if lost > 0 else bullets
+            counts.add(str(rows.weapon[hit.first]), float(distance[hit.first]), hit.hits, killed)
+    total = sum(sum(c.counts.get(ALL, [])) for c in (bullets, bullets_hurt))
+    if not total:
         raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
     if not weapons:
         raise ModelError(
@@ -259,7 +210,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         "hits": len(weapons),
         "hits_by_hp_lost": explained,
         "hits_unexplained": len(unknown) - explained,
-        "steps": int(sum(bullets.every) + sum(bullets_hurt.every)),
+        "steps": int(total),
         "rounds": used_rounds,
         "maps": sorted(maps),
         "left_out": dict(stats.excluded),
@@ -295,7 +246,7 @@ def pair_outcome(
     """One damaging step of one pair (module doc, step 2) on a victim with `victim_hp` at the
     step's start: (health damage summed over the bullets, armour they took, the hit group of
     the bullet that did the most)."""
-    p = rules.bullet_counts(victim_hp).probabilities(weapon)
+    p = rules.bullet_counts(victim_hp).probabilities(weapon, distance_u)
     count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
     groups = rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
     health, taken, largest, largest_group = 0, 0, -1, groups[0]
