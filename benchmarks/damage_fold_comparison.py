@@ -53,15 +53,16 @@ def main() -> None:
             spec = load_dog(SHIPPED_MODELS).spec
             cvae = CvaeTraining(options, DogLossWeights(kl=0.05), spec)
         results = compare_on_folds(rounds, samples, folders, seed=args.seed, cvae=cvae)
+    width = max(len(r.name) for r in results)
     print(
-        f"{'model':<46} {'mean W':>7} {'max W':>7} {'floor':>6} {'cells':>5} {'per fold':>14}  "
-        "hit-group TV"
+        f"{'model':<{width}} {'mean W':>7} {'max W':>7} {'floor':>6} {'cells':>5} "
+        f"{'per fold':>14}  hit-group TV"
     )
     for r in results:
         folds = np.array(r.fold_means)
         tv = ", ".join(f"{w} {v:.3f}" for w, v in r.group_tv.items())
         print(
-            f"{r.name:<46} {r.mean_wasserstein_hp:7.2f} {r.max_wasserstein_hp:7.2f} "
+            f"{r.name:<{width}} {r.mean_wasserstein_hp:7.2f} {r.max_wasserstein_hp:7.2f} "
             f"{r.mean_floor_hp:6.2f} {r.cells:5d} {folds.mean():6.2f} ± {folds.std(ddof=1):4.2f}  "
             f"{tv}"
         )
