@@ -5,8 +5,9 @@ Per combat step, over every visible ordered pair at once:
 1. DIP decides which attackers hit their victim in this 0.5 s step (`DipDecision`: its threshold,
    or its calibration's rule);
 2. for each hitting pair, the number of bullets that land in the step is drawn from a
-   distribution learned from real hits per weapon class (`BulletCounts`), each bullet's hit group
-   from `HitGroupModel` (weapon and distance), and each bullet's health and armour damage from
+   distribution learned from real steps by weapon and range, apart for victims unhurt and hurt
+   (`bullet_counts.BulletCounts`), each bullet's hit group from `HitGroupModel` (weapon and
+   distance), and each bullet's health and armour damage from
    the rules (decoy_cli/damage/rules.py) against the victim's armour and helmet, the armour worn
    down bullet by bullet, and a learned share of bullets scaled down as through a wall
    (`Penetration`);
