@@ -242,3 +242,17 @@ def test_rules_file_keeps_bullets_of_hurt_victims(tmp_path: Path) -> None:
     assert again.bullet_counts(99).probabilities("AK-47", 300.0)[0] == 1.0
     old = dataclasses.replace(rules, bullets_hurt=None)
     assert old.bullet_counts(40) is old.bullets
+
+
+def test_hits_without_position_or_view_are_counted_by_reason(tmp_path: Path) -> None:
+    """Round 2's first hit loses its victim's z, the second its attacker's view angle: neither
+    becomes a sample, each is counted with its reason."""
+    document = make_match()
+    damages = document["gameRounds"][1]["damages"]
+    damages[0]["victimZ"] = None
+    damages[1]["attackerViewX"] = None
+    path = write_match(tmp_path / "m.json.xz", document)
+    samples, stats = build_samples([path], mode="events")
+    assert stats.excluded["no attacker or victim position (x, y or z)"] == 1
+    assert stats.excluded["no attacker or victim view angle"] == 1
+    assert not samples.hit.any()

@@ -201,8 +201,11 @@ def _event_positives(
         v_pos = np.array([table[f"victim{axis}_m"].iloc[first] for axis in "XYZ"])
         a_yaw = float(table["attackerViewX"].iloc[first])
         v_yaw = float(table["victimViewX"].iloc[first])
-        if not np.isfinite([*a_pos, *v_pos, a_yaw, v_yaw]).all():
-            stats.excluded["no attacker or victim state"] += 1
+        if not np.isfinite([*a_pos, *v_pos]).all():
+            stats.excluded["no attacker or victim position (x, y or z)"] += 1
+            continue
+        if not np.isfinite([a_yaw, v_yaw]).all():
+            stats.excluded["no attacker or victim view angle"] += 1
             continue
         tick = float(damages.tick[first])
         armor, helmet = events.armor_of(victim)
