@@ -256,3 +256,12 @@ def test_hits_without_position_or_view_are_counted_by_reason(tmp_path: Path) -> 
     assert stats.excluded["no attacker or victim position (x, y or z)"] == 1
     assert stats.excluded["no attacker or victim view angle"] == 1
     assert not samples.hit.any()
+
+
+def test_models_evaluate_none_is_one_error_line(tmp_path: Path) -> None:
+    path = write_match(tmp_path / "m.json.xz", make_match())
+    result = CliRunner().invoke(app, ["models", "evaluate", "none", str(path)], env=WIDE)
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines() == [
+        "error: none: no models to evaluate (none turns shooting off)"
+    ]

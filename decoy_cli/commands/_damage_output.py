@@ -40,7 +40,9 @@ VAL_HELP = "Share of the split units for validation (early stopping, DIP thresho
 TEST_HELP = "Share of the split units held out for the test metrics."
 BALANCE_HELP = "DIP: keep all positives and as many random negatives per part (the paper's 1:1)."
 DRAWS_HELP = "DOG generative mode: samples drawn per test condition."
-MIN_CELL_HELP = "DOG: fewest real samples a (weapon, hit group) cell needs for the Wasserstein."
+MIN_CELL_HELP = (
+    "Fewest real samples a (weapon, hit group or distance band) cell needs for the Wasserstein."
+)
 
 FAILURES_SHOWN = 5
 """Failed inputs printed one per line; the rest are counted (all are in the JSON report)."""

@@ -73,6 +73,8 @@ def evaluate_model_folder(
     ModelError line."""
     from decoy_cli.damage import damages_by_rules, resolve_models
 
+    if models == "none":
+        raise ModelError("none: no models to evaluate (none turns shooting off)")
     folder = resolve_models(models)
     by_rules = damages_by_rules(models, folder)
     has_dip = (folder / "dip.json").is_file()
