@@ -303,7 +303,8 @@ def evaluate(
         console.print(dog_table(result.dog.metrics, f"DOG of {result.name} ({subset} samples)"))
         if result.dog.metrics["cells"]:
             console.print(cells_table(result.dog.metrics["cells"]))
-    console.print(hp_lost_table(result.hp_lost, f"HP lost, {result.name} against real"))
+    if result.hp_lost:
+        console.print(hp_lost_table(result.hp_lost, f"HP lost, {result.name} against real"))
     for note in result.notes:
         console.print(note, highlight=False)
     console.print(f"metrics and {len(result.figures)} figures written to {result.out}")

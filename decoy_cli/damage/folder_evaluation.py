@@ -120,16 +120,27 @@ def evaluate_model_folder(
         report["dip_by_map"] = dip_by_map(dip_result, samples.map_name[chosen])
         figures += write_dip_figures(dip_result, out, f"DIP of {name}")
     hits = index[samples.hit[index]]
-    if len(hits) == 0:
+    outcome = RulesFile.load(folder) if by_rules else load_dog(folder) if has_dog else None
+    hp_lost: dict[str, dict[str, HpLostScores]] = {}
+    if outcome is None:
+        notes.append("no DOG and no rules.json: the damage is not scored")
+    elif len(hits) == 0:
         raise ModelError(f"no damaging samples in the {subset} samples: damage cannot be scored")
-    rules = RulesFile.load(folder) if by_rules else None
-    outcome = rules if rules is not None else load_dog(folder)
-    if has_dog:
+    else:
+        positives = samples.take(hits)
+        damage, _ = draw_outcomes(outcome, positives, choice.seed, draws)
+        hp_lost["step"] = score_by_map(positives, damage, min_cell)
+    if isinstance(outcome, RulesFile):
+        per_hit = _hit_samples(choice, samples, subset, index)
+        if len(per_hit):
+            one = BulletCounts({ALL: [1.0] + [0.0] * (MAX_BULLETS - 1)})
+            one_bullet = replace(outcome, bullets=one, bullets_hurt=None)
+            drawn, _ = draw_outcomes(one_bullet, per_hit, choice.seed, draws)
+            hp_lost["hit"] = score_by_map(per_hit, drawn, min_cell)
+    elif outcome is not None:
         known = hits[samples.outcome_known[hits]]
         if len(known):
-            dog_result = evaluate_dog(
-                load_dog(folder), samples.take(known), choice.seed, draws, min_cell
-            )
+            dog_result = evaluate_dog(outcome, samples.take(known), choice.seed, draws, min_cell)
             report["dog"] = dog_result.metrics
             figures += write_dog_figures(dog_result, out, f"DOG of {name}")
         if len(known) < len(hits):
@@ -137,17 +148,6 @@ def evaluate_model_folder(
                 f"DOG by hit group: {len(hits) - len(known)} of {len(hits)} damaging steps left "
                 "out (their data records no hit group or raw damage); all are in the HP lost"
             )
-    positives = samples.take(hits)
-    damage, _ = draw_outcomes(outcome, positives, choice.seed, draws)
-    hp_lost = {"step": score_by_map(positives, damage, min_cell)}
-    if rules is not None:
-        per_hit = _hit_samples(choice, samples, subset, index)
-        if len(per_hit):
-            one = BulletCounts({ALL: [1.0] + [0.0] * (MAX_BULLETS - 1)})
-            one_bullet = replace(rules, bullets=one, bullets_hurt=None)
-            drawn, _ = draw_outcomes(one_bullet, per_hit, choice.seed, draws)
-            hp_lost["hit"] = score_by_map(per_hit, drawn, min_cell)
-    else:
         notes.append("per hit: a DOG draws a step's damage, not a bullet's: scored per step only")
     report["hp_lost"] = {
         unit: {where: scores.to_json() for where, scores in of_map.items()}

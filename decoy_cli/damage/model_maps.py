@@ -47,6 +47,8 @@ def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
         parts["dog"] = "DOG (how much damage)"
     lines = []
     for part, what in parts.items():
+        if not (folder / (RULES_FILE if part == "rules" else f"{part}.json")).is_file():
+            continue
         known = trained_maps(folder, part)
         if known is None:
             lines.append(
