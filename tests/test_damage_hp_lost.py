@@ -265,3 +265,20 @@ def test_models_evaluate_none_is_one_error_line(tmp_path: Path) -> None:
     assert result.output.strip().splitlines() == [
         "error: none: no models to evaluate (none turns shooting off)"
     ]
+
+
+def test_models_evaluate_a_dip_alone(tmp_path: Path) -> None:
+    """A folder with a DIP and neither DOG nor rules.json: its DIP is scored, the damage is
+    not, and the output says so."""
+    folder = tmp_path / "dip-only"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    path = write_match(tmp_path / "m.json.xz", make_match())
+    out = tmp_path / "out"
+    args = ["models", "evaluate", str(folder), str(path), "--out", str(out), "--mode", "events"]
+    result = CliRunner().invoke(app, args, env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert "no DOG and no rules.json: the damage is not scored" in result.output
+    report = json.loads((out / "metrics.json").read_text())
+    assert report["dip"]["positives"] == 2 and report["hp_lost"] == {}
