@@ -282,3 +282,26 @@ def test_models_evaluate_a_dip_alone(tmp_path: Path) -> None:
     assert "no DOG and no rules.json: the damage is not scored" in result.output
     report = json.loads((out / "metrics.json").read_text())
     assert report["dip"]["positives"] == 2 and report["hp_lost"] == {}
+
+
+def test_the_evaluation_report_names_who_decides_hits_and_damage() -> None:
+    """report.md and summary.json say which model decided the hits and which the damage, and
+    warn when a model was not trained on the evaluated map."""
+    from decoy_cli.evaluate.report import model_lines
+    from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
+
+    common = {"bomb": True, "mover": "kinematic", "seed": 0, "code": "c"}
+    grid = HeatGrid.for_map("de_ancient")
+    ancient = EvalSettings(
+        map_name="de_ancient", combat=True, models="rules", grid=grid, models_fingerprint="f",
+        **common,
+    )  # fmt: skip
+    lines = model_lines(ancient)
+    assert lines["hits decided by"] == "the DIP of the shipped models"
+    assert lines["damage decided by"].startswith("the game's damage rules")
+    assert "trained on de_dust2 only, not on de_ancient" in lines["model warnings"]
+    off = dataclasses.replace(ancient, combat=False, models="none", models_fingerprint="")
+    assert model_lines(off) == {
+        "hits decided by": "none (no shooting)",
+        "damage decided by": "none (no shooting)",
+    }
