@@ -305,3 +305,15 @@ def test_the_evaluation_report_names_who_decides_hits_and_damage() -> None:
         "hits decided by": "none (no shooting)",
         "damage decided by": "none (no shooting)",
     }
+
+
+def test_unidentifiable_players_are_counted_by_reason(tmp_path: Path) -> None:
+    """Round 2's first hit loses its attacker's steamID and name, the second its victim's."""
+    document = make_match()
+    damages = document["gameRounds"][1]["damages"]
+    damages[0]["attackerSteamID"] = damages[0]["attackerName"] = None
+    damages[1]["victimSteamID"] = damages[1]["victimName"] = None
+    path = write_match(tmp_path / "m.json.xz", document)
+    _, stats = build_samples([path], mode="events")
+    assert stats.excluded["attacker not identifiable (no steamID or name)"] == 1
+    assert stats.excluded["victim not identifiable (no steamID or name)"] == 1

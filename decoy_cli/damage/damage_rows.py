@@ -108,7 +108,9 @@ def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
     usable = np.zeros(len(table), dtype=bool)
     outcome_known = np.zeros(len(table), dtype=bool)
     for i in range(len(table)):
-        if attacker[i] is None or weapon[i] == "World":
+        if attacker[i] is None and weapon[i] in VOCABULARY:
+            reason = "attacker not identifiable (no steamID or name)"
+        elif attacker[i] is None or weapon[i] == "World":
             reason = "world damage (no attacker)"
         elif friendly[i] is True or (attacker_side[i] and attacker_side[i] == victim_side[i]):
             reason = "friendly fire"
@@ -116,8 +118,10 @@ def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
             reason = "grenade, fire or bomb"
         elif weapon[i] not in VOCABULARY:
             reason = "weapon outside the vocabulary"
-        elif not (hp_taken[i] > 0 or hp_damage[i] > 0) or victim[i] is None:
-            reason = "no damage value or victim"
+        elif not (hp_taken[i] > 0 or hp_damage[i] > 0):
+            reason = "no damage value"
+        elif victim[i] is None:
+            reason = "victim not identifiable (no steamID or name)"
         elif not np.isfinite(tick[i]):
             reason = "no tick"
         else:
