@@ -317,3 +317,18 @@ def test_unidentifiable_players_are_counted_by_reason(tmp_path: Path) -> None:
     _, stats = build_samples([path], mode="events")
     assert stats.excluded["attacker not identifiable (no steamID or name)"] == 1
     assert stats.excluded["victim not identifiable (no steamID or name)"] == 1
+
+
+def test_paper_names_the_imported_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """--models paper is the folder `paper`, else decoy-out/models/paper; with neither, one
+    ModelError line says how to import it."""
+    from decoy_cli.damage import resolve_models
+    from decoy_cli.errors import ModelError
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ModelError, match="import the paper's models first"):
+        resolve_models("paper")
+    (tmp_path / "decoy-out" / "models" / "paper").mkdir(parents=True)
+    assert resolve_models("paper") == Path("decoy-out") / "models" / "paper"
+    (tmp_path / "paper").mkdir()
+    assert resolve_models("paper") == Path("paper")
