@@ -2,10 +2,11 @@
 python benchmarks/damage_fold_comparison.py [EVENTS...] [--paper CHECKPOINTS] [--seed N]
 
 The rules-grounded model (its parts fitted per fold), the paper's DOG (imported from its
-published checkpoints, trained on other matches) and the shipped DOG (trained on 60% of these
-very rounds, so flattered here) are scored as decoy_cli/damage/fold_comparison.py says: mean
-Wasserstein per (weapon, hit group) cell with at least 5 real samples, pooled and per fold, and
-the hit-group total variation per weapon with at least 30 samples.
+published checkpoints, trained on other matches) and the shipped DOG (its label says how many
+of these rounds it was trained or validated on, from its metadata: flattered on those) are
+scored as decoy_cli/damage/fold_comparison.py says: mean Wasserstein per (weapon, hit group)
+cell with at least 5 real samples, pooled and per fold, and the hit-group total variation per
+weapon with at least 30 samples.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.damage import SHIPPED_MODELS
-from decoy_cli.damage.fold_comparison import CvaeTraining, compare_on_folds
+from decoy_cli.damage.fold_comparison import CvaeTraining, compare_on_folds, training_overlap
 from decoy_cli.damage.model_folder import load_dog
 from decoy_cli.damage.paper import import_paper
 from decoy_cli.damage.samples import build_samples
@@ -41,7 +42,8 @@ def main() -> None:
     samples, _ = build_samples(files)
     print(f"{int(samples.hit.sum())} damaging samples of {len(rounds)} rounds, 5 folds by round")
     with tempfile.TemporaryDirectory() as scratch:
-        folders = {"shipped DOG (trained on 60% of these rounds)": SHIPPED_MODELS}
+        seen = training_overlap(load_dog(SHIPPED_MODELS).metadata, samples)
+        folders = {f"shipped DOG ({seen})": SHIPPED_MODELS}
         if args.paper.is_dir():
             import_paper(args.paper, Path(scratch) / "paper")
             folders = {"paper DOG (imported checkpoint)": Path(scratch) / "paper", **folders}
@@ -51,15 +53,16 @@ def main() -> None:
             spec = load_dog(SHIPPED_MODELS).spec
             cvae = CvaeTraining(options, DogLossWeights(kl=0.05), spec)
         results = compare_on_folds(rounds, samples, folders, seed=args.seed, cvae=cvae)
+    width = max(len(r.name) for r in results)
     print(
-        f"{'model':<46} {'mean W':>7} {'max W':>7} {'floor':>6} {'cells':>5} {'per fold':>14}  "
-        "hit-group TV"
+        f"{'model':<{width}} {'mean W':>7} {'max W':>7} {'floor':>6} {'cells':>5} "
+        f"{'per fold':>14}  hit-group TV"
     )
     for r in results:
         folds = np.array(r.fold_means)
         tv = ", ".join(f"{w} {v:.3f}" for w, v in r.group_tv.items())
         print(
-            f"{r.name:<46} {r.mean_wasserstein_hp:7.2f} {r.max_wasserstein_hp:7.2f} "
+            f"{r.name:<{width}} {r.mean_wasserstein_hp:7.2f} {r.max_wasserstein_hp:7.2f} "
             f"{r.mean_floor_hp:6.2f} {r.cells:5d} {folds.mean():6.2f} ± {folds.std(ddof=1):4.2f}  "
             f"{tv}"
         )

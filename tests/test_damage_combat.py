@@ -405,15 +405,16 @@ def test_a_calibrated_dip_decides_by_its_rule(folder: Path, tmp_path: Path) -> N
 
 
 def test_rules_damage_is_the_rules_per_bullet(firing: Path) -> None:
+    from decoy_cli.damage.bullet_counts import BulletCounts
     from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
     from decoy_cli.damage.rules import shot_damage
-    from decoy_cli.damage.rules_model import BulletCounts, RulesDamage, RulesFile
+    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
     rng = np.random.default_rng(61)
     groups = [GROUPS[i] for i in rng.integers(0, 6, 600)]
     hit_groups = HitGroupModel.fit(["AK-47"] * 600, rng.uniform(100, 2000, 600), groups)
     single = BulletCounts()
-    single.add("AK-47", 1)  # every damaging step lands one bullet
+    single.add("AK-47", 500.0, 1)  # every damaging step lands one bullet
     model = RulesDamage(load_dip(firing), RulesFile(hit_groups, single))
     pairs = batch(300, seed=6, weapons=["AK-47"] * 299 + ["Knife"])
     first = model(pairs, np.random.default_rng(4))
@@ -469,11 +470,12 @@ def test_the_shipped_rules_are_a_models_choice() -> None:
 
 
 def test_rules_bullets_wear_armour_down_one_after_another() -> None:
+    from decoy_cli.damage.bullet_counts import BulletCounts
     from decoy_cli.damage.hit_groups import HitGroupModel
-    from decoy_cli.damage.rules_model import BulletCounts, RulesFile, pair_outcome
+    from decoy_cli.damage.rules_model import RulesFile, pair_outcome
 
     three = BulletCounts()
-    three.add("AK-47", 3)
+    three.add("AK-47", 800.0, 3)
     hit_groups = HitGroupModel.fit(["AK-47"], [800.0], ["Chest"])
     hit_groups.sample = lambda rng, weapons, distances: ["Chest"] * len(weapons)  # type: ignore[method-assign]
     rules = RulesFile(hit_groups, three)

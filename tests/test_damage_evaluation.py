@@ -110,7 +110,7 @@ def test_wasserstein_cells() -> None:
     cells = wasserstein_cells(
         weapon, group, damage, generated_weapon, generated_group, generated_damage, min_cell=10
     )
-    assert [(c.weapon, c.hit_group, c.real, c.generated) for c in cells] == [
+    assert [(c.weapon, c.part, c.real, c.generated) for c in cells] == [
         ("AK-47", "Chest", 20, 60),
         ("AWP", "Chest", 12, 95),
         ("AK-47", "Head", 10, 40),

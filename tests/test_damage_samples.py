@@ -341,6 +341,7 @@ def synthetic(groups: int, per_group: int, matches: int = 1, seed: int = 0) -> S
         victim_helmet=np.ones(k, bool),
         hit=hit,
         damage=np.where(hit, 27.0, 0.0).astype(np.float32),
+        hp_lost=np.where(hit, 27.0, 0.0).astype(np.float32),
         hit_group=np.where(hit, 2, -1).astype(np.int8),
         group=group,
         match=np.array([g.split()[0] for g in group], dtype=object),

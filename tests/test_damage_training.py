@@ -60,6 +60,7 @@ def planted(count: int, seed: int, groups: int = 20) -> Samples:
         victim_helmet=np.ones(count, bool),
         hit=hit,
         damage=np.where(hit, np.clip(damage, 1, 100), 0).astype(np.float32),
+        hp_lost=np.where(hit, np.clip(damage, 1, 100), 0).astype(np.float32),
         hit_group=np.where(hit, np.where(head, 0, 2), -1).astype(np.int8),
         group=group,
         match=np.full(count, "m", dtype=object),

@@ -11,30 +11,44 @@ from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model
-from decoy_cli.damage.rules_model import MAX_BULLETS, RulesDamage
+from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS
+from decoy_cli.damage.rules_model import RulesDamage
 from decoy_cli.errors import ModelError
 
 runner = CliRunner()
 ROOT = Path(__file__).resolve().parents[1]
 EVENTS = ROOT.parent / "shared" / "data" / "esta_dust2_events"
+ANCIENT = ROOT.parent / "shared" / "data" / "events_ancient"
 
 
-@pytest.mark.skipif(not EVENTS.is_dir(), reason="needs ../shared/data/esta_dust2_events")
+@pytest.mark.skipif(
+    not (EVENTS.is_dir() and ANCIENT.is_dir()),
+    reason="needs ../shared/data/esta_dust2_events and ../shared/data/events_ancient",
+)
 def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     folder = tmp_path / "rules"
     folder.mkdir()
     for name in ("dip.pt", "dip.json"):
         shutil.copy(ROOT / "models" / name, folder / name)
-    result = runner.invoke(app, ["models", "fit-rules", str(folder), str(EVENTS)])
+    result = runner.invoke(
+        app, ["models", "fit-rules", str(folder), str(EVENTS), str(ANCIENT)], env={"COLUMNS": "300"}
+    )
     assert result.exit_code == 0, result.output
-    assert "396 firearm hits of 18 rounds" in result.output
+    # hit groups from de_dust2's 396 hits and the de_ancient hits the rules explain; bullets
+    # per step from the steps of both maps
+    assert "396 firearm hits" in result.output and "1536 damaging steps" in result.output
     data = json.loads((folder / "rules.json").read_text())
-    assert sum(data["bullets"]["every"]) > 0 and len(data["bullets"]["every"]) == MAX_BULLETS
+    explained, left = data["provenance"]["hits_by_hp_lost"], data["provenance"]["hits_unexplained"]
+    assert explained + left == 1835 and explained > 4 * left
+    data = json.loads((folder / "rules.json").read_text())
+    every = data["bullets"]["counts"][ALL]
+    assert sum(every) > 0 and len(every) == MAX_BULLETS and data["bullets"]["censored"]
     # the shipped rules.json is this very fit
     shipped = json.loads((ROOT / "models" / "rules.json").read_text())
     assert data["bullets"] == shipped["bullets"]
     assert data["penetration"] == shipped["penetration"]
     assert data["penetration"]["hits"] == 396 and 0 < len(data["penetration"]["shares"]) < 396 / 5
+    assert data["provenance"]["maps"] == ["de_ancient", "de_dust2"]
     assert isinstance(load_damage_model(str(folder)), RulesDamage)  # a DIP and rules, no DOG
 
 

@@ -40,7 +40,9 @@ VAL_HELP = "Share of the split units for validation (early stopping, DIP thresho
 TEST_HELP = "Share of the split units held out for the test metrics."
 BALANCE_HELP = "DIP: keep all positives and as many random negatives per part (the paper's 1:1)."
 DRAWS_HELP = "DOG generative mode: samples drawn per test condition."
-MIN_CELL_HELP = "DOG: fewest real samples a (weapon, hit group) cell needs for the Wasserstein."
+MIN_CELL_HELP = (
+    "Fewest real samples a (weapon, hit group or distance band) cell needs for the Wasserstein."
+)
 
 FAILURES_SHOWN = 5
 """Failed inputs printed one per line; the rest are counted (all are in the JSON report)."""
@@ -98,6 +100,12 @@ def print_samples(console: Console, samples: int, stats: SampleStats) -> None:
             else ""
         )
     )
+    if stats.partial:
+        console.print(
+            "kept with part of their outcome missing: "
+            + ", ".join(f"{n} {why}" for why, n in sorted(stats.partial.items())),
+            highlight=False,
+        )
     failures = stats.failures
     if not failures:
         return
@@ -189,9 +197,38 @@ def cells_table(cells: list[dict[str, Any]]) -> Table:
     for cell in cells:
         table.add_row(
             cell["weapon"],
-            cell["hit_group"],
+            cell["part"],
             f"{cell['real']:,}",
             f"{cell['generated']:,}",
             f"{cell['wasserstein_hp']:.2f}",
         )
+    return table
+
+
+def hp_lost_table(scores: dict[str, dict[str, Any]], title: str) -> Table:
+    """HP lost drawn against real, per unit (step, hit) and map (`damage.hp_lost`)."""
+    table = Table(title=title)
+    columns = ("unit", "map", "n", "real", "drawn", "bias", "W", "max W", "floor", "cells")
+    for column in columns:
+        table.add_column(column, justify="left" if column in ("unit", "map") else "right")
+    for unit, of_map in scores.items():
+        for where, s in of_map.items():
+            bias = 100.0 * (s.drawn_mean_hp / s.real_mean_hp - 1.0) if s.real_mean_hp else math.nan
+            table.add_row(
+                unit,
+                where,
+                f"{s.steps:,}",
+                _number(s.real_mean_hp, 1),
+                _number(s.drawn_mean_hp, 1),
+                "–" if not math.isfinite(bias) else f"{bias:+.1f}%",
+                _number(s.mean_wasserstein_hp, 2),
+                _number(s.max_wasserstein_hp, 2),
+                _number(s.mean_floor_hp, 2),
+                str(len(s.cells)),
+            )
+    table.caption = (
+        "mean HP lost (capped by the victim's HP), real and drawn, per 0.5 s step or per hit; "
+        "W: mean Wasserstein (HP) per (weapon, distance band) cell with enough samples, max W "
+        "the largest; floor: what the model would score were the real samples drawn from it"
+    )
     return table

@@ -25,6 +25,7 @@ from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
+from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
 from decoy_cli.esta.plausibility import check_policy
@@ -187,6 +188,9 @@ def evaluate(
         where = f"{count} local worker process{'es' if count > 1 else ''}"
     info = RunInfo(command=command, backend=where, sample=sample, machine=machine_line())
     console.print(f"evaluating with {where}: {mechanics(settings)}", highlight=False)
+    if settings.combat:
+        for line in map_warnings(settings.models, [settings.map_name]):
+            console.print(f"warning: {line}", style="yellow", markup=False)
     with output_lock(out):
         try:
             with backend, _ProgressDisplay() as on_progress:

@@ -13,6 +13,7 @@ from rich.table import Table
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
+from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 from decoy_cli.synth import PlayedRound, write_sample
@@ -50,6 +51,8 @@ def make_sample(
         console.print(
             "no damage models: combat is off (rounds end by bomb or time)", style="yellow"
         )
+    for line in map_warnings(models, [map_id]):
+        console.print(f"warning: {line}", style="yellow", markup=False)
     check_folder_writable(out)  # fail before playing, not after
     status = make_console(stderr=True)
     progress = Progress(

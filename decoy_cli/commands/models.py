@@ -23,9 +23,11 @@ from decoy_cli.commands._damage_output import (
     cells_table,
     dip_table,
     dog_table,
+    hp_lost_table,
     print_samples,
     progress_bars,
 )
+from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
@@ -41,7 +43,7 @@ from decoy_cli.damage.split import (
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 
-DEFAULT_IMPORT_OUT = Path("decoy-out") / "models" / "paper"
+DEFAULT_IMPORT_OUT = PAPER_FOLDER
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
 
 app = typer.Typer(
@@ -123,7 +125,7 @@ def fit_rules_command(
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
 ) -> None:
     """Learn the parts of the rules-grounded damage model from real hits (where shots land, by
-    weapon and distance; how many land in one 0.5 s step, by weapon class) and write rules.json
+    weapon and distance; how many land in one 0.5 s step, by weapon) and write rules.json
     into a folder that holds a DIP and no DOG: `--models FOLDER` then damages by the game's
     rules. (A folder with a DOG keeps damaging by its DOG: copy its dip.* to a new folder.)"""
     from decoy_cli.damage.rules_model import fit_rules
@@ -143,8 +145,12 @@ def fit_rules_command(
     rules.provenance["data"] = [f.name for f in files]
     path = rules.save(model_folder)
     make_console().print(
-        f"rules fitted on {rules.provenance['hits']} firearm hits of "
-        f"{rules.provenance['rounds']} rounds; written to {path}",
+        f"rules fitted on {rules.provenance['rounds']} rounds of "
+        f"{', '.join(sorted({r.map_name for r in rounds}))}: hit groups from "
+        f"{rules.provenance['hits']} firearm hits with their hit group and raw damage and "
+        f"{rules.provenance['hits_by_hp_lost']} whose HP lost the rules explain (left out: "
+        f"{rules.provenance['hits_unexplained']} they do not), penetration from the former, "
+        f"bullets per step from {rules.provenance['steps']} damaging steps; written to {path}",
         highlight=False,
     )
 
@@ -225,9 +231,7 @@ def calibrate(
 
 @app.command("evaluate")
 def evaluate(
-    model_folder: Path = typer.Argument(
-        ..., help="A model folder: dip.pt/json and/or dog.pt/json (trained or imported)."
-    ),
+    models: str = typer.Argument(..., help=f"The models to score: {CHOICES_HELP}."),
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
     out: Path = typer.Option(
         DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
@@ -251,12 +255,14 @@ def evaluate(
     draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
     min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),
 ) -> None:
-    """Evaluate a damage-model folder (trained or imported) on ESTA data.
+    """Evaluate any --models choice (rules, shipped, paper or a folder) on ESTA data.
 
-    Prints DIP's and DOG's metrics beside the paper's and writes metrics.json with the figures:
-    ROC and precision-recall curves, reconstructed vs real damage, the error histogram, the
-    hit-group confusion matrix, generated vs real damage per weapon and hit group. Exits
-    non-zero, after writing them, when a file or round failed."""
+    Prints DIP's and DOG's metrics beside the paper's, and the HP lost drawn by whatever decides
+    the damage (DOG or rules) against the real per 0.5 s step and, for the rules, per hit, by
+    map and (weapon, distance band) cell with the sampling floor; writes metrics.json with the
+    figures: ROC and precision-recall curves, reconstructed vs real damage, the error
+    histogram, the hit-group confusion matrix, generated vs real damage per weapon and hit
+    group. Exits non-zero, after writing them, when a file or round failed."""
     choice = SampleChoice(
         data=data,
         mode=mode,
@@ -270,7 +276,7 @@ def evaluate(
     bars, on_file, _ = progress_bars()
     with bars:
         result = evaluate_model_folder(
-            folder=model_folder,
+            models=models,
             choice=choice,
             out=out,
             subset=subset,
@@ -282,12 +288,25 @@ def evaluate(
         )
     console = make_console()
     print_samples(console, result.samples, result.stats)
+    for line in result.warnings:
+        console.print(f"warning: {line}", style="yellow", markup=False)
     if result.dip is not None:
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
+        for where, m in result.report["dip_by_map"].items():
+            console.print(
+                f"DIP on {where}: recall {m['recall']:.3f}, precision {m['precision']:.3f}, "
+                f"ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} damaging, "
+                f"{m['negatives']:,} not)",
+                highlight=False,
+            )
     if result.dog is not None:
         console.print(dog_table(result.dog.metrics, f"DOG of {result.name} ({subset} samples)"))
         if result.dog.metrics["cells"]:
             console.print(cells_table(result.dog.metrics["cells"]))
+    if result.hp_lost:
+        console.print(hp_lost_table(result.hp_lost, f"HP lost, {result.name} against real"))
+    for note in result.notes:
+        console.print(note, highlight=False)
     console.print(f"metrics and {len(result.figures)} figures written to {result.out}")
     failed = len(result.stats.failures)
     if failed:

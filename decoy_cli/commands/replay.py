@@ -13,6 +13,7 @@ from rich.table import Table
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
+from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.deaths import DeathProtocol
@@ -122,6 +123,8 @@ def replay(
         console.print(f"inferred: {note}", style="yellow", markup=False)
     if options.combat:
         console.print(f"deaths decided by: {options.deaths}")
+        for line in map_warnings(models, [round_.map_name]):
+            console.print(f"warning: {line}", style="yellow", markup=False)
     _show_bomb(console, result.bomb_row())
     for title, names in (
         ("clock protocol", METRIC_NAMES_CLOCK),

@@ -42,7 +42,8 @@ SHIPPED_CHOICES = ("shipped", "rules")
 
 CHOICES_HELP = (
     '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIP with damage by '
-    'the game\'s rules), "none" (no shooting) or a model folder'
+    'the game\'s rules), "paper" (the paper\'s, once imported), "none" (no shooting) or a '
+    "model folder"
 )
 
 
@@ -51,40 +52,90 @@ def shipped_models_installed() -> bool:
     return (SHIPPED_MODELS / "dip.json").is_file() and (SHIPPED_MODELS / "dog.json").is_file()
 
 
+PAPER_FOLDER = Path("decoy-out") / "models" / "paper"
+"""Where `decoy models import-decoy` and `download-decoy` write the paper's models unless told:
+`--models paper` uses a folder `paper` when there is one, else this one."""
+
+
+def resolve_models(choice: str) -> Path:
+    """The model folder a `--models` choice names (not "none"): the shipped one for "shipped"
+    and "rules", a folder for "paper" (`PAPER_FOLDER`) or a path. A missing folder is one
+    ModelError line."""
+    if choice in SHIPPED_CHOICES:
+        if not shipped_models_installed():
+            raise ModelError(
+                f"no shipped damage models in {SHIPPED_MODELS}: pass a model folder "
+                "(e.g. from `decoy models import-decoy`) or none"
+            )
+        return SHIPPED_MODELS
+    folder = Path(choice).expanduser()
+    if choice == "paper" and not folder.is_dir():
+        folder = PAPER_FOLDER
+        if not folder.is_dir():
+            raise ModelError(
+                "paper: no folder paper or decoy-out/models/paper: import the paper's models "
+                "first (decoy models download-decoy, or import-decoy CHECKPOINTS)"
+            )
+    if not folder.is_dir():
+        raise ModelError(f"{choice}: no such model folder (expected {CHOICES_HELP})")
+    return folder
+
+
+def damages_by_rules(choice: str, folder: Path) -> bool:
+    """True when the choice's damage comes from the game's rules (`rules.json`), False when
+    from the folder's DOG: "rules", or a folder with a rules.json and no DOG."""
+    from decoy_cli.damage.rules_model import RULES_FILE
+
+    return choice == "rules" or (
+        (folder / RULES_FILE).is_file() and not (folder / "dog.json").is_file()
+    )
+
+
+def model_roles(choice: str) -> dict[str, str]:
+    """Which model decides who hits and which how much, in words, for a `--models` choice
+    (a folder that cannot be read names itself only)."""
+    if choice == "none":
+        return {"hits": "none (no shooting)", "damage": "none (no shooting)"}
+    try:
+        folder = resolve_models(choice)
+    except ModelError:
+        return {"hits": f"the DIP of {choice}", "damage": f"the models of {choice}"}
+    name = "the shipped models" if folder == SHIPPED_MODELS else str(folder)
+    if damages_by_rules(choice, folder):
+        damage = f"the game's damage rules with the learned parts of {name} (rules.json)"
+    else:
+        damage = f"the DOG of {name}"
+    return {"hits": f"the DIP of {name}", "damage": damage}
+
+
 def load_damage_model(choice: str) -> DamageModel | None:
-    """The damage model a user chose: "shipped", "rules", "none" (None: no shooting) or the
-    path of a model folder holding a DIP and a DOG (e.g. written by `decoy models import-decoy`)
-    or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's rules).
+    """The damage model a user chose: "shipped", "rules", "none" (None: no shooting), "paper"
+    or the path of a model folder holding a DIP and a DOG (e.g. written by `decoy models
+    import-decoy`) or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's
+    rules).
 
     A missing or incompatible folder is one ModelError line.
     """
     if choice == "none":
         return None
-    if choice in SHIPPED_CHOICES:
-        folder = SHIPPED_MODELS
-        if not shipped_models_installed():
-            raise ModelError(
-                f"no shipped damage models in {folder}: pass a model folder "
-                "(e.g. from `decoy models import-decoy`) or none"
-            )
-    else:
-        folder = Path(choice).expanduser()
-        if not folder.is_dir():
-            raise ModelError(f"{choice}: no such model folder (expected {CHOICES_HELP})")
+    folder = resolve_models(choice)
     from decoy_cli.damage.combat import LearnedDamage
     from decoy_cli.damage.model_folder import load_dip, load_dog
-    from decoy_cli.damage.rules_model import RULES_FILE, RulesDamage, RulesFile
+    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
-    rules_only = (folder / RULES_FILE).is_file() and not (folder / "dog.json").is_file()
-    if choice == "rules" or rules_only:
+    if damages_by_rules(choice, folder):
         return RulesDamage(load_dip(folder), RulesFile.load(folder))
     return LearnedDamage(load_dip(folder), load_dog(folder))
 
 
 __all__ = [
     "CHOICES_HELP",
+    "PAPER_FOLDER",
     "SHIPPED_CHOICES",
     "SHIPPED_MODELS",
+    "damages_by_rules",
     "load_damage_model",
+    "model_roles",
+    "resolve_models",
     "shipped_models_installed",
 ]

@@ -3,7 +3,11 @@
 Which damage counts (both modes): firearm damage between enemies. Left out, with the reason
 counted in `SampleStats.excluded`: world damage (no attacker), friendly fire, grenade, fire and
 bomb damage (weaponClass "Grenade" or hitGroup "Generic"), weapons outside the models'
-vocabulary (`features.WEAPONS`: knife, Zeus, C4) and rows without a damage value or hit group.
+vocabulary (`features.WEAPONS`: knife, Zeus, C4) and rows without any damage value, victim or
+tick. A row without a hit group or a raw `hpDamage` (data that records only the HP lost, such as
+`events_ancient`) still says that the pair hit and how much HP it cost: it is `usable` (a hit,
+its HP lost) but not `outcome_known` (what a DOG learns from: raw damage and hit group), and is
+counted in `SampleStats.partial` with what it lacks.
 
 Damage value: `hpDamage` (the raw HP damage of the hit, before the victim's remaining HP caps
 it), summed over the hits of one pair in one step and capped at 100. Not `hpDamageTaken`: that
@@ -73,10 +77,11 @@ class DamageRows:
     victim: np.ndarray
     weapon: np.ndarray
     hp_damage: np.ndarray  # float64
-    hp_taken: np.ndarray  # float64 (NaN -> 0 when summed)
+    hp_taken: np.ndarray  # float64 HP lost (hpDamageTaken, else hpDamage; NaN -> 0 when summed)
     armor_damage: np.ndarray  # float64
     group_code: np.ndarray  # int64, -1 when none
-    usable: np.ndarray  # bool
+    usable: np.ndarray  # bool: a firearm hit between enemies with its HP lost
+    outcome_known: np.ndarray  # bool: usable, with its raw damage and hit group
 
 
 def damage_rows(round_: Round, stats: SampleStats) -> DamageRows:
@@ -96,11 +101,16 @@ def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
     victim_side = strings(table, "victimSide")
     friendly = table["isFriendlyFire"].to_numpy(dtype=object, na_value=None)
     hp_damage = ints(table, "hpDamage")
+    hp_taken = ints(table, "hpDamageTaken")
+    hp_taken = np.where(np.isfinite(hp_taken), hp_taken, hp_damage)
     tick = ints(table, "tick")
     group_code = np.array([_HIT_GROUP_CODE.get(g, -1) for g in hit_group], dtype=np.int64)
     usable = np.zeros(len(table), dtype=bool)
+    outcome_known = np.zeros(len(table), dtype=bool)
     for i in range(len(table)):
-        if attacker[i] is None or weapon[i] == "World":
+        if attacker[i] is None and weapon[i] in VOCABULARY:
+            reason = "attacker not identifiable (no steamID or name)"
+        elif attacker[i] is None or weapon[i] == "World":
             reason = "world damage (no attacker)"
         elif friendly[i] is True or (attacker_side[i] and attacker_side[i] == victim_side[i]):
             reason = "friendly fire"
@@ -108,12 +118,19 @@ def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
             reason = "grenade, fire or bomb"
         elif weapon[i] not in VOCABULARY:
             reason = "weapon outside the vocabulary"
-        elif group_code[i] < 0:
-            reason = "unknown hit group"
-        elif not (hp_damage[i] > 0) or victim[i] is None or not np.isfinite(tick[i]):
-            reason = "no damage value, victim or tick"
+        elif not (hp_taken[i] > 0 or hp_damage[i] > 0):
+            reason = "no damage value"
+        elif victim[i] is None:
+            reason = "victim not identifiable (no steamID or name)"
+        elif not np.isfinite(tick[i]):
+            reason = "no tick"
         else:
             usable[i] = True
+            outcome_known[i] = group_code[i] >= 0 and hp_damage[i] > 0
+            if group_code[i] < 0:
+                stats.partial["no hit group (scored on HP lost, over all hit groups)"] += 1
+            elif not hp_damage[i] > 0:
+                stats.partial["no raw damage (scored on HP lost)"] += 1
             continue
         stats.excluded[reason] += 1
     return DamageRows(
@@ -122,11 +139,25 @@ def classify_damages(table: pd.DataFrame, stats: SampleStats) -> DamageRows:
         victim=victim,
         weapon=weapon,
         hp_damage=hp_damage,
-        hp_taken=np.nan_to_num(ints(table, "hpDamageTaken")),
+        hp_taken=np.nan_to_num(hp_taken),
         armor_damage=np.nan_to_num(ints(table, "armorDamage")),
         group_code=group_code,
         usable=usable,
+        outcome_known=outcome_known,
     )
+
+
+@dataclass(frozen=True)
+class StepHit:
+    """The hits of one pair in one step: the raw damage summed and capped at 100 (NaN when a hit
+    lacks it), the hit group of the largest hit (-1 when a hit lacks one), the first row, the HP
+    lost summed (capped by the victim's HP, as recorded) and the number of hits."""
+
+    damage: float
+    group: int
+    first: int
+    hp_lost: float
+    hits: int
 
 
 def aggregate(
@@ -135,24 +166,25 @@ def aggregate(
     victim: np.ndarray,
     damages: DamageRows,
     rows: np.ndarray,
-) -> dict[tuple[int, object, object], tuple[float, int, int]]:
-    """Per (step, attacker, victim): (summed hpDamage capped at 100, hit group of the largest
-    hit, the first row), over the damage rows `rows` (in row order)."""
-    out: dict[tuple[int, object, object], tuple[float, int, int]] = {}
-    largest: dict[tuple[int, object, object], float] = {}
+) -> dict[tuple[int, object, object], StepHit]:
+    """Per (step, attacker, victim), over the damage rows `rows` (in row order): its `StepHit`.
+    A step is known (a finite damage, a group) only when all its hits are `outcome_known`."""
+    keyed: dict[tuple[int, object, object], list[int]] = {}
     for r in rows:
-        key = (int(step[r]), attacker[r], victim[r])
-        value = float(damages.hp_damage[r])
-        if key not in out:
-            out[key] = (value, int(damages.group_code[r]), int(r))
-            largest[key] = value
-            continue
-        total, group, first = out[key]
-        if value > largest[key]:
-            largest[key] = value
-            group = int(damages.group_code[r])
-        out[key] = (total + value, group, first)
-    return {k: (min(v[0], MAX_DAMAGE_HP), v[1], v[2]) for k, v in out.items()}
+        keyed.setdefault((int(step[r]), attacker[r], victim[r]), []).append(int(r))
+    out = {}
+    for key, hits in keyed.items():
+        raw = damages.hp_damage[hits]
+        known = bool(damages.outcome_known[hits].all())
+        largest = hits[int(np.argmax(raw))] if known else hits[0]
+        out[key] = StepHit(
+            damage=min(float(raw.sum()), MAX_DAMAGE_HP) if known else float("nan"),
+            group=int(damages.group_code[largest]) if known else -1,
+            first=hits[0],
+            hp_lost=float(damages.hp_taken[hits].sum()),
+            hits=len(hits),
+        )
+    return out
 
 
 def step_clock(round_: Round) -> tuple[int, int]:

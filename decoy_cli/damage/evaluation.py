@@ -183,10 +183,11 @@ def evaluate_dog(
     draws: int = DRAWS,
     min_cell: int = MIN_CELL,
 ) -> DogEvaluation:
-    """DOG's metrics on the positive samples of `samples` (module docstring)."""
+    """DOG's metrics on the hits of `samples` whose raw damage and hit group are known (module
+    docstring)."""
     from scipy.stats import wasserstein_distance
 
-    positives = samples.take(samples.hit)
+    positives = samples.take(samples.outcome_known)
     if len(positives) == 0:
         raise ValueError("no damaging samples to evaluate DOG on")
     reconstructed, reconstructed_group = dog_reconstruct(dog, positives, seed)

@@ -170,22 +170,42 @@ def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples
     return samples_from_rows([{**common, **row} for row in rows])
 
 
-def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, object]]:
-    """One sample per (virtual frame, attacker, victim) with usable damage; the state of the
-    group's first damage row."""
+def hit_samples(round_: Round, stats: SampleStats) -> Samples:
+    """One damaging sample per usable damage row (a hit, not a step): the unit of a model that
+    draws one bullet, as `event_samples` builds its positives."""
+    events = _EventRound(round_, damage_rows(round_, stats))
+    common = {
+        "map_name": round_.map_name,
+        "group": group_id(round_),
+        "match": round_.match_id,
+        "mode": "events",
+    }
+    rows = _event_positives(events, stats, per_hit=True)
+    return samples_from_rows([{**common, **row} for row in rows])
+
+
+def _event_positives(
+    events: _EventRound, stats: SampleStats, per_hit: bool = False
+) -> list[dict[str, object]]:
+    """One sample per (virtual frame, attacker, victim) with usable damage, or per usable row
+    with `per_hit`; the state of the group's first damage row."""
     damages, table = events.damages, events.round.damages
     usable = np.flatnonzero(damages.usable)
-    frame = events.frame(np.nan_to_num(damages.tick))
+    frame = np.arange(len(damages.tick)) if per_hit else events.frame(np.nan_to_num(damages.tick))
     rows = []
-    for (k, attacker, victim), (total, code, first) in aggregate(
+    for (k, attacker, victim), step in aggregate(
         frame, damages.attacker, damages.victim, damages, usable
     ).items():
+        first = step.first
         a_pos = np.array([table[f"attacker{axis}_m"].iloc[first] for axis in "XYZ"])
         v_pos = np.array([table[f"victim{axis}_m"].iloc[first] for axis in "XYZ"])
         a_yaw = float(table["attackerViewX"].iloc[first])
         v_yaw = float(table["victimViewX"].iloc[first])
-        if not np.isfinite([*a_pos, *v_pos, a_yaw, v_yaw]).all():
-            stats.excluded["no attacker or victim state"] += 1
+        if not np.isfinite([*a_pos, *v_pos]).all():
+            stats.excluded["no attacker or victim position (x, y or z)"] += 1
+            continue
+        if not np.isfinite([a_yaw, v_yaw]).all():
+            stats.excluded["no attacker or victim view angle"] += 1
             continue
         tick = float(damages.tick[first])
         armor, helmet = events.armor_of(victim)
@@ -201,9 +221,10 @@ def _event_positives(events: _EventRound, stats: SampleStats) -> list[dict[str, 
                 "victim_armor": armor,
                 "victim_helmet": helmet,
                 "hit": True,
-                "damage": total,
-                "hit_group": code,
-                "tick": events.frame_tick(k),
+                "damage": step.damage,
+                "hp_lost": step.hp_lost,
+                "hit_group": step.group,
+                "tick": int(tick) if per_hit else events.frame_tick(k),
             }
         )
     return rows
@@ -260,6 +281,7 @@ def _event_negatives(events: _EventRound, window: float) -> list[dict[str, objec
                         "victim_helmet": helmet,
                         "hit": False,
                         "damage": 0.0,
+                        "hp_lost": 0.0,
                         "hit_group": NO_HIT,
                         "tick": int(anchor),
                     }

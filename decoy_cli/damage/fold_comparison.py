@@ -24,12 +24,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.features import FeatureSpec
-from decoy_cli.damage.rules_model import fit_rules, rules_generate
+from decoy_cli.damage.rules_model import fit_rules
 from decoy_cli.damage.sample_set import Samples
 from decoy_cli.damage.scores import hit_group_tv, sampling_floor, wasserstein_cells
 from decoy_cli.damage.split import FOLDS, deal_folds
@@ -141,6 +142,44 @@ def _score(
     )
 
 
+def rules_out_of_fold(
+    rounds: Sequence[Round], positives: Samples, fold: np.ndarray, seed: int, draws: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(draws, K) damage and hit-group codes of the K damaging samples, each fold's drawn by
+    rules fitted on the rounds of the other folds only (`fold`: each sample's fold)."""
+    from decoy_cli.damage.damage_rows import group_id
+    from decoy_cli.damage.hp_lost import draw_outcomes
+
+    fold_of_group = {str(g): int(f) for g, f in zip(positives.group, fold, strict=True)}
+    damage = np.zeros((draws, len(positives)))
+    group = np.zeros((draws, len(positives)), dtype=np.int64)
+    for k in np.unique(fold):
+        test = np.flatnonzero(fold == k)
+        train = [r for r in rounds if fold_of_group.get(group_id(r), -1) != k]
+        rules = fit_rules(train)
+        damage[:, test], group[:, test] = draw_outcomes(
+            rules, positives.take(test), seed + int(k), draws
+        )
+    return damage, group
+
+
+def training_overlap(metadata: dict[str, Any], samples: Samples) -> str:
+    """What share of the samples' rounds a model saw while it was trained (its training or
+    validation part, as its metadata's split records them), in words for a label."""
+    split = metadata.get("split") or {}
+    units = split.get("units") or {}
+    seen = set(units.get("train", [])) | set(units.get("val", []))
+    key = samples.match if split.get("by") == "match" else samples.group
+    rounds = {str(g): str(k) for g, k in zip(samples.group, key, strict=True)}
+    overlap = sum(1 for unit in rounds.values() if unit in seen)
+    if not split:
+        return "its training data unrecorded"
+    if overlap == 0:
+        maps = metadata.get("maps")
+        return "trained on none of these rounds" + (f" ({', '.join(maps)})" if maps else "")
+    return f"trained or validated on {overlap} of these {len(rounds)} rounds"
+
+
 def compare_on_folds(
     rounds: Sequence[Round],
     samples: Samples,
@@ -150,36 +189,14 @@ def compare_on_folds(
     cvae: CvaeTraining | None = None,
 ) -> list[ModelScores]:
     """Every model's scores on the same folds of the damaging samples (module doc)."""
-    from decoy_cli.damage.damage_rows import group_id
     from decoy_cli.damage.evaluation import dog_generate
     from decoy_cli.damage.model_folder import load_dog
 
-    positives = samples.take(np.flatnonzero(samples.hit))
+    positives = samples.take(np.flatnonzero(samples.outcome_known))
     fold_of_group = deal_folds(positives.group.tolist(), np.random.default_rng(seed))
     fold = np.array([fold_of_group[g] for g in positives.group])
-    round_of_group = {group_id(r): r for r in rounds}
     results = []
-
-    damage = np.zeros((draws, len(positives)))
-    group = np.zeros((draws, len(positives)), dtype=np.int64)
-    distance = np.linalg.norm(positives.victim_position - positives.attacker_position, axis=1)
-    for k in range(FOLDS):
-        test = np.flatnonzero(fold == k)
-        if not len(test):
-            continue
-        train_rounds = [
-            round_of_group[g] for g, f in fold_of_group.items() if f != k and g in round_of_group
-        ]
-        rules = fit_rules(train_rounds)
-        damage[:, test], group[:, test] = rules_generate(
-            rules,
-            list(positives.attacker_weapon[test]),
-            distance[test],
-            positives.victim_armor[test],
-            positives.victim_helmet[test],
-            seed + k,
-            draws,
-        )
+    damage, group = rules_out_of_fold(rounds, positives, fold, seed, draws)
     results.append(_score("rules (fitted per fold)", positives, damage, group, fold))
 
     if cvae is not None:

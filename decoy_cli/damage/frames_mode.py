@@ -82,6 +82,7 @@ def frame_samples(round_: Round, stats: SampleStats) -> Samples:
     k = len(f_idx)
     hit = np.zeros(k, dtype=bool)
     damage = np.zeros(k, dtype=np.float32)
+    hp_lost = np.zeros(k, dtype=np.float32)
     group = np.full(k, NO_HIT, dtype=np.int8)
     weapon = round_.weapon[a, f_idx].astype(object)
     position_of = {int(c): i for i, c in enumerate(codes)}
@@ -90,9 +91,9 @@ def frame_samples(round_: Round, stats: SampleStats) -> Samples:
         if i is None:
             stats.excluded["hit on a pair not alive in its frame"] += 1
             continue
-        total, hit_group, first = hits[key]
-        hit[i], damage[i], group[i] = True, total, hit_group
-        weapon[i] = damages.weapon[first]  # the gun that fired, not the one in hand at the frame
+        step = hits[key]
+        hit[i], damage[i], hp_lost[i], group[i] = True, step.damage, step.hp_lost, step.group
+        weapon[i] = damages.weapon[step.first]  # the gun that fired, not the one in hand
     return Samples(
         map_name=np.full(k, round_.map_name, dtype=object),
         attacker_position=round_.position[a, f_idx],
@@ -106,6 +107,7 @@ def frame_samples(round_: Round, stats: SampleStats) -> Samples:
         victim_helmet=round_.helmet[v, f_idx].astype(bool),
         hit=hit,
         damage=damage,
+        hp_lost=hp_lost,
         hit_group=group,
         group=np.full(k, group_id(round_), dtype=object),
         match=np.full(k, round_.match_id, dtype=object),

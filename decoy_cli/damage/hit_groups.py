@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from decoy_cli.damage.rules import rule_group
+from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.sim.combat import HIT_GROUPS
 from decoy_cli.weapons import WEAPONS
 
@@ -73,6 +73,21 @@ class HitGroupModel:
                 table.setdefault(key, [[0.0] * len(GROUPS) for _ in range(bands)])[b][g] += 1
             model.band_counts[b][g] += 1
         return model
+
+    def add(self, weapon: str, distance_u: float, weights: np.ndarray) -> None:
+        """Count one hit whose group is known only as `weights` (6,) over `GROUPS`, summing
+        to 1: each group gets its share of a hit."""
+        bands = len(DISTANCE_BANDS_U) + 1
+        b = band(float(distance_u))
+        for table, key in (
+            (self.weapon_counts, weapon),
+            (self.class_counts, weapon_class(weapon)),
+        ):
+            row = table.setdefault(key, [[0.0] * len(GROUPS) for _ in range(bands)])[b]
+            row[:] = [c + float(w) for c, w in zip(row, weights, strict=True)]
+        self.band_counts[b] = [
+            c + float(w) for c, w in zip(self.band_counts[b], weights, strict=True)
+        ]
 
     def probabilities(self, weapon: str, distance_u: float) -> np.ndarray:
         """(6,) P(group | weapon, distance) in `GROUPS` order (module doc)."""
@@ -135,3 +150,29 @@ class HitGroupModel:
     def from_json(cls, text: str) -> HitGroupModel:
         """`from_dict` of JSON text."""
         return cls.from_dict(json.loads(text))
+
+
+def group_posterior(
+    prior: HitGroupModel,
+    weapon: str,
+    distance_u: float,
+    hp_lost: float,
+    hp_before: float,
+    armored: bool,
+) -> np.ndarray | None:
+    """(6,) P(group | a hit's HP lost) for a hit whose data records no hit group: the prior's
+    P(group | weapon, distance) times 1 where the rules (decoy_cli/damage/rules.py) explain the
+    HP lost and 0 elsewhere. A hit that left the victim alive lost what the rules give, within
+    1 HP; one that killed lost the victim's HP, so any group the rules give at least that much
+    explains it. None when no group explains it (a shot through something, armour that ran
+    out)."""
+    explained = np.zeros(len(GROUPS))
+    killed = hp_lost >= hp_before - 0.5
+    for g, name in enumerate(GROUPS):
+        health = shot_damage(weapon, name, distance_u, armor=100 if armored else 0, helmet=armored)
+        value = health.health
+        explained[g] = value >= hp_lost - 0.5 if killed else abs(value - hp_lost) <= 1.0
+    weights = prior.probabilities(weapon, distance_u) * explained
+    if weights.sum() <= 0:
+        return None
+    return weights / weights.sum()

@@ -32,7 +32,7 @@ from typing import Any
 
 import torch
 
-from decoy_cli.damage.features import HIT_GROUPS, PAPER_SPEC
+from decoy_cli.damage.features import HIT_GROUPS, MAPS, PAPER_SPEC
 from decoy_cli.damage.model_folder import (
     load_state,
     read_torch_file,
@@ -186,5 +186,6 @@ def _metadata(info: ImportedModel, args: dict[str, Any] | None) -> dict[str, Any
         "epoch": info.epoch,
         "best_val_loss": info.best_val_loss,
         "training_args": args,
+        "maps": list(MAPS),  # the paper's models were trained on ESTA data of all eight
         "note": notes[info.kind],
     }

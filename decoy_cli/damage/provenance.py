@@ -54,13 +54,21 @@ class SampleChoice:
 
 
 def provenance(
-    *, command: str, choice: SampleChoice, split: Split, stats: SampleStats, options: TrainOptions
+    *,
+    command: str,
+    choice: SampleChoice,
+    split: Split,
+    stats: SampleStats,
+    options: TrainOptions,
+    maps: list[str],
 ) -> dict[str, Any]:
-    """What a model was trained on and how (`command` is "dip" or "dog"): kept in the model's
-    JSON metadata, so a model folder says where it came from."""
+    """What a model was trained on and how (`command` is "dip" or "dog", `maps` those of its
+    training samples): kept in the model's JSON metadata, so a model folder says where it came
+    from."""
     return {
         "trained_with": f"decoy {__version__}: decoy train {command}",
         "data": [str(d) for d in choice.data],
+        "maps": maps,
         "mode": choice.mode,
         "window_s": choice.window_s,
         "split": {

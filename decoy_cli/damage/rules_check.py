@@ -42,14 +42,15 @@ FULL_ARMOR = 100
 
 def firearm_hits(damages: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, int]]:
     """The rows the rules apply to: the firearm damage between enemies the DOG's samples use
-    (`damage_rows.classify_damages`) that has a distance; and the rows left out by reason."""
+    (`damage_rows.classify_damages`: raw damage and hit group known) that has a distance; and
+    the rows left out by reason."""
     stats = SampleStats()
     rows = classify_damages(damages, stats)
     distance = pd.to_numeric(damages["distance"], errors="coerce").to_numpy(np.float64)
-    usable = rows.usable & np.isfinite(distance)
-    left_out = dict(stats.excluded)
-    if int((rows.usable & ~usable).sum()):
-        left_out["no distance"] = int((rows.usable & ~usable).sum())
+    usable = rows.outcome_known & np.isfinite(distance)
+    left_out = dict(stats.excluded) | dict(stats.partial)
+    if int((rows.outcome_known & ~usable).sum()):
+        left_out["no distance"] = int((rows.outcome_known & ~usable).sum())
     return damages[usable].reset_index(drop=True), left_out
 
 

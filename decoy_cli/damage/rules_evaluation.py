@@ -177,7 +177,7 @@ def _cells(real: pd.DataFrame, generated: pd.DataFrame) -> pd.DataFrame:
     weapon, group, damage = _by_draw(generated)
     floors = sampling_floor(found, weapon, group, damage)
     rows = [
-        (c.weapon, c.hit_group, c.real, c.generated, c.wasserstein_hp, floor)
+        (c.weapon, c.part, c.real, c.generated, c.wasserstein_hp, floor)
         for c, floor in zip(found, floors, strict=True)
     ]
     columns = ["weapon", "group", "real", "generated", "wasserstein_hp", "floor_hp"]

@@ -5,8 +5,9 @@ Per combat step, over every visible ordered pair at once:
 1. DIP decides which attackers hit their victim in this 0.5 s step (`DipDecision`: its threshold,
    or its calibration's rule);
 2. for each hitting pair, the number of bullets that land in the step is drawn from a
-   distribution learned from real hits per weapon class (`BulletCounts`), each bullet's hit group
-   from `HitGroupModel` (weapon and distance), and each bullet's health and armour damage from
+   distribution learned from real steps by weapon and range, apart for victims unhurt and hurt
+   (`bullet_counts.BulletCounts`), each bullet's hit group from `HitGroupModel` (weapon and
+   distance), and each bullet's health and armour damage from
    the rules (decoy_cli/damage/rules.py) against the victim's armour and helmet, the armour worn
    down bullet by bullet, and a learned share of bullets scaled down as through a wall
    (`Penetration`);
@@ -31,7 +32,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, weapon_class
+from decoy_cli.damage.bullet_counts import ALL, BulletCounts
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
 from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
@@ -39,37 +41,12 @@ from decoy_cli.files import write_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
+    from decoy_cli.damage.damage_rows import DamageRows
     from decoy_cli.damage.model_folder import LoadedDip
 
 RULES_FILE = "rules.json"
-MAX_BULLETS = 10
-"""Bullet counts above this are counted as this many."""
-PRIOR_STEPS = 5.0
-"""Pseudo-steps pulling a class's bullet counts toward all classes'."""
-
-
-@dataclass
-class BulletCounts:
-    """How many bullets of one pair land in one damaging step, by weapon class (module doc)."""
-
-    by_class: dict[str, list[float]] = field(default_factory=dict)
-    every: list[float] = field(default_factory=lambda: [0.0] * MAX_BULLETS)
-
-    def add(self, weapon: str, bullets: int) -> None:
-        n = min(max(bullets, 1), MAX_BULLETS) - 1
-        self.by_class.setdefault(weapon_class(weapon), [0.0] * MAX_BULLETS)[n] += 1
-        self.every[n] += 1
-
-    def probabilities(self, weapon: str) -> np.ndarray:
-        """(MAX_BULLETS,) P(1..MAX_BULLETS bullets); one bullet when nothing was counted."""
-        every = np.asarray(self.every, np.float64)
-        if every.sum() == 0:
-            p = np.zeros(MAX_BULLETS)
-            p[0] = 1.0
-            return p
-        p = every / every.sum()
-        counts = np.asarray(self.by_class.get(weapon_class(weapon), [0.0] * MAX_BULLETS))
-        return (counts + PRIOR_STEPS * p) / (counts.sum() + PRIOR_STEPS)
+FULL_HP = 100
+"""A victim at this HP at a step's start is unhurt (`RulesFile.bullets`)."""
 
 
 PENETRATED_BELOW = 0.9
@@ -124,12 +101,21 @@ class RulesFile:
     provenance: dict[str, object] = field(default_factory=dict)
     penetration: Penetration = field(default_factory=Penetration)
     """Empty in a `rules.json` written before it was learned: every path is clear."""
+    bullets_hurt: BulletCounts | None = None
+    """The bullets of steps on a victim already hurt (below 100 HP at the step's start), and
+    `bullets` those on a victim unhurt; None in a `rules.json` written before: `bullets`."""
+
+    def bullet_counts(self, victim_hp: int) -> BulletCounts:
+        """The bullet counts of a step on a victim with `victim_hp` at its start."""
+        hurt = victim_hp < FULL_HP and self.bullets_hurt is not None
+        return self.bullets_hurt if hurt and self.bullets_hurt is not None else self.bullets
 
     def save(self, folder: Path) -> Path:
         """Write `rules.json` into the folder (atomically, as every JSON file of the project)."""
         data = {
             "hit_groups": self.hit_groups.to_dict(),
-            "bullets": {"by_class": self.bullets.by_class, "every": self.bullets.every},
+            "bullets": self.bullets.to_dict(),
+            "bullets_hurt": None if self.bullets_hurt is None else self.bullets_hurt.to_dict(),
             "penetration": {"hits": self.penetration.hits, "shares": self.penetration.shares},
             "provenance": self.provenance,
         }
@@ -142,10 +128,12 @@ class RulesFile:
         try:
             data = json.loads(path.read_text())
             hit_groups = HitGroupModel.from_dict(data["hit_groups"])
-            bullets = BulletCounts(
-                {str(k): [float(v) for v in c] for k, c in data["bullets"]["by_class"].items()},
-                [float(v) for v in data["bullets"]["every"]],
-            )
+            bullets = BulletCounts.from_dict(data["bullets"])
+            hurt = data.get("bullets_hurt")
+            bullets_hurt = None if hurt is None else BulletCounts.from_dict(hurt)
+            for counts in (bullets, bullets_hurt):
+                if counts is not None:
+                    counts.check()
             provenance = dict(data.get("provenance", {}))
             through = data.get("penetration", {"hits": 0, "shares": []})
             penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
@@ -153,22 +141,20 @@ class RulesFile:
             raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
         except (ValueError, KeyError, TypeError, AttributeError) as error:
             raise ModelError(f"{path}: not a rules file ({error})") from None
-        if len(bullets.every) != MAX_BULLETS or any(
-            len(c) != MAX_BULLETS for c in bullets.by_class.values()
-        ):
-            raise ModelError(f"{path}: bullet counts of another length than {MAX_BULLETS}")
         if not (0 <= len(penetration.shares) <= penetration.hits) or not all(
             0.0 <= v <= 1.0 for v in penetration.shares
         ):
             raise ModelError(f"{path}: penetration shares must be in [0, 1], at most one per hit")
-        return cls(hit_groups, bullets, provenance, penetration)
+        return cls(hit_groups, bullets, provenance, penetration, bullets_hurt)
 
 
 def fit_rules(rounds: Sequence[Round]) -> RulesFile:
-    """Learn the hit groups and the bullets per step from the rounds' firearm hits: the damage
-    rows the DOG's samples use (`damage_rows`), counted per (attacker, victim) and virtual 2 Hz
-    step exactly as the events mode aggregates them, so a step here is a sample's step."""
-    from decoy_cli.damage.damage_rows import damage_rows, step_clock
+    """Learn the hit groups, the penetration and the bullets per step from the rounds' firearm
+    hits: the damage rows the DOG's samples use (`damage_rows`). Bullets are counted per
+    (attacker, victim) and virtual 2 Hz step exactly as the events mode aggregates them, so a
+    step here is a sample's step, from every hit (also those whose data records only the HP
+    lost); hit groups and penetration from the hits whose raw damage and hit group are known."""
+    from decoy_cli.damage.damage_rows import aggregate, damage_rows, step_clock
     from decoy_cli.damage.sample_set import SampleStats
 
     stats = SampleStats()
@@ -176,37 +162,77 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     distances: list[float] = []
     groups: list[str] = []
     health: list[float] = []
-    bullets = BulletCounts()
+    bullets, bullets_hurt = BulletCounts(censored=True), BulletCounts()
+    unknown: list[tuple[str, float, float, float, bool]] = []
     used_rounds = 0
+    maps: set[str] = set()
     for round_ in rounds:
         rows = damage_rows(round_, stats)
-        usable = np.flatnonzero(rows.usable & np.isfinite(round_.damages["distance"].to_numpy()))
-        if not len(usable):
+        distance = round_.damages["distance"].to_numpy(np.float64, na_value=np.nan)
+        usable = rows.usable & np.isfinite(distance)
+        if not usable.any():
             continue
         used_rounds += 1
-        table = round_.damages.iloc[usable]
+        maps.add(round_.map_name)
+        known = np.flatnonzero(usable & rows.outcome_known)
+        unknown += _hp_lost_hits(round_, rows, usable & ~rows.outcome_known, distance)
+        table = round_.damages.iloc[known]
         weapons += [str(w) for w in table["weapon"]]
         distances += [float(d) for d in table["distance"]]
         groups += [str(g) for g in table["hitGroup"]]
         health += [float(h) for h in table["hpDamage"]]
         origin, step_ticks = step_clock(round_)
-        steps: dict[tuple[int, object, object], list[str]] = {}
-        for r in usable:
-            step = int(np.rint((rows.tick[r] - origin) / step_ticks))
-            steps.setdefault((step, rows.attacker[r], rows.victim[r]), []).append(rows.weapon[r])
-        for hits in steps.values():
-            bullets.add(hits[0], len(hits))
-    if not weapons:
+        step = np.rint((np.nan_to_num(rows.tick) - origin) / step_ticks)
+        steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
+        for hit in steps.values():
+            earlier = (rows.victim == rows.victim[hit.first]) & (rows.tick < rows.tick[hit.first])
+            lost = float(rows.hp_taken[earlier].sum())
+            killed = lost + hit.hp_lost >= FULL_HP - 0.5
+            counts = bullets_hurt if lost > 0 else bullets
+            counts.add(str(rows.weapon[hit.first]), float(distance[hit.first]), hit.hits, killed)
+    total = sum(sum(c.counts.get(ALL, [])) for c in (bullets, bullets_hurt))
+    if not total:
         raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
+    if not weapons:
+        raise ModelError(
+            "no firearm hit in the data records its hit group and raw damage: the hit groups "
+            "and penetration cannot be learned"
+        )
     model = HitGroupModel.fit(weapons, distances, groups)
+    prior = HitGroupModel.from_dict(model.to_dict())
+    explained = 0
+    for weapon, distance, lost, before, armored in unknown:
+        weights = group_posterior(prior, weapon, distance, lost, before, armored)
+        if weights is not None:
+            model.add(weapon, distance, weights)
+            explained += 1
     penetration = Penetration.learn(weapons, groups, distances, health)
     provenance = {
         "hits": len(weapons),
-        "steps": int(sum(bullets.every)),
+        "hits_by_hp_lost": explained,
+        "hits_unexplained": len(unknown) - explained,
+        "steps": int(total),
         "rounds": used_rounds,
+        "maps": sorted(maps),
         "left_out": dict(stats.excluded),
+        "hp_lost_only": dict(stats.partial),
     }
-    return RulesFile(model, bullets, provenance, penetration)
+    return RulesFile(model, bullets, provenance, penetration, bullets_hurt)
+
+
+def _hp_lost_hits(
+    round_: Round, rows: DamageRows, chosen: np.ndarray, distance: np.ndarray
+) -> list[tuple[str, float, float, float, bool]]:
+    """(weapon, distance, HP lost, victim's HP before, armour took part) of the `chosen` rows,
+    hits whose data records only the HP lost."""
+    out = []
+    for r in np.flatnonzero(chosen):
+        earlier = (rows.victim == rows.victim[r]) & (rows.tick < rows.tick[r])
+        before = 100.0 - float(rows.hp_taken[earlier].sum())
+        armored = bool(rows.armor_damage[r] > 0)
+        lost = float(rows.hp_taken[r])
+        out.append((str(rows.weapon[r]), float(distance[r]), lost, before, armored))
+    return out
 
 
 def pair_outcome(
@@ -216,10 +242,12 @@ def pair_outcome(
     armor: int,
     helmet: bool,
     draw: np.random.Generator,
+    victim_hp: int = FULL_HP,
 ) -> tuple[int, int, str]:
-    """One damaging step of one pair (module doc, step 2): (health damage summed over the
-    bullets, armour they took, the hit group of the bullet that did the most)."""
-    p = rules.bullets.probabilities(weapon)
+    """One damaging step of one pair (module doc, step 2) on a victim with `victim_hp` at the
+    step's start: (health damage summed over the bullets, armour they took, the hit group of
+    the bullet that did the most)."""
+    p = rules.bullet_counts(victim_hp).probabilities(weapon, distance_u)
     count = 1 + int(np.searchsorted(np.cumsum(p), draw.random() * p.sum()))
     groups = rules.hit_groups.sample(draw, [weapon] * count, [distance_u] * count)
     health, taken, largest, largest_group = 0, 0, -1, groups[0]
@@ -240,10 +268,12 @@ def rules_generate(
     distances_m: np.ndarray,
     armor: np.ndarray,
     helmet: np.ndarray,
+    victim_hp: np.ndarray,
     seed: int,
     draws: int,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """`draws` outcomes of K damaging pair-steps, as the DOG's generative mode gives them:
+    """`draws` outcomes of K damaging pair-steps (victims with `victim_hp` at its start), as
+    the DOG's generative mode gives them:
     (draws, K) damage in HP (summed, in [1, 100]) and hit-group codes. A weapon the rules lack
     raises `UnknownWeaponError`."""
     draw = np.random.default_rng(seed)
@@ -258,6 +288,7 @@ def rules_generate(
                 int(armor[k]),
                 bool(helmet[k]),
                 draw,
+                int(victim_hp[k]),
             )
             damage[d, k] = min(max(health, 1), 100)
             group[d, k] = GROUPS.index(name)
@@ -302,6 +333,7 @@ class RulesDamage:
                 int(batch.victim_armor[row]),
                 bool(batch.victim_helmet[row]),
                 draw,
+                int(batch.victim_hp[row]),
             )
             damage[row] = min(max(health, 1), max(int(batch.victim_hp[row]), 1))
             armor_damage[row] = taken

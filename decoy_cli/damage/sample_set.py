@@ -26,7 +26,9 @@ MAX_DAMAGE_HP = 100.0
 class Samples:
     """K samples: the pair state (metres, degrees), the labels and the group of each.
 
-    `damage` is HP (0 for a negative), `hit_group` a code into HIT_GROUPS (-1 for a negative),
+    `damage` is the raw HP damage (0 for a negative, NaN for a hit whose data lacks it),
+    `hp_lost` the HP the victim lost (capped by its HP, as recorded), `hit_group` a code into
+    HIT_GROUPS (-1 for a negative, or a hit whose data lacks it),
     `group` "MATCH rROUND", `match` the match id, `tick` the step's tick, `mode` "frames" or
     "events" (how the sample's round was read).
     """
@@ -43,6 +45,7 @@ class Samples:
     victim_helmet: np.ndarray  # (K,) bool
     hit: np.ndarray  # (K,) bool
     damage: np.ndarray  # (K,) float32 HP
+    hp_lost: np.ndarray  # (K,) float32 HP
     hit_group: np.ndarray  # (K,) int8
     group: np.ndarray  # (K,) str
     match: np.ndarray  # (K,) str
@@ -51,6 +54,12 @@ class Samples:
 
     def __len__(self) -> int:
         return len(self.hit)
+
+    @property
+    def outcome_known(self) -> np.ndarray:
+        """(K,) bool: the hits whose raw damage and hit group are known (what a DOG learns
+        from and is scored on by hit group)."""
+        return self.hit & (self.hit_group >= 0) & np.isfinite(self.damage)
 
     def take(self, index: np.ndarray | slice) -> Samples:
         """The samples at `index` (integer indices, a boolean mask or a slice)."""
@@ -128,6 +137,7 @@ def empty_samples() -> Samples:
         victim_helmet=np.zeros(0, bool),
         hit=np.zeros(0, bool),
         damage=np.zeros(0, np.float32),
+        hp_lost=np.zeros(0, np.float32),
         hit_group=np.zeros(0, np.int8),
         group=np.zeros(0, dtype=object),
         match=np.zeros(0, dtype=object),
@@ -146,6 +156,8 @@ class SampleStats:
     rounds_without_samples: int = 0
     failures: list[RoundFailure] = field(default_factory=list)
     excluded: Counter[str] = field(default_factory=Counter)
+    partial: Counter[str] = field(default_factory=Counter)
+    """Hits kept with part of their outcome missing, by what they lack (damage_rows.py)."""
     realigned: int = 0
     positives: int = 0
     negatives: int = 0
@@ -167,6 +179,7 @@ class SampleStats:
         self.rounds_without_samples += other.rounds_without_samples
         self.failures.extend(other.failures)
         self.excluded.update(other.excluded)
+        self.partial.update(other.partial)
         self.realigned += other.realigned
 
     def to_json(self) -> dict[str, object]:
@@ -179,6 +192,7 @@ class SampleStats:
             "round_errors": self.round_errors,
             "file_errors": self.file_errors,
             "excluded_damage_rows": dict(sorted(self.excluded.items())),
+            "partial_damage_rows": dict(sorted(self.partial.items())),
             "realigned_hits": self.realigned,
             "positives": self.positives,
             "negatives": self.negatives,
@@ -201,6 +215,7 @@ def samples_from_rows(rows: list[dict[str, object]]) -> Samples:
         "victim_helmet": bool,
         "hit": bool,
         "damage": np.float32,
+        "hp_lost": np.float32,
         "hit_group": np.int8,
         "tick": np.int64,
     }

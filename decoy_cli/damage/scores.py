@@ -1,6 +1,7 @@
 """The numbers of the damage models' evaluation, plain numpy (scipy for the Wasserstein):
 ROC AUC, average precision, their curves, the best-F1 threshold, classification and regression
-metrics, the confusion matrix and the Wasserstein distance per (weapon, hit group) cell.
+metrics, the confusion matrix and the Wasserstein distance per (weapon, hit group or distance
+band) cell.
 
 No scikit-learn: these few metrics do not justify the dependency, and each is checked by hand
 in tests/test_damage_evaluation.py.
@@ -143,13 +144,50 @@ def confusion_matrix(real: np.ndarray, predicted: np.ndarray, classes: int) -> n
 
 @dataclass(frozen=True)
 class Cell:
-    """One (weapon, hit group) cell: sample counts and the Wasserstein distance in HP."""
+    """One (weapon, part) cell, the part a hit group or a distance band: sample counts and the
+    Wasserstein distance in HP."""
 
     weapon: str
-    hit_group: str
+    part: str
     real: int
     generated: int
     wasserstein_hp: float
+
+
+def group_names(codes: np.ndarray) -> np.ndarray:
+    """Hit-group codes as their names ("" for a code outside HIT_GROUPS)."""
+    names = np.array([*HIT_GROUPS, ""], dtype=object)
+    codes = np.asarray(codes, dtype=np.int64)
+    return names[np.where((codes >= 0) & (codes < len(HIT_GROUPS)), codes, len(HIT_GROUPS))]
+
+
+def keyed_cells(
+    real_weapon: np.ndarray,
+    real_part: np.ndarray,
+    real_value: np.ndarray,
+    generated_weapon: np.ndarray,
+    generated_part: np.ndarray,
+    generated_value: np.ndarray,
+    min_cell: int = MIN_CELL,
+) -> list[Cell]:
+    """The (weapon, part) cells with at least `min_cell` real and generated samples, most real
+    samples first; the parts are labels (hit-group names, distance bands)."""
+    from scipy.stats import wasserstein_distance
+
+    real_weapon = np.asarray(real_weapon, dtype=object)
+    real_part = np.asarray(real_part, dtype=object)
+    generated_weapon = np.asarray(generated_weapon, dtype=object)
+    generated_part = np.asarray(generated_part, dtype=object)
+    cells = []
+    for weapon, part in sorted(
+        {(str(w), str(p)) for w, p in zip(real_weapon, real_part, strict=True)}
+    ):
+        real = real_value[(real_weapon == weapon) & (real_part == part)]
+        generated = generated_value[(generated_weapon == weapon) & (generated_part == part)]
+        if len(real) >= min_cell and len(generated) >= min_cell:
+            distance = float(wasserstein_distance(real, generated))
+            cells.append(Cell(weapon, part, len(real), len(generated), distance))
+    return sorted(cells, key=lambda c: (-c.real, c.weapon, c.part))
 
 
 def wasserstein_cells(
@@ -161,42 +199,42 @@ def wasserstein_cells(
     generated_damage: np.ndarray,
     min_cell: int = MIN_CELL,
 ) -> list[Cell]:
-    """The cells with at least `min_cell` real and generated samples, most real samples first."""
-    from scipy.stats import wasserstein_distance
-
-    cells = []
-    for weapon in np.unique(real_weapon):
-        for code, name in enumerate(HIT_GROUPS):
-            real = real_damage[(real_weapon == weapon) & (real_group == code)]
-            generated = generated_damage[(generated_weapon == weapon) & (generated_group == code)]
-            if len(real) >= min_cell and len(generated) >= min_cell:
-                distance = float(wasserstein_distance(real, generated))
-                cells.append(Cell(str(weapon), name, len(real), len(generated), distance))
-    return sorted(cells, key=lambda c: (-c.real, c.weapon, c.hit_group))
+    """`keyed_cells` by (weapon, hit group), the groups given as codes."""
+    return keyed_cells(
+        real_weapon,
+        group_names(real_group),
+        real_damage,
+        generated_weapon,
+        group_names(generated_group),
+        generated_damage,
+        min_cell,
+    )
 
 
 def sampling_floor(
-    cells: list[Cell], weapon: np.ndarray, group: np.ndarray, damage: np.ndarray
+    cells: list[Cell], weapon: np.ndarray, part: np.ndarray, value: np.ndarray
 ) -> list[float]:
     """Per cell, the Wasserstein distance the model would score were the real samples drawn from
-    it. `weapon` (K,) is each sample's, `group` and `damage` (D, K) the model's D draws for
-    each. For each draw d, the model's d-th outcome of every sample stands in for the real one
-    (each keeps its own inputs: weapon, range, armour), and its cell is compared with the cell
-    of all draws; the floor is the mean over d. A cell of a few real samples scores about this
-    much by chance alone: a model cannot be told from the real game below it."""
+    it. `weapon` (K,) is each sample's, `part` (D, K) the part label (or hit-group code) and
+    `value` (D, K) the value of the model's D draws for each. For each draw d, the model's d-th
+    outcome of every sample stands in for the real one (each keeps its own inputs: weapon,
+    range, armour), and its cell is compared with the cell of all draws; the floor is the mean
+    over d. A cell of a few real samples scores about this much by chance alone: a model cannot
+    be told from the real game below it."""
     from scipy.stats import wasserstein_distance
 
     weapons = np.asarray(weapon, dtype=object)
+    part = np.asarray(part)
+    labels = group_names(part) if np.issubdtype(part.dtype, np.integer) else part.astype(object)
     floors = []
     for cell in cells:
-        code = HIT_GROUPS.index(cell.hit_group)
         of_weapon = weapons == cell.weapon
-        drawn, groups = damage[:, of_weapon], group[:, of_weapon]
-        pool = drawn[groups == code]
+        drawn, parts = value[:, of_weapon], labels[:, of_weapon]
+        pool = drawn[parts == cell.part]
         found = [
-            wasserstein_distance(drawn[d][groups[d] == code], pool)
+            wasserstein_distance(drawn[d][parts[d] == cell.part], pool)
             for d in range(len(drawn))
-            if np.any(groups[d] == code)
+            if np.any(parts[d] == cell.part)
         ]
         floors.append(float(np.mean(found)) if found else math.nan)
     return floors

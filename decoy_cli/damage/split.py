@@ -95,6 +95,27 @@ def deal_folds(
     return {str(unit): k % folds for k, unit in enumerate(shuffled)}
 
 
+def leave_matches_out(samples: Samples, rng: np.random.Generator) -> np.ndarray:
+    """(K,) the test fold of every sample: each match of a map with several matches is a fold
+    of its own (leave-one-match-out); the rounds of a map with one match are dealt into
+    `FOLDS` folds of their own (`deal_folds`), as no other match of that map could stand in."""
+    fold = np.zeros(len(samples), dtype=np.int64)
+    next_fold = 0
+    for name in sorted({str(m) for m in samples.map_name}):
+        of_map = samples.map_name == name
+        matches = sorted({str(m) for m in samples.match[of_map]})
+        if len(matches) > 1:
+            unit_of = {m: next_fold + k for k, m in enumerate(matches)}
+            units = samples.match
+        else:
+            dealt = deal_folds([str(g) for g in samples.group[of_map]], rng)
+            unit_of = {g: next_fold + k for g, k in dealt.items()}
+            units = samples.group
+        fold[of_map] = [unit_of[str(u)] for u in units[of_map]]
+        next_fold = int(fold[of_map].max()) + 1
+    return fold
+
+
 def balance(samples: Samples, index: np.ndarray, seed: int) -> np.ndarray:
     """The indices in `index` with all positives and as many negatives, drawn with the seed (all
     negatives when there are fewer), sorted: the paper's 1:1 balanced DIP set."""

@@ -297,9 +297,11 @@ def dip_parts(samples: Samples, split: Split, balanced: str, seed: int) -> dict[
 
 
 def dog_parts(samples: Samples, split: Split) -> dict[str, np.ndarray]:
-    """Train, validation and test indices for DOG: the damaging samples of each part."""
+    """Train, validation and test indices for DOG: the damaging samples of each part whose raw
+    damage and hit group are known."""
     parts = {name: split.part(name) for name in ("train", "val", "test")}
-    return {name: index[samples.hit[index]] for name, index in parts.items()}
+    known = samples.outcome_known
+    return {name: index[known[index]] for name, index in parts.items()}
 
 
 def fit_dip(

@@ -87,7 +87,14 @@ def train_dip_model(
 
     run = fit_dip(samples, split, options, FeatureSpec(), balanced, progress)
     metadata = {
-        **provenance(command="dip", choice=choice, split=split, stats=stats, options=options),
+        **provenance(
+            command="dip",
+            choice=choice,
+            split=split,
+            stats=stats,
+            options=options,
+            maps=sorted({str(m) for m in samples.map_name[split.train]}),
+        ),
         "balanced": balanced,
         "threshold_rule": DIP_THRESHOLD_RULE,
         **run.summary(),
@@ -128,7 +135,14 @@ def train_dog_model(
 
     run = fit_dog(samples, split, options, FeatureSpec(), weights, draws, min_cell, progress)
     metadata = {
-        **provenance(command="dog", choice=choice, split=split, stats=stats, options=options),
+        **provenance(
+            command="dog",
+            choice=choice,
+            split=split,
+            stats=stats,
+            options=options,
+            maps=sorted({str(m) for m in samples.map_name[split.train]}),
+        ),
         "loss_weights": weights.to_json(),
         "damage_target": DOG_DAMAGE_TARGET,
         **run.summary(),

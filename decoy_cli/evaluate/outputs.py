@@ -37,7 +37,14 @@ from decoy_cli.errors import OutputError
 from decoy_cli.evaluate.cache import CACHE_DIR
 from decoy_cli.evaluate.figures import draw_figures
 from decoy_cli.evaluate.record import WARNING_SEPARATOR
-from decoy_cli.evaluate.report import RunInfo, data_kind, mechanics, report_markdown, run_counts
+from decoy_cli.evaluate.report import (
+    RunInfo,
+    data_kind,
+    mechanics,
+    model_lines,
+    report_markdown,
+    run_counts,
+)
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.evaluate.view_page import run_page
@@ -253,6 +260,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, 
                 "sample": info.sample,
             },
             "mechanics": mechanics(evaluation.settings),
+            "models": model_lines(evaluation.settings),
             "counts": run_counts(evaluation, tables),
             "wall_seconds": evaluation.wall_seconds,
             "compute_seconds": evaluation.compute_seconds,

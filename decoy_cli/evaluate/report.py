@@ -75,6 +75,20 @@ def mechanics(settings: EvalSettings) -> str:
     return f"{bomb}, no shooting (--models none): deaths scripted from the data"
 
 
+def model_lines(settings: EvalSettings) -> dict[str, str]:
+    """ "hits decided by" and "damage decided by", in words (`damage.model_roles`)."""
+    from decoy_cli.damage import model_roles
+    from decoy_cli.damage.model_maps import map_warnings
+
+    models = settings.models if settings.combat else "none"
+    roles = model_roles(models)
+    lines = {"hits decided by": roles["hits"], "damage decided by": roles["damage"]}
+    warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
+    if warnings:
+        lines["model warnings"] = "; ".join(warnings)
+    return lines
+
+
 def command_line(
     inputs: Sequence[Path], settings: EvalSettings, sample: int | None, out: Path
 ) -> str:
@@ -252,6 +266,7 @@ def report_markdown(
             "(below, and the `inferred` column of `rounds.csv`)",
         ],
         ["mechanics", mechanics(evaluation.settings)],
+        *([name, text] for name, text in model_lines(settings).items()),
         ["mover, seed", f"{settings.mover}, {settings.seed}"],
         ["ran on", f"{info.backend}; {info.machine}"],
         ["wall time", f"{evaluation.wall_seconds:.1f} s (before writing the outputs)"],

@@ -140,13 +140,12 @@ def make_settings(
             raise GraphError(f"{graph}: a graph of {graph_map or 'no map'}, not {name} (--map)")
     models_fingerprint = ""
     if combat:
-        from decoy_cli.damage import SHIPPED_CHOICES, SHIPPED_MODELS, load_damage_model
+        from decoy_cli.damage import SHIPPED_CHOICES, load_damage_model, resolve_models
 
         if models not in (*SHIPPED_CHOICES, "none"):  # a folder: absolute, for workers elsewhere
-            models = str(Path(models).expanduser().resolve())
+            models = str(resolve_models(models).resolve())
         if load_damage_model(models) is not None:
-            folder = SHIPPED_MODELS if models in SHIPPED_CHOICES else Path(models)
-            models_fingerprint = folder_fingerprint(folder)
+            models_fingerprint = folder_fingerprint(resolve_models(models))
     return EvalSettings(
         map_name=name,
         combat=combat,

@@ -1,0 +1,65 @@
+"""Which maps a model was trained on, and the warnings when it is used on others.
+
+A model folder says it in its metadata: `dip.json` and `dog.json` under "metadata" -> "maps"
+(`decoy train` writes the maps of its training samples, `decoy models import-decoy` the paper's
+eight), `rules.json` under "provenance" -> "maps" (`decoy models fit-rules`). A model knows no
+map it was not trained on: the networks take a map one-hot and positions in that map's frame,
+so on another map what they say is not to be trusted; the rules' learned parts (where bullets
+land, how many per step) are not tied to a map's geometry, but were still measured on these.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from pathlib import Path
+
+from decoy_cli.damage.rules_model import RULES_FILE
+
+
+def trained_maps(folder: Path, part: str) -> list[str] | None:
+    """The maps the folder's `part` ("dip", "dog" or "rules") was trained on; None when its
+    file does not say (or cannot be read: loading it reports that)."""
+    path = folder / (RULES_FILE if part == "rules" else f"{part}.json")
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        maps = data["provenance" if part == "rules" else "metadata"]["maps"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not isinstance(maps, list) or not all(isinstance(m, str) for m in maps):
+        return None
+    return sorted(maps)
+
+
+def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
+    """One line per model part of the `--models` choice that was not trained on every one of
+    `maps`, naming the maps it was trained on (or saying it does not say); none for "none"."""
+    from decoy_cli.damage import damages_by_rules, resolve_models
+
+    if choice == "none":
+        return []
+    folder = resolve_models(choice)
+    used = sorted(set(maps))
+    parts = {"dip": "DIP (who hits)"}
+    if damages_by_rules(choice, folder):
+        parts["rules"] = "damage rules' learned parts (rules.json)"
+    else:
+        parts["dog"] = "DOG (how much damage)"
+    lines = []
+    for part, what in parts.items():
+        if not (folder / (RULES_FILE if part == "rules" else f"{part}.json")).is_file():
+            continue
+        known = trained_maps(folder, part)
+        if known is None:
+            lines.append(
+                f"the {what} of --models {choice} does not say which maps it was trained on: "
+                f"on {', '.join(used)} it may not be trusted"
+            )
+            continue
+        other = [m for m in used if m not in known]
+        if other:
+            lines.append(
+                f"the {what} of --models {choice} was trained on {', '.join(known)} only, not "
+                f"on {', '.join(other)}: what it says there is not to be trusted"
+            )
+    return lines
