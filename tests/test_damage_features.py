@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -171,6 +172,37 @@ def test_normalised_features_by_hand() -> None:
     coords = encode(batch, spec).coords[0]
     expected = [1.0, 0.0, 0.5, -0.5, 1.0, 1.5, 0.5, 0.0, 0.4, 30 / 50, -1.0]
     np.testing.assert_allclose(coords, expected, atol=1e-6)
+
+
+def test_relative_features_by_hand_name_no_place_nor_map() -> None:
+    """The same pair moved elsewhere, turned by the same angle for both, or on another map has
+    the same relative features: distance, height difference, both bearings, HP."""
+    spec = FeatureSpec(units="relative", centre_m=(1.0, 2.0, 0.0), half_extent_m=(10, 20, 4))
+    u = 1 / HAMMER_TO_M
+    here = batch_of(
+        attacker_u=[(11 * u, 2 * u, 2 * u)],
+        victim_u=[(11 * u, 32 * u, 4 * u)],  # 30 m north, 2 m higher
+        attacker_yaw=[270.0],  # looks south: the victim is behind
+        victim_yaw=[270.0],  # looks south, at the attacker
+        hp=[40],
+        weapons=["Nova"],
+    )
+    features = encode(here, spec)
+    distance = np.hypot(30, 2) / 50
+    expected = [0, 0, 2 / 4, 0, 0, 0, 0, 0.0, 0.4, distance, -1.0]
+    np.testing.assert_allclose(features.coords[0], expected, atol=1e-6)
+    assert not features.map.any()
+    there = batch_of(
+        attacker_u=[(-500 * u, 700 * u, -3 * u)],
+        victim_u=[(-530 * u, 700 * u, -1 * u)],  # the same pair turned 90 degrees, elsewhere
+        attacker_yaw=[0.0],
+        victim_yaw=[0.0],
+        hp=[40],
+        weapons=["Nova"],
+    )
+    there = replace(there, map_name="de_ancient")
+    np.testing.assert_allclose(encode(there, spec).coords, features.coords, atol=1e-6)
+    assert FeatureSpec.from_json(spec.to_json()) == spec
 
 
 def test_normalised_features_stay_near_unit_range_on_the_map() -> None:

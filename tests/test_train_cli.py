@@ -95,6 +95,13 @@ def test_train_prints_the_paper_beside(data: Path, tmp_path: Path) -> None:
     assert "split by round (seed 1): 1 test, 1 val, 6 train" in result.output
 
 
+def test_a_dip_on_relative_features_keeps_its_units(data: Path, tmp_path: Path) -> None:
+    args = ["train", "dip", str(data), "--out", str(tmp_path), "--units", "relative", *FAST]
+    result = runner.invoke(app, args, env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert load_dip(tmp_path).spec.units == "relative"
+
+
 def test_evaluate_the_test_part_again(trained: Path, data: Path, tmp_path: Path) -> None:
     """`models evaluate` with the training's split options scores the same test part."""
     out = tmp_path / "evaluation"

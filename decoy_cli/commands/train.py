@@ -8,6 +8,7 @@ model folder and the report) and prints what it gave.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
 import typer
 from rich.console import Console
@@ -104,6 +105,13 @@ def dip(
     ),
     xavier: bool = typer.Option(XAVIER, "--xavier/--no-xavier", help=XAVIER_HELP),
     threads: int = typer.Option(THREADS, "--threads", help=THREADS_HELP),
+    units: Literal["normalised", "relative"] = typer.Option(
+        "normalised",
+        "--units",
+        help="Features: normalised (positions in the de_dust2 box, the map one-hot, as the "
+        "paper's layout) or relative (distance, height difference and bearings only: nothing "
+        "that names a place on one map).",
+    ),
 ) -> None:
     """Train DIP, the Damage Indicator Predictor (does a shot land in a 0.5 s step).
 
@@ -138,6 +146,7 @@ def dip(
             balanced=balanced,
             on_file=on_file,
             progress=on_step,
+            units=units,
         )
     console = make_console()
     _print_start(console, result, choice)

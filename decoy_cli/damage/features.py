@@ -132,7 +132,7 @@ __all__ = [
 COORDS = 11
 """Number of coordinate and angle features."""
 
-UNITS = ("normalised", "hammer")
+UNITS = ("normalised", "hammer", "relative")
 
 DUST2_CENTRE_M = (-4.0, 18.5, -0.3)
 """Centre of the built-in de_dust2 waypoints' bounding box, metres (rounded)."""
@@ -159,7 +159,7 @@ class FeatureSpec:
 
     def __post_init__(self) -> None:
         if self.units not in UNITS:
-            raise ModelError(f"unknown feature units {self.units!r} (normalised or hammer)")
+            raise ModelError(f"unknown feature units {self.units!r} ({', '.join(UNITS)})")
         centre = tuple(float(x) for x in self.centre_m)
         half = tuple(float(x) for x in self.half_extent_m)
         if len(centre) != 3 or not all(math.isfinite(x) for x in centre):
@@ -312,6 +312,9 @@ def encode(batch: CombatBatch, spec: FeatureSpec) -> Features:
         coords[:, 0:3] = (attacker - centre) / half
         coords[:, 3] = _wrap(np.radians(attacker_yaw)) / np.pi
         coords[:, 4:7] = (victim - centre) / half
+        if spec.units == "relative":  # nothing that names a place on one map
+            coords[:, 0:7] = 0.0
+            coords[:, 2] = delta[:, 2] / half[2]
         seen_by_victim = np.arctan2(-delta[:, 1], -delta[:, 0]) - np.radians(victim_yaw)
         coords[:, 7] = _wrap(seen_by_victim) / np.pi
         coords[:, 9] = np.linalg.norm(delta, axis=1) / spec.distance_scale_m
@@ -324,7 +327,8 @@ def encode(batch: CombatBatch, spec: FeatureSpec) -> Features:
         )
 
     map_onehot = np.zeros((k, len(MAPS)), dtype=np.float32)
-    map_onehot[:, m] = 1.0
+    if spec.units != "relative":
+        map_onehot[:, m] = 1.0
     weapon = np.zeros((k, len(WEAPONS)), dtype=np.float32)
     index = weapon_index(np.asarray(batch.attacker_weapon).reshape(k))
     known = np.flatnonzero(index >= 0)

@@ -71,6 +71,7 @@ def train_dip_model(
     balanced: str = DEFAULT_BALANCE,
     on_file: FileCallback | None = None,
     progress: ProgressCallback | None = None,
+    units: str = "normalised",
 ) -> TrainingResult[DipRun]:
     """Train DIP on `choice`'s training part, choose its threshold by the best F1 on the
     validation part, evaluate it on the test part; write `out`/dip.pt and .json and the report
@@ -85,7 +86,7 @@ def train_dip_model(
     from decoy_cli.damage.model_folder import save_dip
     from decoy_cli.damage.training import fit_dip
 
-    run = fit_dip(samples, split, options, FeatureSpec(), balanced, progress)
+    run = fit_dip(samples, split, options, FeatureSpec(units=units), balanced, progress)
     metadata = {
         **provenance(
             command="dip",
