@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from decoy_cli.errors import OutputError
+from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.text import csv_inert
 
 
@@ -108,6 +108,20 @@ def json_text(data: Any, *, sort_keys: bool = True) -> str:
 def write_json(path: str | Path, data: Any, *, sort_keys: bool = True) -> Path:
     """Write `data` as pretty strict JSON, atomically: the one JSON writer of every output."""
     return write_atomic(path, json_text(data, sort_keys=sort_keys).encode())
+
+
+def read_json_object(path: Path, written_by: str) -> dict[str, Any]:
+    """The JSON object a command wrote to `path` (`written_by`: "`decoy replay`", ...); a
+    missing, unreadable or other file is one DecoyError line saying so."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DecoyError(f"{path}: not found (is {path.parent} a {written_by} output?)") from None
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise DecoyError(f"{path}: not readable JSON ({str(error).splitlines()[0]})") from None
+    if not isinstance(data, dict):
+        raise DecoyError(f"{path}: not written by {written_by}")
+    return data
 
 
 def check_writable(path: str | Path) -> Path:

@@ -7,7 +7,6 @@ is a DecoyError with one line.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +16,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.compare import read_run
 from decoy_cli.evaluate.runner import round_id
+from decoy_cli.files import read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.text import visible
 from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
@@ -44,7 +44,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     """The page's data of the run in `folder`; its cache is under `cache_root` (default: the
     folder; evaluate writes the page into a staging folder beside the cache)."""
     run = read_run(folder)
-    summary = _summary(folder / "summary.json")
+    summary = read_json_object(folder / "summary.json", "`decoy evaluate`")
     keys = summary.get("cache_keys")
     if not isinstance(keys, dict):
         raise DecoyError(
@@ -95,20 +95,6 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
         "rounds": rounds,
         "initial": 0,
     }
-
-
-def _summary(path: Path) -> dict[str, Any]:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DecoyError(
-            f"{path}: not found (is {path.parent} a `decoy evaluate` output?)"
-        ) from None
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        raise DecoyError(f"{path}: not readable JSON ({str(error).splitlines()[0]})") from None
-    if not isinstance(data, dict):
-        raise DecoyError(f"{path}: not a summary of a `decoy evaluate` run")
-    return data
 
 
 def _said(value: object) -> str:

@@ -7,7 +7,6 @@ A folder that is not a replay, lacks a file, or was written by a decoy that wrot
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +14,7 @@ import msgspec
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
+from decoy_cli.files import read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
@@ -33,7 +33,7 @@ def is_replay_folder(folder: Path) -> bool:
 
 def replay_page(folder: Path) -> PageData:
     """The page's data of the replay in `folder`."""
-    summary = _read_json(folder / "summary.json")
+    summary = read_json_object(folder / "summary.json", "`decoy replay`")
     trace_path = folder / TRACE_FILE
     if not trace_path.is_file():
         raise DecoyError(
@@ -75,18 +75,6 @@ def replay_page(folder: Path) -> PageData:
         "rounds": [round_entry(label, info, trace)],
         "initial": 0,
     }
-
-
-def _read_json(path: Path) -> dict[str, Any]:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DecoyError(f"{path}: not found (is {path.parent} a `decoy replay` output?)") from None
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        raise DecoyError(f"{path}: not readable JSON ({str(error).splitlines()[0]})") from None
-    if not isinstance(data, dict):
-        raise DecoyError(f"{path}: not the summary of a `decoy replay`")
-    return data
 
 
 def _summary_rows(summary: dict[str, Any]) -> pd.DataFrame:
