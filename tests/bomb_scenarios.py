@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from esta_fixtures import one_round_match
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.sim.sites import SiteZones
@@ -125,20 +126,9 @@ class BombScenario:
             "winningSide": None,
             "roundEndReason": None,
             "frames": frames,
-            "kills": [],
-            "damages": [],
             "bombEvents": self.bomb_events,
-            "grenades": [],
-            "weaponFires": [],
-            "flashes": [],
         }
-        return {
-            "matchID": "bomb-scenario",
-            "clientName": "decoy tests",
-            "mapName": "de_dust2",
-            "tickRate": TICK_RATE,
-            "gameRounds": [round_],
-        }
+        return one_round_match("bomb-scenario", TICK_RATE, round_)
 
     def write(self, path: Path) -> Path:
         path.write_text(json.dumps(self.document()))

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from esta_fixtures import one_round_match
+
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.waypoints.build import builtin_graph
 
@@ -68,10 +70,6 @@ class BothTeams:
             "roundEndReason": self.reason,
             "frames": [self._frame(j) for j in range(self.frames)],
             "kills": [self._kill(*kill) for kill in self.kills],
-            "damages": [],
-            "grenades": [],
-            "weaponFires": [],
-            "flashes": [],
             "bombEvents": []
             if self.plant is None
             else [
@@ -89,13 +87,7 @@ class BothTeams:
                 }
             ],
         }
-        return {
-            "matchID": "both-teams",
-            "clientName": "",
-            "mapName": "de_dust2",
-            "tickRate": TICK_RATE,
-            "gameRounds": [round_],
-        }
+        return one_round_match("both-teams", TICK_RATE, round_, client="")
 
     def write(self, path: Path) -> Path:
         path.write_text(json.dumps(self.document()))

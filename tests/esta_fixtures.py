@@ -354,6 +354,20 @@ def _bomb_event(tick: int, action: str) -> dict[str, Any]:
     }
 
 
+def one_round_match(
+    match_id: str, tick_rate: int, round_: dict[str, Any], client: str = "decoy tests"
+) -> dict[str, Any]:
+    """A match document of one de_dust2 round; event lists the round does not give are empty."""
+    empty = ("kills", "damages", "grenades", "weaponFires", "flashes", "bombEvents")
+    return {
+        "matchID": match_id,
+        "clientName": client,
+        "mapName": "de_dust2",
+        "tickRate": tick_rate,
+        "gameRounds": [{key: [] for key in empty} | round_],
+    }
+
+
 def encode(document: Any) -> bytes:
     """JSON bytes as Python writes them (NaN and Infinity literals allowed)."""
     return json.dumps(document).encode()
