@@ -60,15 +60,15 @@ def provenance(
     split: Split,
     stats: SampleStats,
     options: TrainOptions,
-    maps: list[str],
+    samples: Samples,
 ) -> dict[str, Any]:
-    """What a model was trained on and how (`command` is "dip" or "dog", `maps` those of its
+    """What a model was trained on and how (`command` is "dip" or "dog"; "maps", those of its
     training samples): kept in the model's JSON metadata, so a model folder says where it came
     from."""
     return {
         "trained_with": f"decoy {__version__}: decoy train {command}",
         "data": [str(d) for d in choice.data],
-        "maps": maps,
+        "maps": sorted({str(m) for m in samples.map_name[split.train]}),
         "mode": choice.mode,
         "window_s": choice.window_s,
         "split": {
