@@ -55,10 +55,11 @@ def write_csv(path: str | Path, frame: pd.DataFrame) -> Path:
 
 @contextlib.contextmanager
 def staged(folder: str | Path) -> Iterator[Path]:
-    """A staging folder inside `folder` for a set of files that replace the previous ones
-    together: written there, then moved into place by renames (which a full disk does not
-    stop). On any error while writing, the stage is removed and the previous files stay as
-    they were; the error passes on."""
+    """A staging folder inside `folder` for a set of files (and folders) that replace the
+    previous ones together: written there, then moved into place by renames (which a full disk
+    does not stop; a folder replaces the previous folder of its name whole). On any error while
+    writing, the stage is removed and the previous files stay as they were; the error passes
+    on."""
     folder = Path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -74,7 +75,10 @@ def staged(folder: str | Path) -> Iterator[Path]:
         raise
     try:
         for entry in sorted(stage.iterdir()):
-            os.replace(entry, folder / entry.name)
+            target = folder / entry.name
+            if entry.is_dir() and target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            os.replace(entry, target)
         stage.rmdir()
     except OSError as error:
         raise OutputError(

@@ -48,7 +48,7 @@ from decoy_cli.evaluate.report import (
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.evaluate.view_page import run_page
-from decoy_cli.files import json_ready, write_atomic, write_csv, write_json
+from decoy_cli.files import json_ready, staged, write_atomic, write_csv, write_json
 from decoy_cli.text import visible
 from decoy_cli.view.page import write_page
 
@@ -144,28 +144,12 @@ def ctrl_c_deferred() -> Iterator[None]:
 def _write_and_publish(
     evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, view: bool
 ) -> list[Path]:
-    stage = out / f".staging-{os.getpid()}"
-    shutil.rmtree(stage, ignore_errors=True)
-    try:
+    with staged(out) as stage:
         written = _write_outputs(evaluation, tables, stage, info)
         if view:
             written.append(write_page(stage / VIEW_PAGE, run_page(stage, cache_root=out)))
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        raise
-    try:
-        for entry in sorted(stage.iterdir()):
-            target = out / entry.name
-            if target.is_dir() and not target.is_symlink():
-                shutil.rmtree(target)
-            os.replace(entry, target)
-        stage.rmdir()
-        if not view:
-            (out / VIEW_PAGE).unlink(missing_ok=True)
-    except OSError as error:
-        raise OutputError(
-            f"cannot move the outputs into {out}: {error.strerror or error}"
-        ) from None
+    if not view:
+        (out / VIEW_PAGE).unlink(missing_ok=True)
     return [out / path.relative_to(stage) for path in written]
 
 
