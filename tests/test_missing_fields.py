@@ -14,6 +14,7 @@ from both_teams import BothTeams, Mate, site_node
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round, read_match
 from decoy_cli.metrics.kills import kill_row, kill_table
@@ -23,6 +24,7 @@ from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import CombatBatch, DamageResult
 from decoy_cli.sim.rules import RulesConfig, SiteZones
 from decoy_cli.waypoints.build import builtin_graph
+from decoy_cli.weapons import FIREARMS
 
 
 def read(doc: BothTeams, tmp_path: Path, name: str = "m.json") -> Round:
@@ -263,6 +265,29 @@ def test_a_death_the_fight_misses_is_taken_from_the_data_after_the_window(
     assert result.outcome is not None and result.outcome.winner == "T"
     row = result.kill_row(round_)
     assert row["deaths_original"] == 1 and row["deaths_recalled"] == 0  # not by the fight
+
+
+class GrazesWhenArmed:
+    """Every visible attacker holding a firearm hits for 1 HP (nobody dies; a test model)."""
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        armed = np.isin(batch.attacker_weapon, FIREARMS)
+        return DamageResult(armed.astype(np.int64), np.where(armed, 2, -1), armed)
+
+
+def test_a_player_past_his_real_death_is_a_target_and_shoots_nobody(tmp_path: Path) -> None:
+    doc = facing_off()
+    doc.kills = [(5.5, "t1", "ct1", "AK-47")]
+    doc.players[1].dead_from = 6
+    round_ = read(doc, tmp_path)
+    result = replay_round(round_, builtin_graph(), ReplayOptions(damage_model=GrazesWhenArmed()))
+    hits = [(e.agent, e.tick / TICK_RATE) for e in result.events if e.kind == "damage"]
+    by_ct = [s for agent, s in hits if agent == 1]
+    by_t = [s for agent, s in hits if agent == 0]
+    assert by_ct and max(by_ct) <= 5.5  # armed until the data's death, then not
+    assert max(by_t) == 8.0  # the T hits him until he is taken out at 8.5 s
+    (death,) = [e for e in result.events if e.kind == "death"]
+    assert death.tick / TICK_RATE == pytest.approx(8.5, abs=2 / TICK_RATE)
 
 
 def test_kill_row_by_hand() -> None:

@@ -10,8 +10,10 @@ data is removed at its death time when combat is off or the deaths follow the da
 fight kills, and a player the data shows dead whom the fight has not killed within
 `DEATH_WINDOW_S` of its real death (the tolerance of the kill-level metrics) is removed then,
 as "scripted" too: its data has ended, there is nothing left to replay, and a player standing
-on at the spot where he died would fight a round that no longer exists. The metrics count such
-deaths as not reproduced by the fight.
+on at the spot where he died would fight a round that no longer exists. From his real death to
+that removal he is a target only: he holds no weapon (in the game he is dead and shoots nobody;
+armed, he killed players who survived in reality). The metrics count such deaths as not
+reproduced by the fight.
 
 Fields the game needs and the data lacks (weapons, armour, the bomb's carrier, the defuser) are
 filled by the rules of `decoy_cli.replay.missing` and named in `ReplayResult.inferred`.
@@ -55,7 +57,7 @@ from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import MoverName, OpenRound, RoundSetup, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import FIREARMS, max_speed_m_s
+from decoy_cli.weapons import FIREARMS, NO_WEAPON, max_speed_m_s
 from decoy_cli.world.physics import PhysicsWorld
 
 DATA_FRAME_S = 0.5
@@ -349,12 +351,12 @@ def replay_round(
         # The data's deaths are scripted at their time without shooting or with `deaths` "data";
         # with the fight deciding, a player the fight has not killed by `DEATH_WINDOW_S` after
         # its real death is taken out then (its data ends: nothing is left to replay).
+        # From the real death to then the player holds no weapon (module docstring).
         grace = DEATH_WINDOW_S if sim.combat is not None and options.deaths == "simulated" else 0
-        deaths = {
-            i: tick_at(truth.seconds[i] + grace)
-            for i, p in enumerate(plan.plans)
-            if p.death_frame >= 0
-        }
+        dying = [i for i, p in enumerate(plan.plans) if p.death_frame >= 0]
+        deaths = {i: tick_at(truth.seconds[i] + grace) for i in dying}
+        disarm = {i: tick_at(truth.seconds[i]) for i in dying} if grace else {}
+        unarmed: set[int] = set()
         # The replay follows the data to its last frame: a round the rules end earlier (the
         # clock, the bomb) goes on moving through the round-end delay, as the real players
         # did, with the outcome as decided (`Simulator.step(after_end=True)`).
@@ -367,9 +369,13 @@ def replay_round(
                 if tick <= sim.tick + 1 and agents.alive[i]:
                     sim.kill(i, "scripted")
                     scripted[i] = True
+            for i, tick in disarm.items():
+                if tick <= sim.tick + 1 and i not in unarmed:
+                    agents.weapon[i] = NO_WEAPON
+                    unarmed.add(i)
             stop = int(frame_ticks[np.searchsorted(frame_ticks, sim.tick, side="right")])
-            for i, tick in deaths.items():
-                if agents.alive[i]:
+            for i, tick in [*deaths.items(), *disarm.items()]:
+                if agents.alive[i] and tick > sim.tick + 1:
                     stop = min(stop, tick - 1)
             sim.run(to_tick=max(stop, sim.tick + 1), after_end=True)
             f = frame_of_tick.get(sim.tick)
@@ -380,7 +386,7 @@ def replay_round(
                     i = int(alive)
                     if present[i, f]:
                         agents.has_defuser[i] = kit_frames[i, f]
-                    if weapon_frames[i, f]:
+                    if weapon_frames[i, f] and i not in unarmed:
                         agents.weapon[i] = weapon_frames[i, f]
                         sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
         played_from = sim.tick
