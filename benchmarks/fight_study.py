@@ -16,6 +16,11 @@ For every real firearm kill of the rounds (both teams in the frames):
 * what the replay (`--deaths simulated`) did: the victim killed by the fight within 3 s,
   earlier, later or never, and whether the real killer was dead by then or never hit him.
 
+For every kill of that replay's fight: whether it reproduces a real death (within 3 s) or not
+(the victim survived, or died more than 3 s away), and whether the two players saw each other
+at a real frame within 1 s of it in each world: the fight's kills that are wrong and that
+reality's geometry would have prevented.
+
 Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
 frames) against those in which the replay's fight damaged one, and the HP real victims had one
 frame before they died (how fast real fights end). Nothing here is timed.
@@ -118,6 +123,7 @@ def main() -> None:
     hp_before_death = []
     dip = collections.Counter()
     fates = collections.Counter()
+    fight_kills = collections.Counter()
     kills = real_seconds = replay_seconds = 0
     files, _ = collect_match_files(args.inputs)
     for round_ in iter_rounds(files, map_name="de_dust2"):
@@ -177,6 +183,18 @@ def main() -> None:
                 fates[f"{fate}; the real killer never hit him"] += 1
             else:
                 fates[f"{fate}; the real killer hit him first {hit_at[(a, v)] - t:+.0f} s off"] += 1
+        for event in result.events:
+            if event.kind != "kill" or event.agent is None or event.agent < 0:
+                continue
+            a, v, at = event.agent, int(event.other), event.tick / TICK_RATE
+            right = bool(abs(truth.seconds[v] - at) <= DEATH_WINDOW_S)  # NaN (survived): False
+            near = np.flatnonzero(np.abs(round_.frame_seconds - at) <= 1.0)
+            a_eyes, v_eyes = round_.position[a, near] + EYE, round_.position[v, near] + EYE
+            known = np.isfinite(a_eyes).all(axis=1) & np.isfinite(v_eyes).all(axis=1)
+            fight_kills[("reproducing a real death" if right else "wrong", "all")] += 1
+            for name, world in worlds.items():
+                seen_there = bool(world.line_of_sight(a_eyes[known], v_eyes[known]).any())
+                fight_kills[("reproducing a real death" if right else "wrong", name)] += seen_there
         hp = np.where(round_.hp >= 0, round_.hp, np.nan).astype(float)
         for player in range(round_.num_players):
             dead = np.flatnonzero(~np.asarray(round_.alive[player], bool))
@@ -200,6 +218,12 @@ def main() -> None:
         print(f"  DIP says hit, attacker's yaw {name}: {count / max(kills, 1):.2f}")
     for fate, count in fates.most_common():
         print(f"  {count:3d} {fate}")
+    for kind in ("reproducing a real death", "wrong"):
+        line = ", ".join(f"{fight_kills[(kind, name)]} in sight in the {name}" for name in worlds)
+        print(
+            f"  fight's kills that {kind.replace('wrong', 'are wrong')}: "
+            f"{fight_kills[(kind, 'all')]}; at a real frame within 1 s: {line}"
+        )
     print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
     full = np.asarray(hp_before_death) >= 100
     print(f"real deaths from full HP within one frame: {full.sum()} of {len(full)}")

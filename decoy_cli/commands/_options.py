@@ -14,6 +14,11 @@ DEATHS_HELP = (
     "reproduced) or data (the paper's protocol: a player dies when the data says so; shooting "
     "wounds but does not kill). Without shooting, deaths come from the data either way."
 )
+SIGHT_MESH_HELP = (
+    "The map's geometry to test line of sight in when shooting: a triangle mesh in Hammer units, "
+    "z up (awpy's .tri, or an .obj). Default: the nav world the graph was built on, which lacks "
+    "windows, props and low cover."
+)
 MISSING_HELP = (
     "Fields the game needs and the data lacks (weapon in hand, armour, the bomb's carrier, the "
     "defuser): infer (filled by the rules of decoy_cli/replay/missing.py and named per round "

@@ -23,7 +23,13 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
+from decoy_cli.commands._options import (
+    DEATHS_HELP,
+    MAPS_HELP,
+    MISSING_HELP,
+    MOVER_HELP,
+    SIGHT_MESH_HELP,
+)
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
@@ -80,6 +86,7 @@ def evaluate(
         help="Waypoint graph (.npz from build-waypoints, e.g. with --learn-patches) to replay "
         "on, with the world it was built on; its map must be --map. Default: the shipped one.",
     ),
+    sight_mesh: Path | None = typer.Option(None, "--sight-mesh", help=SIGHT_MESH_HELP),
     sample: int | None = typer.Option(
         None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
     ),
@@ -172,6 +179,7 @@ def evaluate(
         missing=missing,
         fastdtw=fastdtw,
         graph=graph,
+        sight_mesh=sight_mesh,
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend

@@ -11,7 +11,13 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import DEATHS_HELP, MAPS_HELP, MISSING_HELP, MOVER_HELP
+from decoy_cli.commands._options import (
+    DEATHS_HELP,
+    MAPS_HELP,
+    MISSING_HELP,
+    MOVER_HELP,
+    SIGHT_MESH_HELP,
+)
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.esta.plausibility import check_policy
@@ -40,6 +46,7 @@ def replay(
         "--graph",
         help="Waypoint graph (.npz from build-waypoints; default: the built-in one of the map).",
     ),
+    sight_mesh: Path | None = typer.Option(None, "--sight-mesh", help=SIGHT_MESH_HELP),
     out: Path | None = typer.Option(
         None,
         "--out",
@@ -89,6 +96,7 @@ def replay(
         graph_file=graph_file,
         out=out,
         gif=gif,
+        sight_mesh=sight_mesh,
     )
     round_, result, players = run.round_, run.result, run.players
     real = (round_.winning_side, round_.end_reason)

@@ -33,6 +33,7 @@ from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import PlaceFinder, RoundRecord, build_record
 from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.world.occlusion import OcclusionScene
 
 if TYPE_CHECKING:
     from decoy_cli.replay.replayer import ReplayResult
@@ -91,10 +92,11 @@ class _WorkerState:
         from decoy_cli.waypoints.build import graph_world
         from decoy_cli.world.physics import PhysicsWorld
 
-        self.key = (settings.map_name, settings.graph, settings.graph_sha)
+        self.key = worker_key(settings)
         self.graph = run_graph(settings)
         self.places = PlaceFinder(self.graph)
         self.physics = PhysicsWorld(graph_world(self.graph))
+        self.sight = run_sight(settings, self.graph)
         self.models: dict[str, DamageModel | None] = {}
         self.matches: OrderedDict[tuple[str, str, str], Match] = OrderedDict()
 
@@ -147,10 +149,27 @@ def run_graph(settings: EvalSettings) -> WaypointGraph:
     return WaypointGraph.load(settings.graph)
 
 
+def run_sight(settings: EvalSettings, graph: WaypointGraph) -> OcclusionScene | None:
+    """The geometry a run tests line of sight in: the user's `--sight-mesh` (checked to be the
+    file the run hashed), else None (the graph's world)."""
+    if not settings.sight_mesh:
+        return None
+    from decoy_cli.sim.sight import read_sight_mesh
+
+    if file_sha256(Path(settings.sight_mesh)) != settings.sight_mesh_sha:
+        raise DecoyError(f"{settings.sight_mesh}: the mesh changed while the evaluation ran")
+    return OcclusionScene(read_sight_mesh(Path(settings.sight_mesh), graph))
+
+
+def worker_key(settings: EvalSettings) -> tuple[str, ...]:
+    """What a worker's state is built from: the map, the graph and the sight mesh."""
+    return (settings.map_name, settings.graph, settings.graph_sha, settings.sight_mesh_sha)
+
+
 def worker_state(settings: EvalSettings) -> _WorkerState:
     """This thread's worker state, built on first use (one per process in a local pool)."""
     state = getattr(_local, "state", None)
-    if state is None or state.key != (settings.map_name, settings.graph, settings.graph_sha):
+    if state is None or state.key != worker_key(settings):
         state = _WorkerState(settings)
         _local.state = state
     return state
@@ -247,5 +266,6 @@ def _replay(
         deaths=settings.deaths,
         missing=settings.missing,
         implausible=settings.implausible,
+        sight=state.sight,
     )
     return replay_round(round_, state.graph, options, physics=state.physics)

@@ -86,6 +86,13 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
     warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
     if warnings:
         lines["model warnings"] = "; ".join(warnings)
+    if settings.models_fingerprint:
+        lines["line of sight in"] = (
+            f"{settings.sight_mesh} (sha256 {settings.sight_mesh_sha[:12]})"
+            if settings.sight_mesh
+            else "the nav world the graph was built on (approximate: no windows, props or low "
+            "cover; --sight-mesh gives the map's geometry)"
+        )
     return lines
 
 
@@ -96,6 +103,8 @@ def command_line(
     words = ["decoy", "evaluate", *map(str, inputs), "--map", settings.map_name]
     if settings.graph:
         words += ["--graph", settings.graph]
+    if settings.sight_mesh:
+        words += ["--sight-mesh", settings.sight_mesh]
     if sample is not None:
         words += ["--sample", str(sample)]
     words += ["--seed", str(settings.seed), "--combat" if settings.combat else "--no-combat"]

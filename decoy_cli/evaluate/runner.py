@@ -124,11 +124,12 @@ def make_settings(
     missing: Missing = "infer",
     fastdtw: bool | None = None,
     graph: Path | None = None,
+    sight_mesh: Path | None = None,
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round. `fastdtw` None
     means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise."""
-    from decoy_cli.waypoints.build import canonical_map
+    from decoy_cli.waypoints.build import builtin_graph, canonical_map
 
     name = canonical_map(map_name)
     graph_path, graph_sha = "", ""
@@ -138,6 +139,14 @@ def make_settings(
         graph_map = str(WaypointGraph.load(graph_path).meta.get("map", ""))
         if graph_map != name:
             raise GraphError(f"{graph}: a graph of {graph_map or 'no map'}, not {name} (--map)")
+    sight_path, sight_sha = "", ""
+    if sight_mesh is not None and combat:  # checked here: a wrong mesh fails once, at once
+        from decoy_cli.sim.sight import read_sight_mesh
+
+        sight_path = str(sight_mesh.expanduser().resolve())
+        sight_sha = file_sha256(Path(sight_path))
+        graph_of_run = WaypointGraph.load(graph_path) if graph_path else builtin_graph(name)
+        read_sight_mesh(Path(sight_path), graph_of_run)
     models_fingerprint = ""
     if combat:
         from decoy_cli.damage import SHIPPED_CHOICES, load_damage_model, resolve_models
@@ -162,6 +171,8 @@ def make_settings(
         fastdtw=(not combat and not bomb) if fastdtw is None else fastdtw,
         graph=graph_path,
         graph_sha=graph_sha,
+        sight_mesh=sight_path,
+        sight_mesh_sha=sight_sha,
     )
 
 

@@ -126,6 +126,10 @@ class EvalSettings:
     on it and on the world it was built on (`graph_world`)."""
     graph_sha: str = ""
     """SHA-256 of that file (a different graph is a different result)."""
+    sight_mesh: str = ""
+    """A map's geometry for line of sight (`--sight-mesh`), absolute ("": the graph's world)."""
+    sight_mesh_sha: str = ""
+    """SHA-256 of that file."""
 
     def to_json(self) -> str:
         return json.dumps(asdict(self), sort_keys=True)

@@ -58,6 +58,7 @@ from decoy_cli.sim.setup import MoverName, OpenRound, RoundSetup, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import FIREARMS, NO_WEAPON, max_speed_m_s
+from decoy_cli.world.occlusion import OcclusionScene
 from decoy_cli.world.physics import PhysicsWorld
 
 DATA_FRAME_S = 0.5
@@ -239,6 +240,8 @@ class ReplayOptions:
     implausible: Implausible = "fail"
     """Whether a player far off the map fails the round or is a warning (as the reader's
     policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
+    sight: OcclusionScene | None = None
+    """The map's geometry line of sight is tested in (`RoundSetup.sight`; None: the world)."""
 
     def setup(self, graph: WaypointGraph, round_: Round) -> RoundSetup:
         """The simulator setup of a replay of `round_` on `graph`."""
@@ -257,6 +260,7 @@ class ReplayOptions:
             damage_model=self.damage_model,
             combat_kills=self.deaths == "simulated",
             rules=rules,
+            sight=self.sight,
         )
 
 

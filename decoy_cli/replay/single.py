@@ -11,7 +11,7 @@ from __future__ import annotations
 import hashlib
 import re
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,9 +25,11 @@ from decoy_cli.files import staged
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
+from decoy_cli.sim.sight import read_sight_mesh
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
+from decoy_cli.world.occlusion import OcclusionScene
 
 DEFAULT_REPLAY_OUT = Path("decoy-out") / "replay"
 
@@ -54,12 +56,14 @@ def replay_address(
     graph_file: Path | None = None,
     out: Path | None = None,
     gif: bool = False,
+    sight_mesh: Path | None = None,
 ) -> SingleReplay:
     """Replay the round at "FILE:ROUND" and write its files (see the module docstring).
 
     `models` names the damage models in the summary (None: no shooting). The round is replayed
     on its own map (the file's `mapName`); `map_name`, when given, must agree with it, and so
-    must the map a `graph_file` was built for.
+    must the map a `graph_file` was built for. `sight_mesh`: the map's geometry line of sight
+    is tested in when shooting (`read_sight_mesh`).
     """
     if map_name is not None:
         map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
@@ -69,11 +73,15 @@ def replay_address(
     graph_map = str(graph.meta.get("map", ""))
     if graph_map and graph_map != map_id:
         raise DecoyError(f"{address}: a {map_id} round, but the graph {graph_file} is {graph_map}")
+    sight = "the graph's world"
+    if sight_mesh is not None and options.combat:
+        options = replace(options, sight=OcclusionScene(read_sight_mesh(sight_mesh, graph)))
+        sight = str(sight_mesh)
     started = time.perf_counter()
     result = replay_round(round_, graph, options)
     seconds = time.perf_counter() - started
     players = player_metrics(round_, result.trace())
-    summary = replay_summary(address, round_, options, models, result, players, seconds)
+    summary = replay_summary(address, round_, options, models, result, players, seconds, sight)
     folder = out or DEFAULT_REPLAY_OUT / replay_folder_name(round_.path, round_.round_num)
     nav = load_navmesh(map_id)
     shown = "".join(c if c.isprintable() else "?" for c in round_.match_id[:8])
@@ -126,6 +134,7 @@ def replay_summary(
     result: ReplayResult,
     players: pd.DataFrame,
     seconds: float,
+    sight: str = "the graph's world",
 ) -> dict[str, Any]:
     """The contents of `summary.json`: the round, the options, both outcomes, counts, the
     fields inferred, the bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off) and the
@@ -145,6 +154,7 @@ def replay_summary(
             "missing_fields": options.missing,
         },
         "damage_models": models if options.combat else None,
+        "line_of_sight_in": sight if options.combat else None,
         "played_out_s": round(result.played_out_s, 3),
         "outcome_original": {"winner": round_.winning_side, "reason": round_.end_reason},
         "outcome_replay": {

@@ -30,6 +30,7 @@ from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import WaypointGraph
 
 if TYPE_CHECKING:
+    from decoy_cli.world.occlusion import OcclusionScene
     from decoy_cli.world.physics import PhysicsWorld
     from decoy_cli.world.world import World
 
@@ -63,6 +64,9 @@ class RoundSetup:
     """False: shooting wounds but never kills (HP stops at 1): deaths come from elsewhere, as
     in a replay whose deaths follow the data (`--deaths data`, the paper's protocol)."""
     world: World | None = None
+    sight: OcclusionScene | None = None
+    """Geometry line of sight is tested in (a map's full geometry, `read_sight_mesh`); None:
+    the pybullet client's world."""
     rules: RulesConfig | None = None
     zones: SiteZones | None = None
 
@@ -143,7 +147,7 @@ def open_round(
         combat = None
         if setup.shooting:
             assert physics is not None and setup.damage_model is not None
-            los = LineOfSight(physics, agents.count)
+            los = LineOfSight(physics, agents.count, scene=setup.sight)
             stack.callback(los.close)
             combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.combat_kills)
         rules = BombRules(setup.site_zones(), setup.rules_config())
