@@ -221,7 +221,7 @@ def main() -> None:
     for kind in ("reproducing a real death", "wrong"):
         line = ", ".join(f"{fight_kills[(kind, name)]} in sight in the {name}" for name in worlds)
         print(
-            f"  fight's kills that {kind.replace('wrong', 'are wrong')}: "
+            f"  fight's kills {'that are wrong' if kind == 'wrong' else kind}: "
             f"{fight_kills[(kind, 'all')]}; at a real frame within 1 s: {line}"
         )
     print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
