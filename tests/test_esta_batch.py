@@ -7,8 +7,15 @@ from pathlib import Path
 import pytest
 from esta_fixtures import make_match, write_match
 
-from decoy_cli.errors import EstaError
-from decoy_cli.esta import RoundFailure, collect_match_files, failure_from, iter_rounds
+from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.esta import (
+    Round,
+    RoundFailure,
+    collect_match_files,
+    each_round,
+    failure_from,
+    iter_rounds,
+)
 
 
 def _kinds(items: list) -> list[tuple[str, int | None, str]]:
@@ -88,3 +95,30 @@ def test_dangling_and_looping_links_are_failures_not_silence(tmp_path: Path) -> 
     assert "no such file" in failures[0].message
     assert "cannot read the file" in failures[1].message
     assert len(items) - len(failures) == 3 and good.exists()
+
+
+def test_each_round_works_or_records_and_goes_on(tmp_path: Path) -> None:
+    broken = make_match()
+    broken["gameRounds"][1]["frames"] = "not a list"
+    path = write_match(tmp_path / "b.json", broken)
+
+    def work(round_: Round) -> int:
+        if round_.round_num == 3:
+            raise DecoyError("round three is refused")
+        return round_.round_num * 10
+
+    items = list(each_round(iter_rounds([path]), work, "my work"))
+    done = [
+        (r.round_num, made) for r, made in (x for x in items if not isinstance(x, RoundFailure))
+    ]
+    assert done == [(1, 10)]
+    assert _kinds(items) == [("b.json", 2, "broken round"), ("b.json", 3, "my work")]
+    assert isinstance(items[2], RoundFailure) and items[2].message == "round three is refused"
+
+    def buggy(round_: Round) -> int:
+        raise KeyError("oops")
+
+    bugs = [x for x in each_round(iter_rounds([path]), buggy, "w") if isinstance(x, RoundFailure)]
+    assert [b.kind for b in bugs] == ["internal error", "broken round", "internal error"]
+    with pytest.raises(KeyError):  # outside `catch`: not caught
+        list(each_round(iter_rounds([path]), buggy, "w", catch=DecoyError))

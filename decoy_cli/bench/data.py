@@ -17,7 +17,14 @@ from typing import Any
 import numpy as np
 
 from decoy_cli.errors import DecoyError, EstaError
-from decoy_cli.esta import RoundFailure, failure_from, iter_match_files, iter_rounds, read_match
+from decoy_cli.esta import (
+    Round,
+    RoundFailure,
+    each_round,
+    iter_match_files,
+    iter_rounds,
+    read_match,
+)
 from decoy_cli.esta.source import read_bytes
 from decoy_cli.metrics import player_metrics
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
@@ -141,28 +148,29 @@ def replay_throughput(
     wall = cpu = 0.0
     warmed = False
     with PhysicsWorld(nav_world()) as physics:
-        for item in iter_rounds(files):
-            if max_rounds is not None and len(per_round) >= max_rounds:
-                break
+
+        def timed(round_: Round) -> tuple[float, float]:
+            """The wall and CPU seconds of the replay and its metrics."""
+            started, cpu_started = time.perf_counter(), time.process_time()
+            player_metrics(round_, replay_round(round_, graph, options, physics=physics).trace())
+            return time.perf_counter() - started, time.process_time() - cpu_started
+
+        rounds = each_round(iter_rounds(files), timed, "replay error", catch=DecoyError)
+        for item in rounds if max_rounds is None or max_rounds > 0 else ():
             if isinstance(item, RoundFailure):
                 failures.append(item)
-                continue
-            started = time.perf_counter()
-            cpu_started = time.process_time()
-            try:
-                replayed = replay_round(item, graph, options, physics=physics)
-                player_metrics(item, replayed.trace())
-            except DecoyError as error:
-                failures.append(failure_from(error, item.path, item.round_num, "replay error"))
                 continue
             if not warmed:
                 warmed = True
                 continue
-            per_round.append(time.perf_counter() - started)
-            wall += per_round[-1]
-            cpu += time.process_time() - cpu_started
-            frames += item.num_frames
-            game_s += float(np.ptp(item.frame_seconds))
+            round_, (round_wall, round_cpu) = item
+            per_round.append(round_wall)
+            wall += round_wall
+            cpu += round_cpu
+            frames += round_.num_frames
+            game_s += float(np.ptp(round_.frame_seconds))
+            if max_rounds is not None and len(per_round) >= max_rounds:
+                break  # before the next round is replayed
     result: dict[str, Any] = {
         "rounds": len(per_round),
         "failed": len(failures),

@@ -39,7 +39,7 @@ from decoy_cli.damage.split import (
     split_samples,
 )
 from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Round, RoundFailure, collect_match_files, failure_from, iter_rounds
+from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
 
 MODES = ("auto", "frames", "events")
 DEFAULT_MODE = "auto"
@@ -75,13 +75,21 @@ def build_samples(
         raise DecoyError("no data given: pass ESTA match files or folders")
     stats = SampleStats(files=len(files))
     parts: list[Samples] = []
+
+    def counted(round_: Round) -> tuple[Samples | None, SampleStats]:
+        counts = SampleStats()
+        return round_samples(round_, mode, window_s, counts), counts
+
     for done, path in enumerate(files, start=1):
-        for item in iter_rounds([path]):
-            if isinstance(item, RoundFailure):
+        for item in each_round(iter_rounds([path]), counted, SAMPLE_ERROR):
+            if isinstance(item, RoundFailure):  # counts of a failed round are left out
                 stats.failures.append(item)
                 continue
-            part = _samples_of(item, mode, window_s, stats)
-            if part is not None:
+            _, (part, counts) = item
+            stats.merge(counts)
+            if part is None or len(part) == 0:
+                stats.rounds_without_samples += 1
+            else:
                 parts.append(part)
         if on_file is not None:
             on_file(path, done, len(files))
@@ -91,23 +99,6 @@ def build_samples(
     if len(samples) == 0:
         raise DecoyError(_no_samples_message(data, stats))
     return samples, stats
-
-
-def _samples_of(round_: Round, mode: str, window_s: float, stats: SampleStats) -> Samples | None:
-    """The samples of one round with its counts added to `stats`; None (counted) when it has
-    none, None with a recorded failure when building them raised (counts of a failed round are
-    left out)."""
-    counts = SampleStats()
-    try:
-        part = round_samples(round_, mode, window_s, counts)
-    except Exception as error:  # the batch policy: one failed round does not stop the rest
-        stats.failures.append(failure_from(error, round_.path, round_.round_num, SAMPLE_ERROR))
-        return None
-    stats.merge(counts)
-    if part is None or len(part) == 0:
-        stats.rounds_without_samples += 1
-        return None
-    return part
 
 
 def _no_samples_message(data: Sequence[str | Path], stats: SampleStats) -> str:

@@ -6,6 +6,7 @@ See decoy_cli/esta/reader.py for what is tolerated and what fails the file or on
 from decoy_cli.esta.batch import (
     RoundFailure,
     collect_match_files,
+    each_round,
     failure_from,
     iter_matches,
     iter_rounds,
@@ -29,6 +30,7 @@ __all__ = [
     "RoundClock",
     "RoundFailure",
     "collect_match_files",
+    "each_round",
     "failure_from",
     "iter_match_files",
     "iter_matches",

@@ -10,12 +10,15 @@ with the place it was raised.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from decoy_cli.errors import DecoyError, EstaError, describe_bug
 from decoy_cli.esta.reader import MATCH_SUFFIXES, Match, Round, iter_match_files, read_match
+
+Result = TypeVar("Result")
 
 UNREADABLE_FILE = "unreadable file"
 OTHER_MAP = "other map"
@@ -60,6 +63,29 @@ def failure_from(
     summary, where = describe_bug(error)
     at = f" (at {where})" if where else ""
     return RoundFailure(str(file), round_num, INTERNAL_ERROR, summary + at)
+
+
+def each_round(
+    rounds: Iterable[Round | RoundFailure],
+    work: Callable[[Round], Result],
+    kind: str,
+    *,
+    catch: type[BaseException] | tuple[type[BaseException], ...] = Exception,
+) -> Iterator[tuple[Round, Result] | RoundFailure]:
+    """(round, what `work` made of it) for every round of `rounds` (`iter_rounds`,
+    `match_rounds`), or the failure that stands for it: a round the reader could not build, or
+    one whose work raised one of `catch`, recorded by `failure_from` under `kind`. The batch
+    goes on; an exception outside `catch` (a benchmark's bug) is not caught."""
+    for item in rounds:
+        if isinstance(item, RoundFailure):
+            yield item
+            continue
+        try:
+            result = work(item)
+        except catch as error:
+            yield failure_from(error, item.path, item.round_num, kind)
+            continue
+        yield item, result
 
 
 def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[Path]]:

@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError, EstaError
-from decoy_cli.esta import Match, Round, RoundFailure, failure_from, iter_matches, match_rounds
+from decoy_cli.esta import Match, Round, RoundFailure, each_round, iter_matches, match_rounds
 from decoy_cli.metrics import METRIC_NAMES, MetricSummary, PlayerRound, summarize
 from decoy_cli.metrics.trajectory import trajectory_metrics_frame
 from decoy_cli.replay.rounds import RoundPlan, snap_round
@@ -278,21 +278,22 @@ def _study_match(
     metrics, max_distance, physics = how
     count = len(match.rounds)  # progress counts the rounds the reader built
     built = 0
-    for item in match_rounds(match):
-        if isinstance(item, RoundFailure):
-            failures.append(item)
+
+    def study(round_: Round) -> RoundStudy:
+        return study_round(
+            round_, graph, metrics=metrics, max_distance=max_distance, physics=physics
+        )
+
+    for item in each_round(match_rounds(match), study, SNAP_ERROR, catch=DecoyError):
+        if isinstance(item, RoundFailure) and item.kind != SNAP_ERROR:
+            failures.append(item)  # the reader's: not a round that progress counts
             continue
         built += 1
-        try:
-            studies.append(
-                study_round(
-                    item, graph, metrics=metrics, max_distance=max_distance, physics=physics
-                )
-            )
-        except DecoyError as error:
-            failure = failure_from(error, match.path, item.round_num, SNAP_ERROR)
+        if isinstance(item, RoundFailure):
             prefix = f"{match.path}: round {item.round_num}: "
-            failures.append(replace(failure, message=prefix + failure.message))
+            failures.append(replace(item, message=prefix + item.message))
+        else:
+            studies.append(item[1])
         if on_progress is not None:
             on_progress(index + built / count, len(studies))
 
