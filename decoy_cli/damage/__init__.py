@@ -91,9 +91,11 @@ def damages_by_rules(choice: str, folder: Path) -> bool:
     )
 
 
-def model_roles(choice: str) -> dict[str, str]:
-    """Which model decides who hits and which how much, in words, for a `--models` choice
-    (a folder that cannot be read names itself only)."""
+def model_roles(choice: str, map_name: str) -> dict[str, str]:
+    """Which model decides who hits on `map_name` and which how much, in words, for a
+    `--models` choice (a folder that cannot be read names itself only)."""
+    from decoy_cli.damage.model_maps import dip_for_map
+
     if choice == "none":
         return {"hits": "none (no shooting)", "damage": "none (no shooting)"}
     try:
@@ -105,27 +107,33 @@ def model_roles(choice: str) -> dict[str, str]:
         damage = f"the game's damage rules with the learned parts of {name} (rules.json)"
     else:
         damage = f"the DOG of {name}"
-    return {"hits": f"the DIP of {name}", "damage": damage}
+    return {"hits": dip_for_map(choice, map_name).name, "damage": damage}
 
 
 def load_damage_model(choice: str) -> DamageModel | None:
     """The damage model a user chose: "shipped", "rules", "none" (None: no shooting), "paper"
     or the path of a model folder holding a DIP and a DOG (e.g. written by `decoy models
     import-decoy`) or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's
-    rules).
+    rules). The shipped choices decide hits by the shipped map-independent DIP on the maps
+    their own DIP was not trained on (`model_maps.dip_for_map`).
 
     A missing or incompatible folder is one ModelError line.
     """
     if choice == "none":
         return None
     folder = resolve_models(choice)
-    from decoy_cli.damage.combat import LearnedDamage
+    from decoy_cli.damage.combat import LearnedDamage, StandIn
     from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.model_maps import any_map_folder, trained_maps
     from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
+    stand_in = None
+    fallback = any_map_folder()
+    if choice in SHIPPED_CHOICES and fallback is not None:
+        stand_in = StandIn(load_dip(fallback), frozenset(trained_maps(folder, "dip") or []))
     if damages_by_rules(choice, folder):
-        return RulesDamage(load_dip(folder), RulesFile.load(folder))
-    return LearnedDamage(load_dip(folder), load_dog(folder))
+        return RulesDamage(load_dip(folder), RulesFile.load(folder), stand_in=stand_in)
+    return LearnedDamage(load_dip(folder), load_dog(folder), stand_in=stand_in)
 
 
 __all__ = [
