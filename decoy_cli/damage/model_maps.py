@@ -122,11 +122,11 @@ def _fallback_lines(choice: str, maps: list[str]) -> list[str]:
 
     folder = resolve_models(choice)
     stand_in = dip_for_map(choice, fallen[0])
-    own = trained_maps(folder, "dip") or []
+    own = ", ".join(trained_maps(folder, "dip") or []) or "maps it does not name"
     known = trained_maps(stand_in.folder, "dip")
     lines = [
         f"hits on {', '.join(fallen)} are decided by {stand_in.name}, not the DIP of --models "
-        f"{choice} (trained on {', '.join(own)} only): it was trained on "
+        f"{choice} (trained on {own} only): it was trained on "
         f"{', '.join(known) if known else 'maps it does not name'} with features that name no "
         "place (distance, height difference, bearings, HP)"
     ]
