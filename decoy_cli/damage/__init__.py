@@ -3,6 +3,7 @@
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
+* model_maps.py: the maps a model knows, the DIP each map gets, and the warnings;
 * paper.py, download_paper.py: import of the paper's published checkpoints, and their download;
 * combat.py: `DipDecision` (who hits) and `LearnedDamage`, the simulator's `DamageModel` over a
   DIP and a DOG;
@@ -34,8 +35,9 @@ SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
 DEFAULT_MODELS = "rules"
-"""What `--models` is unless told: the shipped DIP with damage by the game's rules, the
-combination that measures best on the real damage events (README, "Damage models")."""
+"""What `--models` is unless told: the shipped DIP (off its maps, the shipped map-independent
+one: `model_maps.dip_for_map`) with damage by the game's rules, the combination that measures
+best on the real damage events (README, "Damage models")."""
 
 SHIPPED_CHOICES = ("shipped", "rules")
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
