@@ -294,9 +294,10 @@ def evaluate(
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
         for where, m in result.report["dip_by_map"].items():
             console.print(
-                f"DIP on {where}: recall {m['recall']:.3f}, precision {m['precision']:.3f}, "
-                f"ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} damaging, "
-                f"{m['negatives']:,} not)",
+                f"DIP on {where} ({result.report['dip_of_map'][where]}, threshold "
+                f"{m['threshold']:.3f}): recall {m['recall']:.3f}, precision "
+                f"{m['precision']:.3f}, ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} "
+                f"damaging, {m['negatives']:,} not)",
                 highlight=False,
             )
     if result.dog is not None:

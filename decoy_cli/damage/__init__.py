@@ -3,6 +3,7 @@
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
+* model_maps.py: the maps a model knows, the DIP each map gets, and the warnings;
 * paper.py, download_paper.py: import of the paper's published checkpoints, and their download;
 * combat.py: `DipDecision` (who hits) and `LearnedDamage`, the simulator's `DamageModel` over a
   DIP and a DOG;
@@ -34,8 +35,9 @@ SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
 DEFAULT_MODELS = "rules"
-"""What `--models` is unless told: the shipped DIP with damage by the game's rules, the
-combination that measures best on the real damage events (README, "Damage models")."""
+"""What `--models` is unless told: the shipped DIP (off its maps, the shipped map-independent
+one: `model_maps.dip_for_map`) with damage by the game's rules, the combination that measures
+best on the real damage events (README, "Damage models")."""
 
 SHIPPED_CHOICES = ("shipped", "rules")
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
@@ -91,9 +93,11 @@ def damages_by_rules(choice: str, folder: Path) -> bool:
     )
 
 
-def model_roles(choice: str) -> dict[str, str]:
-    """Which model decides who hits and which how much, in words, for a `--models` choice
-    (a folder that cannot be read names itself only)."""
+def model_roles(choice: str, map_name: str) -> dict[str, str]:
+    """Which model decides who hits on `map_name` and which how much, in words, for a
+    `--models` choice (a folder that cannot be read names itself only)."""
+    from decoy_cli.damage.model_maps import dip_for_map
+
     if choice == "none":
         return {"hits": "none (no shooting)", "damage": "none (no shooting)"}
     try:
@@ -105,27 +109,33 @@ def model_roles(choice: str) -> dict[str, str]:
         damage = f"the game's damage rules with the learned parts of {name} (rules.json)"
     else:
         damage = f"the DOG of {name}"
-    return {"hits": f"the DIP of {name}", "damage": damage}
+    return {"hits": dip_for_map(choice, map_name).name, "damage": damage}
 
 
 def load_damage_model(choice: str) -> DamageModel | None:
     """The damage model a user chose: "shipped", "rules", "none" (None: no shooting), "paper"
     or the path of a model folder holding a DIP and a DOG (e.g. written by `decoy models
     import-decoy`) or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's
-    rules).
+    rules). The shipped choices decide hits by the shipped map-independent DIP on the maps
+    their own DIP was not trained on (`model_maps.dip_for_map`).
 
     A missing or incompatible folder is one ModelError line.
     """
     if choice == "none":
         return None
     folder = resolve_models(choice)
-    from decoy_cli.damage.combat import LearnedDamage
+    from decoy_cli.damage.combat import LearnedDamage, StandIn
     from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.model_maps import any_map_folder, trained_maps
     from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
+    stand_in = None
+    fallback = any_map_folder()
+    if choice in SHIPPED_CHOICES and fallback is not None:
+        stand_in = StandIn(load_dip(fallback), frozenset(trained_maps(folder, "dip") or []))
     if damages_by_rules(choice, folder):
-        return RulesDamage(load_dip(folder), RulesFile.load(folder))
-    return LearnedDamage(load_dip(folder), load_dog(folder))
+        return RulesDamage(load_dip(folder), RulesFile.load(folder), stand_in=stand_in)
+    return LearnedDamage(load_dip(folder), load_dog(folder), stand_in=stand_in)
 
 
 __all__ = [

@@ -88,10 +88,10 @@ def evaluate_model_folder(
     samples, stats = choice.read(on_file)
     index = np.arange(len(samples)) if subset == "all" else choice.split(samples).part(subset)
 
-    from decoy_cli.damage.evaluation import evaluate_dip, evaluate_dog
+    from decoy_cli.damage.evaluation import evaluate_dog
     from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
     from decoy_cli.damage.hp_lost import draw_outcomes, score_by_map
-    from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.model_folder import load_dog
     from decoy_cli.damage.model_maps import map_warnings
     from decoy_cli.damage.rules_model import RulesFile
 
@@ -111,13 +111,13 @@ def evaluate_model_folder(
     name = models if models in ("rules", "shipped", "paper") else folder.name or str(folder)
     dip_result = dog_result = None
     if has_dip:
-        dip = load_dip(folder)
         chosen = balance(samples, index, choice.seed) if balanced else index
         if not samples.hit[chosen].any():
             raise ModelError(f"no damaging samples in the {subset} samples: DIP cannot be scored")
-        dip_result = evaluate_dip(dip, samples.take(chosen), threshold)
+        dip_result, by_map, dip_of_map = evaluate_map_dips(models, samples, chosen, threshold)
         report["dip"] = {"balanced": balanced, **dip_result.metrics}
-        report["dip_by_map"] = dip_by_map(dip_result, samples.map_name[chosen])
+        report["dip_by_map"] = by_map
+        report["dip_of_map"] = dip_of_map
         figures += write_dip_figures(dip_result, out, f"DIP of {name}")
     hits = index[samples.hit[index]]
     outcome = RulesFile.load(folder) if by_rules else load_dog(folder) if has_dog else None
@@ -173,17 +173,43 @@ def evaluate_model_folder(
     )
 
 
-def dip_by_map(result: DipEvaluation, maps: np.ndarray) -> dict[str, dict[str, float]]:
-    """DIP's classification metrics (at the same threshold) on each map's samples."""
+def evaluate_map_dips(
+    models: str, samples: Samples, chosen: np.ndarray, threshold: float | None
+) -> tuple[DipEvaluation, dict[str, dict[str, float]], dict[str, str]]:
+    """The `chosen` samples scored map by map by the DIP each map gets
+    (`model_maps.dip_for_map`), at its threshold (or `threshold`): the evaluation of them all,
+    each map's metrics and the name of each map's DIP. With one DIP for every map the
+    evaluation is that DIP's; with several, each sample is decided at its own DIP's threshold,
+    the curves and calibration pool their probabilities (a DIP's calibration is left out)."""
+    from decoy_cli.damage.calibration import calibration_scores
+    from decoy_cli.damage.evaluation import evaluate_dip
+    from decoy_cli.damage.model_folder import LoadedDip, load_dip
+    from decoy_cli.damage.model_maps import dip_for_map
     from decoy_cli.damage.scores import classification_metrics
 
-    threshold = result.metrics["threshold"]
-    return {
-        str(name): classification_metrics(
-            result.labels[maps == name], result.probabilities[maps == name], threshold
-        )
-        for name in sorted({str(m) for m in maps})
-    }
+    maps = np.array([str(m) for m in samples.map_name[chosen]], dtype=object)
+    loaded: dict[Path, LoadedDip] = {}
+    probabilities = np.zeros(len(chosen))
+    thresholds = np.zeros(len(chosen))
+    by_map: dict[str, dict[str, float]] = {}
+    dip_of_map: dict[str, str] = {}
+    for where in sorted(set(maps.tolist())):
+        which = dip_for_map(models, where)
+        if which.folder not in loaded:
+            loaded[which.folder] = load_dip(which.folder)
+        rows = np.flatnonzero(maps == where)
+        result = evaluate_dip(loaded[which.folder], samples.take(chosen[rows]), threshold)
+        probabilities[rows] = result.probabilities
+        thresholds[rows] = result.metrics["threshold"]
+        by_map[where] = result.metrics
+        dip_of_map[where] = which.name
+    if len(loaded) == 1:
+        (only,) = loaded.values()
+        return evaluate_dip(only, samples.take(chosen), threshold), by_map, dip_of_map
+    labels = samples.hit[chosen].copy()
+    metrics = classification_metrics(labels, probabilities, thresholds)
+    metrics |= calibration_scores(labels, probabilities, None)
+    return DipEvaluation(metrics, labels, probabilities), by_map, dip_of_map
 
 
 def _hit_samples(choice: SampleChoice, samples: Samples, subset: str, index: np.ndarray) -> Samples:

@@ -12,9 +12,49 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 from decoy_cli.damage.rules_model import RULES_FILE
+
+ANY_MAP = "any_map"
+"""The subfolder of the shipped models holding the map-independent DIP (module doc)."""
+
+
+@dataclass(frozen=True)
+class MapDip:
+    """The DIP that decides hits on one map for a `--models` choice: the folder whose dip.json
+    it is, its name in words, and whether it stands in for the choice's own DIP (`fallback`:
+    the map is not one that DIP was trained on)."""
+
+    folder: Path
+    name: str
+    fallback: bool
+
+
+def any_map_folder() -> Path | None:
+    """The shipped map-independent DIP's folder, None when the package lacks it."""
+    from decoy_cli.damage import SHIPPED_MODELS
+
+    folder = SHIPPED_MODELS / ANY_MAP
+    return folder if (folder / "dip.json").is_file() else None
+
+
+def dip_for_map(choice: str, map_name: str) -> MapDip:
+    """The DIP that decides hits on `map_name` for a `--models` choice (not "none"): the
+    choice's own; for the shipped choices on a map their DIP was not trained on, the
+    map-independent one (`ANY_MAP`) when it is installed."""
+    from decoy_cli.damage import SHIPPED_CHOICES, SHIPPED_MODELS, resolve_models
+
+    folder = resolve_models(choice)
+    if choice in SHIPPED_CHOICES:
+        fallback = any_map_folder()
+        if fallback is not None and map_name not in (trained_maps(folder, "dip") or []):
+            return MapDip(
+                fallback, f"the map-independent DIP of the shipped models ({ANY_MAP})", True
+            )
+    name = "the shipped models" if folder == SHIPPED_MODELS else str(folder)
+    return MapDip(folder, f"the DIP of {name}", False)
 
 
 def trained_maps(folder: Path, part: str) -> list[str] | None:
@@ -33,7 +73,9 @@ def trained_maps(folder: Path, part: str) -> list[str] | None:
 
 def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
     """One line per model part of the `--models` choice that was not trained on every one of
-    `maps`, naming the maps it was trained on (or saying it does not say); none for "none"."""
+    `maps` where it is used, naming the maps it was trained on (or saying it does not say),
+    and where the map-independent DIP stands in for the choice's own (`dip_for_map`); none for
+    "none"."""
     from decoy_cli.damage import damages_by_rules, resolve_models
 
     if choice == "none":
@@ -45,21 +87,52 @@ def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
         parts["rules"] = "damage rules' learned parts (rules.json)"
     else:
         parts["dog"] = "DOG (how much damage)"
-    lines = []
+    lines = _fallback_lines(choice, used)
     for part, what in parts.items():
         if not (folder / (RULES_FILE if part == "rules" else f"{part}.json")).is_file():
             continue
+        # the maps where the part is used: the DIP's are not those where another stands in
+        where = [m for m in used if part != "dip" or not dip_for_map(choice, m).fallback]
         known = trained_maps(folder, part)
+        if not where:
+            continue
         if known is None:
             lines.append(
                 f"the {what} of --models {choice} does not say which maps it was trained on: "
-                f"on {', '.join(used)} it may not be trusted"
+                f"on {', '.join(where)} it may not be trusted"
             )
             continue
-        other = [m for m in used if m not in known]
+        other = [m for m in where if m not in known]
         if other:
             lines.append(
                 f"the {what} of --models {choice} was trained on {', '.join(known)} only, not "
                 f"on {', '.join(other)}: what it says there is not to be trusted"
             )
+    return lines
+
+
+def _fallback_lines(choice: str, maps: list[str]) -> list[str]:
+    """The lines of the maps where the map-independent DIP stands in for the choice's own
+    (`dip_for_map`): which DIP decides hits there and the maps each was trained on, and the
+    maps it never saw."""
+    fallen = [m for m in maps if dip_for_map(choice, m).fallback]
+    if not fallen:
+        return []
+    from decoy_cli.damage import resolve_models
+
+    folder = resolve_models(choice)
+    stand_in = dip_for_map(choice, fallen[0])
+    own = ", ".join(trained_maps(folder, "dip") or []) or "maps it does not name"
+    known = trained_maps(stand_in.folder, "dip")
+    lines = [
+        f"hits on {', '.join(fallen)} are decided by {stand_in.name}, not the DIP of --models "
+        f"{choice} (trained on {own} only): it was trained on "
+        f"{', '.join(known) if known else 'maps it does not name'} with features that name no "
+        "place (distance, height difference, bearings, HP)"
+    ]
+    unseen = [m for m in fallen if known is not None and m not in known]
+    if unseen:
+        lines.append(
+            f"{stand_in.name} never saw {', '.join(unseen)}: its hits there were not measured"
+        )
     return lines

@@ -41,6 +41,7 @@ from decoy_cli.files import write_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
+    from decoy_cli.damage.combat import StandIn
     from decoy_cli.damage.damage_rows import DamageRows
     from decoy_cli.damage.model_folder import LoadedDip
 
@@ -296,7 +297,8 @@ def rules_generate(
 
 
 class RulesDamage:
-    """A `DamageModel`: DIP decides who hits, the rules how much and where (module doc)."""
+    """A `DamageModel`: DIP decides who hits (with a `stand_in`, the DIP of the batch's map:
+    `MapDecisions`), the rules how much and where (module doc)."""
 
     def __init__(
         self,
@@ -304,10 +306,12 @@ class RulesDamage:
         rules: RulesFile,
         threshold: float | None = None,
         threads: int | None = 1,
+        stand_in: StandIn | None = None,
     ) -> None:
-        from decoy_cli.damage.combat import DipDecision
+        from decoy_cli.damage.combat import MapDecisions
 
-        self.decision = DipDecision(dip, threshold, threads)
+        self.decisions = MapDecisions(dip, threshold, threads, stand_in)
+        self.decision = self.decisions.home
         self.dip = dip
         self.rules = rules
 
@@ -323,7 +327,8 @@ class RulesDamage:
             return DamageResult(damage, group, np.zeros(0, dtype=bool), armor_damage)
         # two independent streams: the hit decisions' and the outcomes'
         decide_seed, outcome_seed = np.random.SeedSequence(seed).spawn(2)
-        hit = self.decision.hits(batch, encode(batch, self.dip.spec), decide_seed)
+        decision = self.decisions.on(batch.map_name)
+        hit = decision.hits(batch, encode(batch, decision.dip.spec), decide_seed)
         draw = np.random.default_rng(outcome_seed)
         for row in np.flatnonzero(hit):
             health, taken, name = pair_outcome(

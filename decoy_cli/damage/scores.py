@@ -95,10 +95,12 @@ def best_f1_threshold(labels: np.ndarray, scores: np.ndarray) -> float:
 
 
 def classification_metrics(
-    labels: np.ndarray, scores: np.ndarray, threshold: float
+    labels: np.ndarray, scores: np.ndarray, threshold: float | np.ndarray
 ) -> dict[str, float]:
     """Accuracy, precision, recall and F1 at `threshold` (positive at or above it), ROC AUC,
-    average precision, the threshold and the class counts."""
+    average precision, the threshold and the class counts. `threshold` may be an array, one
+    per sample (samples scored by several classifiers, each at its own): the threshold given
+    is then NaN."""
     labels, scores = _check(labels, scores)
     predicted = scores >= threshold
     tp = int(np.sum(predicted & labels))
@@ -114,7 +116,7 @@ def classification_metrics(
         "f1": f1,
         "roc_auc": roc_auc(labels, scores),
         "average_precision": average_precision(labels, scores),
-        "threshold": float(threshold),
+        "threshold": float(threshold) if np.ndim(threshold) == 0 else math.nan,
         "positives": int(labels.sum()),
         "negatives": int((~labels).sum()),
     }
