@@ -43,9 +43,10 @@ SHIPPED_CHOICES = ("shipped", "rules")
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
 
 CHOICES_HELP = (
-    '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIP with damage by '
+    '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIPs with damage by '
     'the game\'s rules), "paper" (the paper\'s, once imported), "none" (no shooting) or a '
-    "model folder"
+    "model folder; the shipped DIPs: de_dust2's own on de_dust2, the map-independent one "
+    "(models/any_map) on the other maps"
 )
 
 
