@@ -291,8 +291,9 @@ def test_models_evaluate_a_dip_alone(tmp_path: Path) -> None:
 def test_the_evaluation_report_names_who_decides_hits_and_damage() -> None:
     """report.md and summary.json say which model decided the hits and which the damage, and
     warn when a model was not trained on the evaluated map."""
+    from decoy_cli.evaluate.heat import HeatGrid
     from decoy_cli.evaluate.report import model_lines
-    from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
+    from decoy_cli.evaluate.settings import EvalSettings
 
     common = {"bomb": True, "mover": "kinematic", "seed": 0, "code": "c"}
     grid = HeatGrid.for_map("de_ancient")

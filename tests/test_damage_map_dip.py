@@ -115,8 +115,9 @@ def test_without_the_map_independent_dip_the_shipped_one_decides(shipped: Path) 
 
 
 def test_the_evaluation_report_names_the_dip_of_its_map(shipped: Path) -> None:
+    from decoy_cli.evaluate.heat import HeatGrid
     from decoy_cli.evaluate.report import model_lines
-    from decoy_cli.evaluate.settings import EvalSettings, HeatGrid
+    from decoy_cli.evaluate.settings import EvalSettings
 
     common = {"bomb": True, "mover": "kinematic", "seed": 0, "code": "c", "models": "rules"}
     lines = {

@@ -29,14 +29,16 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
 from decoy_cli.evaluate.cache import RunCache
+from decoy_cli.evaluate.heat import HeatGrid, grid_sums, read_grid_sums
 from decoy_cli.evaluate.job import RoundTask, evaluate_round, is_synthetic
 from decoy_cli.evaluate.outputs import FAILURE_COLUMNS
-from decoy_cli.evaluate.record import PlaceFinder, grid_sums, hp_stats, read_grid_sums
 from decoy_cli.evaluate.runner import Evaluation, ProgressEvent, make_settings, run_evaluation
-from decoy_cli.evaluate.settings import EvalSettings, HeatGrid, round_key
+from decoy_cli.evaluate.settings import EvalSettings, round_key
 from decoy_cli.evaluate.tables import Tables, build_tables, hp_metrics_from_sums
 from decoy_cli.metrics import FASTDTW_METRIC, METRIC_NAMES, hp_metrics
+from decoy_cli.metrics.hp_sums import hp_stats
 from decoy_cli.waypoints.build import GRAPH_FILE, builtin_graph
+from decoy_cli.waypoints.places import PlaceFinder
 from decoy_cli.world.navmesh import asset_dir
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

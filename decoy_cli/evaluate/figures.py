@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.evaluate.settings import HeatGrid
+from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.evaluate.tables import END_OF_DATA, NOT_RECORDED, UNDECIDED, Accumulator, Tables
 from decoy_cli.figures import draw_nav_areas, save_figure
 

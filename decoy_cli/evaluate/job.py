@@ -30,9 +30,10 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
 from decoy_cli.esta.batch import UNREADABLE_FILE
 from decoy_cli.esta.plausibility import Implausible
-from decoy_cli.evaluate.record import PlaceFinder, RoundRecord, build_record
+from decoy_cli.evaluate.record import RoundRecord, build_record
 from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.places import PlaceFinder
 from decoy_cli.world.occlusion import OcclusionScene
 
 if TYPE_CHECKING:

@@ -17,8 +17,9 @@ import numpy as np
 
 from decoy_cli.esta import Round
 from decoy_cli.esta.frame_rate import frame_rates
-from decoy_cli.evaluate.settings import HeatGrid
+from decoy_cli.evaluate.heat import grid_sums
 from decoy_cli.metrics import metric_names, player_metrics
+from decoy_cli.metrics.hp_sums import HpStats, hp_stats
 from decoy_cli.metrics.kills import KILL_COLUMNS
 from decoy_cli.metrics.players import REPLAY_COLUMNS
 from decoy_cli.replay.bomb_fidelity import BOMB_COLUMNS
@@ -27,26 +28,7 @@ from decoy_cli.replay.view_trace import RoundTrace, round_trace
 if TYPE_CHECKING:
     from decoy_cli.evaluate.job import RoundTask
     from decoy_cli.replay.replayer import ReplayResult
-    from decoy_cli.waypoints.graph import WaypointGraph
-
-
-class HpStats(msgspec.Struct, frozen=True, array_like=True):
-    """Integer HP sums of one round over its player-frames with a known original HP.
-
-    `pooled` = [n, Σo, Σs, Σo², Σs², Σo·s, Σ(o−s)²]; `frame_*` per data frame index (for the
-    population-mean curves); `bin_*` per bin of the HP time grid starting at `bin_first`.
-    """
-
-    pooled: list[int]
-    frame_count: list[int]
-    frame_sum_original: list[int]
-    frame_sum_replay: list[int]
-    bin_first: int
-    bin_count: list[int]
-    bin_sum_original: list[int]
-    bin_sum2_original: list[int]
-    bin_sum_replay: list[int]
-    bin_sum2_replay: list[int]
+    from decoy_cli.waypoints.places import PlaceFinder
 
 
 class RoundRecord(msgspec.Struct, frozen=True):
@@ -248,107 +230,4 @@ def build_record(
             settings.hp_bins,
         ),
         trace=round_trace(round_, result),
-    )
-
-
-def grid_sums(grid: HeatGrid, points: np.ndarray, weights: np.ndarray | None = None) -> bytes:
-    """Sparse per-cell sample counts of x-y points on the grid, and with integer `weights`
-    their per-cell sums: uint32 distinct flat cell indices, counts[, sums], little-endian.
-    Points outside the grid are left out."""
-    i = np.floor((points[:, 0] - grid.x0) / grid.cell).astype(np.int64)
-    j = np.floor((points[:, 1] - grid.y0) / grid.cell).astype(np.int64)
-    inside = (i >= 0) & (i < grid.nx) & (j >= 0) & (j < grid.ny)
-    cells, inverse, counts = np.unique(
-        j[inside] * grid.nx + i[inside], return_inverse=True, return_counts=True
-    )
-    parts = [cells, counts]
-    if weights is not None:
-        sums = np.bincount(inverse, weights=np.asarray(weights)[inside], minlength=len(cells))
-        parts.append(sums.astype(np.int64))
-    return b"".join(part.astype("<u4").tobytes() for part in parts)
-
-
-def read_grid_sums(data: bytes, columns: int = 2) -> list[np.ndarray]:
-    """The int64 arrays of a `grid_sums` encoding: cells, counts (and sums: `columns` = 3)."""
-    values = np.frombuffer(data, dtype="<u4").astype(np.int64)
-    return list(values.reshape(columns, -1))
-
-
-NO_PLACE = "(no place)"
-
-
-def place_names(graph: WaypointGraph) -> list[str]:
-    """The place labels of the per-place counts: the graph's places, then `NO_PLACE`."""
-    return [*graph.place_names, NO_PLACE]
-
-
-class PlaceFinder:
-    """The nav place of positions: the place of the nearest waypoint on the position's floor,
-    or, for a position with no waypoint on its floor, of the nearest waypoint in x-y."""
-
-    def __init__(self, graph: WaypointGraph) -> None:
-        from scipy.spatial import cKDTree
-
-        self.graph = graph
-        self.names = place_names(graph)
-        self._place = np.where(graph.node_place < 0, len(self.names) - 1, graph.node_place)
-        self._tree_xy = cKDTree(graph.positions[:, :2])
-
-    def find(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(place index into `names`, whether a waypoint is on the point's floor) per point."""
-        if not len(points):
-            return np.zeros(0, np.int64), np.zeros(0, bool)
-        nodes, _ = self.graph.nearest(points)
-        on_floor = nodes >= 0
-        if not on_floor.all():
-            _, nodes[~on_floor] = self._tree_xy.query(points[~on_floor, :2])
-        return self._place[nodes].astype(np.int64), on_floor
-
-
-def hp_stats(
-    original: np.ndarray,
-    replay: np.ndarray,
-    frame_index: np.ndarray,
-    frame_seconds: np.ndarray,
-    bin_s: float,
-    bins: int,
-) -> HpStats:
-    """Integer HP sums of pooled player-frames (original, replay HP at frame `frame_index`)."""
-    o = np.asarray(original, dtype=np.int64)
-    s = np.asarray(replay, dtype=np.int64)
-    frames = np.asarray(frame_index, dtype=np.int64)
-    size = len(frame_seconds)
-    pooled = [
-        len(o),
-        int(o.sum()),
-        int(s.sum()),
-        int((o * o).sum()),
-        int((s * s).sum()),
-        int((o * s).sum()),
-        int(((o - s) ** 2).sum()),
-    ]
-    frame_bin = np.floor(np.asarray(frame_seconds, dtype=np.float64) / bin_s).astype(np.int64)
-    b = frame_bin[frames] if len(frames) else np.zeros(0, np.int64)
-    keep = (b >= 0) & (b < bins)
-    b, bo, bs = b[keep], o[keep], s[keep]
-    first = int(b.min()) if len(b) else 0
-    length = int(b.max()) - first + 1 if len(b) else 0
-
-    def per_bin(weights: np.ndarray | None) -> list[int]:
-        return np.bincount(b - first, weights=weights, minlength=length).astype(np.int64).tolist()
-
-    def per_frame(weights: np.ndarray | None) -> list[int]:
-        return np.bincount(frames, weights=weights, minlength=size).astype(np.int64).tolist()
-
-    return HpStats(
-        pooled=pooled,
-        frame_count=per_frame(None),
-        frame_sum_original=per_frame(o),
-        frame_sum_replay=per_frame(s),
-        bin_first=first,
-        bin_count=per_bin(None),
-        bin_sum_original=per_bin(bo),
-        bin_sum2_original=per_bin(bo * bo),
-        bin_sum_replay=per_bin(bs),
-        bin_sum2_replay=per_bin(bs * bs),
     )

@@ -32,6 +32,7 @@ from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.cache import RunCache
+from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.evaluate.job import (
     FileIndex,
     IndexTask,
@@ -40,10 +41,9 @@ from decoy_cli.evaluate.job import (
     index_file,
     run_graph,
 )
-from decoy_cli.evaluate.record import RoundRecord, place_names
+from decoy_cli.evaluate.record import RoundRecord
 from decoy_cli.evaluate.settings import (
     EvalSettings,
-    HeatGrid,
     code_fingerprint,
     file_sha256,
     folder_fingerprint,
@@ -55,6 +55,7 @@ from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.sim.setup import MoverName
 from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.places import place_names
 
 
 class Backend(Protocol):

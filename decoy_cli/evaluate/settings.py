@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from dataclasses import asdict, dataclass
 from functools import cache
 from pathlib import Path
@@ -18,7 +17,8 @@ from typing import TYPE_CHECKING
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.plausibility import Implausible
-from decoy_cli.world.navmesh import asset_dir, load_navmesh
+from decoy_cli.evaluate.heat import HeatGrid
+from decoy_cli.world.navmesh import asset_dir
 
 if TYPE_CHECKING:
     from decoy_cli.replay.deaths import DeathProtocol
@@ -27,9 +27,6 @@ if TYPE_CHECKING:
 
 RECORD_VERSION = 7
 """Format of the cached per-round records and file indexes; bump when it changes."""
-
-HEAT_CELL_M = 0.5
-"""Side of a heatmap cell (metres)."""
 
 HP_BIN_S = 1.0
 """Width of a bin of the HP-over-time curve (seconds since freeze-time end)."""
@@ -47,48 +44,12 @@ _CODE_PARTS = (
     "waypoints",
     "world",
     "damage",
+    "evaluate/heat.py",
     "evaluate/job.py",
     "evaluate/record.py",
     "evaluate/settings.py",
 )
 """The package's modules that decide a round's result (presentation code is left out)."""
-
-
-@dataclass(frozen=True)
-class HeatGrid:
-    """A fixed x-y grid over the map (metres): cell (i, j) spans x0 + i·cell, y0 + j·cell."""
-
-    x0: float
-    y0: float
-    cell: float
-    nx: int
-    ny: int
-
-    @classmethod
-    def for_map(cls, map_name: str, cell: float = HEAT_CELL_M) -> HeatGrid:
-        """The grid covering every nav area of a built-in map, one cell of margin."""
-        from decoy_cli.csgo import HAMMER_TO_M
-
-        nav = load_navmesh(map_name)
-        x_lo = math.floor(float(nav.x_min.min()) * HAMMER_TO_M / cell) - 1
-        y_lo = math.floor(float(nav.y_min.min()) * HAMMER_TO_M / cell) - 1
-        x_hi = math.ceil(float(nav.x_max.max()) * HAMMER_TO_M / cell) + 1
-        y_hi = math.ceil(float(nav.y_max.max()) * HAMMER_TO_M / cell) + 1
-        return cls(x0=x_lo * cell, y0=y_lo * cell, cell=cell, nx=x_hi - x_lo, ny=y_hi - y_lo)
-
-    @property
-    def size(self) -> int:
-        return self.nx * self.ny
-
-    @property
-    def extent(self) -> tuple[float, float, float, float]:
-        """(x_min, x_max, y_min, y_max) of the grid, for imshow."""
-        return (
-            self.x0,
-            self.x0 + self.nx * self.cell,
-            self.y0,
-            self.y0 + self.ny * self.cell,
-        )
 
 
 @dataclass(frozen=True, kw_only=True)

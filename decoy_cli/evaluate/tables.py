@@ -25,8 +25,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from decoy_cli.evaluate.heat import read_grid_sums
 from decoy_cli.evaluate.intervals import combat_intervals, trajectory_intervals
-from decoy_cli.evaluate.record import PLAYER_COLUMNS, ROUND_COLUMNS, RoundRecord, read_grid_sums
+from decoy_cli.evaluate.record import PLAYER_COLUMNS, ROUND_COLUMNS, RoundRecord
 from decoy_cli.evaluate.settings import EvalSettings
 from decoy_cli.metrics import (
     ALL_METRIC_NAMES,
