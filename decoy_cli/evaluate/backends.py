@@ -30,17 +30,24 @@ from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any
+from typing import TypeVar
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import RoundFailure
 from decoy_cli.esta.batch import INTERNAL_ERROR
 from decoy_cli.evaluate.job import CRASH_MESSAGE, WORKER_CRASH
 
-Outcomes = Iterator[tuple[Any, Any]]
+Task = TypeVar("Task")
+Outcome = TypeVar("Outcome")
+Outcomes = Iterator[tuple[Task, Outcome | RoundFailure]]
+"""(task, what the job returned, or the failure that stands for it) as tasks finish."""
 
-_BROKEN = object()
-"""The outcome of a task whose pool broke under it."""
+
+class _Broken:
+    """The outcome of a task whose pool broke under it."""
+
+
+_BROKEN = _Broken()
 
 
 def _init_worker() -> None:
@@ -107,7 +114,7 @@ class LocalBackend:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
-    def run(self, job: Callable[[Any], Any], tasks: Iterable[Any]) -> Outcomes:
+    def run(self, job: Callable[[Task], Outcome], tasks: Iterable[Task]) -> Outcomes[Task, Outcome]:
         """Yield (task, outcome) for every task, in the order they finish."""
         queue = deque(tasks)
         while queue:
@@ -116,15 +123,15 @@ class LocalBackend:
                 yield task, self._run_alone(job, task)
 
     def _run_pooled(
-        self, job: Callable[[Any], Any], queue: deque
-    ) -> Generator[tuple[Any, Any], None, list[Any]]:
+        self, job: Callable[[Task], Outcome], queue: deque[Task]
+    ) -> Generator[tuple[Task, Outcome | RoundFailure], None, list[Task]]:
         """Run the queue until it is empty or the pool breaks; returns the suspects."""
         if self._pool is None:
             self._pool = ProcessPoolExecutor(
                 max_workers=self.workers, mp_context=_context(), initializer=_init_worker
             )
-        inflight: dict[Future, Any] = {}
-        suspects: list[Any] = []
+        inflight: dict[Future[Outcome], Task] = {}
+        suspects: list[Task] = []
         while (queue or inflight) and not suspects:
             while queue and len(inflight) < self.workers:
                 task = queue.popleft()
@@ -139,7 +146,7 @@ class LocalBackend:
             for future in done:
                 task = inflight.pop(future)
                 outcome = _result(future)
-                if outcome is _BROKEN:
+                if isinstance(outcome, _Broken):
                     suspects.append(task)
                 else:
                     yield task, outcome
@@ -149,17 +156,17 @@ class LocalBackend:
             self._pool = None
         return suspects
 
-    def _run_alone(self, job: Callable[[Any], Any], task: Any) -> Any:
+    def _run_alone(self, job: Callable[[Task], Outcome], task: Task) -> Outcome | RoundFailure:
         """Run one task in a fresh one-worker pool; a dead worker is the task's failure."""
         pool = ProcessPoolExecutor(max_workers=1, mp_context=_context(), initializer=_init_worker)
         try:
             outcome = _result(pool.submit(job, task))
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
-        return _crash() if outcome is _BROKEN else outcome
+        return _crash() if isinstance(outcome, _Broken) else outcome
 
 
-def _result(future: Future) -> Any:
+def _result(future: Future[Outcome]) -> Outcome | RoundFailure | _Broken:
     try:
         return future.result()
     except BrokenProcessPool:
@@ -185,7 +192,7 @@ class DaskBackend:
                 f"cannot connect to the Dask scheduler at {address}: {error}"
             ) from None
         self.address = address
-        self._futures: list[Any] = []
+        self._futures: list[object] = []  # dask futures
 
     def __enter__(self) -> DaskBackend:
         return self
@@ -200,17 +207,18 @@ class DaskBackend:
             self._futures = []
         self.client.close()
 
-    def run(self, job: Callable[[Any], Any], tasks: Iterable[Any]) -> Outcomes:
+    def run(self, job: Callable[[Task], Outcome], tasks: Iterable[Task]) -> Outcomes[Task, Outcome]:
         """Yield (task, outcome) for every task, in the order they finish."""
         from distributed import KilledWorker, as_completed
 
-        tasks = list(tasks)
-        if not tasks:
+        listed = list(tasks)
+        if not listed:
             return
-        futures = self.client.map(job, tasks, pure=False)
+        futures = self.client.map(job, listed, pure=False)
         self._futures = list(futures)
-        task_of = {future.key: task for future, task in zip(futures, tasks, strict=True)}
+        task_of = {future.key: task for future, task in zip(futures, listed, strict=True)}
         for future in as_completed(futures, loop=self.client.loop):
+            outcome: Outcome | RoundFailure
             try:
                 outcome = future.result()
             except KilledWorker:

@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -31,6 +31,7 @@ from decoy_cli.errors import DecoyError, EstaError, GraphError
 from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
 from decoy_cli.esta.plausibility import Implausible
+from decoy_cli.evaluate.backends import Outcome, Outcomes, Task
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.evaluate.job import (
@@ -61,7 +62,9 @@ from decoy_cli.waypoints.places import place_names
 class Backend(Protocol):
     """Runs a job over tasks and yields (task, outcome) as they finish (see backends.py)."""
 
-    def run(self, job: Callable[[Any], Any], tasks: Sequence[Any]) -> Any: ...
+    def run(
+        self, job: Callable[[Task], Outcome], tasks: Sequence[Task]
+    ) -> Outcomes[Task, Outcome]: ...
 
 
 @dataclass(frozen=True)
@@ -202,7 +205,7 @@ def run_evaluation(
     *,
     sample: int | None = None,
     on_progress: Callable[[ProgressEvent], None] | None = None,
-    job: Callable[[RoundTask], Any] = evaluate_round,
+    job: Callable[[RoundTask], RoundRecord | RoundFailure] = evaluate_round,
     round_timeout_s: float | None = None,
 ) -> Evaluation:
     """Evaluate every round (or a sample) of the inputs; see the module docstring.
@@ -281,7 +284,7 @@ def _report(
         on_progress(ProgressEvent(stage, done, total, failed))
 
 
-def _round_failure(task: RoundTask, outcome: Any) -> RoundFailure:
+def _round_failure(task: RoundTask, outcome: object) -> RoundFailure:
     """The failure of a round task, with the task's file and round (a backend's crash report
     does not know them)."""
     if isinstance(outcome, RoundFailure):
