@@ -177,14 +177,14 @@ def build_nav_triangles(nav: NavMesh) -> np.ndarray:
     return np.asarray(tris, dtype=np.float64)
 
 
-def walled_parts(nav: NavMesh) -> list[tuple[_Side, _OpenPart]]:
-    """Every stretch of an area side that gets a full wall (nothing near beyond it), with its
-    side: what a study of the walls (benchmarks/ledge_candidates.py) looks at."""
+def open_stretches(nav: NavMesh) -> list[tuple[_Side, _OpenPart]]:
+    """Every open stretch of an area side (touching no area) with its side and the nearest area
+    beyond it (`other` -1: none near, a full wall): what a study of the walls and ledges
+    (benchmarks/ledge_candidates.py) looks at."""
     contacts = _find_contacts(nav)
     zx, zy = fit_corner_heights(nav, contacts)
     height = lambda area, x, y: _height(nav, zx, zy, area, x, y)  # noqa: E731
-    covered = _floors_and_joins(nav, contacts, height)[1]
-    return [(side, part) for side, part in _open_stretches(nav, covered) if part.other < 0]
+    return _open_stretches(nav, _floors_and_joins(nav, contacts, height)[1])
 
 
 def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[list, dict]:
