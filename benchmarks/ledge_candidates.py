@@ -47,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES, MAX_DROP_M
+from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES, MAX_DROP_M, SAFE_DROP_M
 from decoy_cli.esta import iter_match_files, read_match
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import EdgeKind
@@ -85,6 +85,7 @@ HULL_U = 32.0
 ADOPT_SHARE = 0.8
 """The decision rule: adopt if at least this share of de_dust2's candidates are open."""
 MAX_DROP_U = MAX_DROP_M / HAMMER_TO_M
+SAFE_DROP_U = SAFE_DROP_M / HAMMER_TO_M
 ROUNDS = [
     Path("../shared/data/esta_dust2_tside"),
     Path("../shared/data/cs2_dust2_both/spirit-vs-falcons-m2-dust2-r01-12.json.xz"),
@@ -321,14 +322,26 @@ def main() -> None:
     parser.add_argument("--rounds", nargs="*", type=Path, default=ROUNDS)
     args = parser.parse_args()
 
-    print("1. candidate stretches per map (linked: by the nav mesh's own connections)")
+    print(
+        "1. candidate stretches per map (linked: by the nav mesh's own connections; by drop: "
+        f"up to the safe fall {SAFE_DROP_U:.0f} u, up to 320 u, deeper)"
+    )
     for map_name in MAP_NAMES:
         nav = load_navmesh(map_name)
         found = candidates(nav)
         links = linked(nav)
         n_linked = sum((c.upper, c.lower) in links for c in found)
         length = sum(len(c.starts) for c in found) * SAMPLE_U
-        print(f"  {map_name:12s} {len(found):3d} stretches, {length:6.0f} u, linked {n_linked}")
+        drop = np.array([np.median(np.subtract(c.starts, c.lands)[:, 2]) for c in found])
+        bands = [
+            int((drop <= SAFE_DROP_U).sum()),
+            int(((drop > SAFE_DROP_U) & (drop <= 320)).sum()),
+        ]
+        bands.append(len(found) - sum(bands))
+        print(
+            f"  {map_name:12s} {len(found):3d} stretches, {length:6.0f} u, linked {n_linked}, "
+            f"by drop {bands}"
+        )
 
     nav = load_navmesh("de_dust2")
     shares = {}
