@@ -300,3 +300,40 @@ def test_pybullet_imports_without_its_banner() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout == "ok\n"
     assert "build time" not in done.stderr
+
+
+def hand_nav(*areas: tuple[float, float, float, float, float]) -> NavMesh:
+    """A nav mesh of flat areas (x_min, y_min, x_max, y_max, z), Hammer units, unlinked."""
+    rows = np.array(areas, dtype=np.float64)
+    return NavMesh(
+        area_id=np.arange(1, len(rows) + 1),
+        place=np.array(["Hand"] * len(rows)),
+        x_min=rows[:, 0],
+        y_min=rows[:, 1],
+        x_max=rows[:, 2],
+        y_max=rows[:, 3],
+        z_at_min=rows[:, 4],
+        z_at_max=rows[:, 4],
+        connections=np.zeros((0, 2), dtype=np.int64),
+        radar={},
+        regions={},
+    )
+
+
+def test_open_stretches_wall_a_side_over_a_lower_floor_reaching_under_it() -> None:
+    """A platform (area 0) with a lower floor reaching under its east side (area 1) and another
+    lower floor 64 u beyond its north side (area 2): the north side is a ledge onto area 2, the
+    east side a full wall (what benchmarks/ledge_candidates.py measures: issue 34's rule)."""
+    nav = hand_nav(
+        (0.0, 0.0, 200.0, 200.0, 200.0),
+        (150.0, 0.0, 400.0, 200.0, 0.0),
+        (0.0, 264.0, 200.0, 400.0, 50.0),
+    )
+    stretches = {
+        (side.axis, side.sign): part.other
+        for side, part in nav_geometry.open_stretches(nav)
+        if side.area == 0
+    }
+    assert stretches[(1, 1.0)] == 2  # north: a ledge onto the floor beyond
+    assert stretches[(0, 1.0)] == -1  # east: walled, though area 1 lies below
+    assert stretches[(0, -1.0)] == -1 and stretches[(1, -1.0)] == -1

@@ -172,6 +172,24 @@ def build_nav_triangles(nav: NavMesh) -> np.ndarray:
     contacts = _find_contacts(nav)
     zx, zy = fit_corner_heights(nav, contacts)
     height = lambda area, x, y: _height(nav, zx, zy, area, x, y)  # noqa: E731
+    tris, covered = _floors_and_joins(nav, contacts, height)
+    tris += _walls(nav, covered, height)
+    return np.asarray(tris, dtype=np.float64)
+
+
+def open_stretches(nav: NavMesh) -> list[tuple[_Side, _OpenPart]]:
+    """Every open stretch of an area side (touching no area) with its side and the nearest area
+    beyond it (`other` -1: none near, a full wall): what a study of the walls and ledges
+    (benchmarks/ledge_candidates.py) looks at."""
+    contacts = _find_contacts(nav)
+    zx, zy = fit_corner_heights(nav, contacts)
+    height = lambda area, x, y: _height(nav, zx, zy, area, x, y)  # noqa: E731
+    return _open_stretches(nav, _floors_and_joins(nav, contacts, height)[1])
+
+
+def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[list, dict]:
+    """Floors, step faces and bridges, and the stretches of each side (area, axis * 2 + high)
+    they cover: the rest of every side is open (`_walls`)."""
     tris: list = []
 
     # floors
@@ -258,24 +276,25 @@ def build_nav_triangles(nav: NavMesh) -> np.ndarray:
                 )
                 covered.setdefault(side_key(first, axis, True), []).append((lo, hi))
                 covered.setdefault(side_key(second, axis, False), []).append((lo, hi))
-
-    # walls along uncovered sides, pushed out
-    tris += _walls(nav, covered, height)
-    return np.asarray(tris, dtype=np.float64)
+    return tris, covered
 
 
-def _walls(nav: NavMesh, covered, height) -> list:
-    """Faces along the open parts of every area side (parts that touch no area), by what lies
-    beyond them (see `_Side.open_parts`)."""
-    tris: list = []
+def _open_stretches(nav: NavMesh, covered) -> list[tuple[_Side, _OpenPart]]:
+    """The open parts of every area side (parts that touch no area), with what lies beyond them
+    (see `_Side.open_parts`)."""
+    stretches = []
     for a in range(nav.num_areas):
         for axis in (0, 1):
             for high in (False, True):
                 side = _Side(nav, a, axis, high, covered)
                 for lo, hi in _subtract((side.lo, side.hi), covered.get((a, axis * 2 + high), [])):
-                    for part in side.open_parts(lo, hi):
-                        tris += side.faces(part, height)
-    return tris
+                    stretches += [(side, part) for part in side.open_parts(lo, hi)]
+    return stretches
+
+
+def _walls(nav: NavMesh, covered, height) -> list:
+    """Faces along the open parts of every area side, by what lies beyond them."""
+    return [tri for side, part in _open_stretches(nav, covered) for tri in side.faces(part, height)]
 
 
 @dataclass(frozen=True)
