@@ -213,7 +213,8 @@ def test_hit_group_from_hp_lost_by_the_rules() -> None:
     """An AK-47 at 0 u on a victim without armour does 144 (head), 36 (neck, chest, arm), 45
     (stomach) or 27 (leg). A hit that left the victim alive after 45 HP was a stomach hit; one
     of 36 HP a neck, chest or arm hit in the prior's proportions; a kill of a 30-HP victim any
-    group doing at least 30 (all but the leg); 10 HP no group (a shot through something)."""
+    group doing at least 30 (all but the leg); 10 HP no group (a shot through something); 33 HP,
+    which no group gives within 1 HP, the groups by how close they come."""
     from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
 
     prior = HitGroupModel.fit(["AK-47"] * 4, [0.0] * 4, ["Head", "Chest", "Chest", "Leg"])
@@ -229,6 +230,18 @@ def test_hit_group_from_hp_lost_by_the_rules() -> None:
     assert kill is not None and kill[GROUPS.index("Leg")] == 0
     np.testing.assert_allclose(kill[:5], p[:5] / p[:5].sum())
     assert group_posterior(prior, "AK-47", 0.0, 10, 100, armored=False) is None
+    # 33 HP: no group within 1 HP; weighed by closeness (15% of the rule damage per spread):
+    # 36 (neck, chest, arm) is 0.56 spreads off, 27 (leg) 1.48, 45 (stomach) 2.67, 144 beyond 3
+    near = group_posterior(prior, "AK-47", 0.0, 33, 100, armored=False)
+    assert near is not None and near[GROUPS.index("Head")] == 0
+    z = {"Chest": 3 / (0.15 * 36), "Leg": 6 / (0.15 * 27), "Stomach": 12 / (0.15 * 45)}
+    weight = {g: p[GROUPS.index(g)] * np.exp(-0.5 * v * v) for g, v in z.items()}
+    assert near[GROUPS.index("Chest")] / near[GROUPS.index("Leg")] == pytest.approx(
+        weight["Chest"] / weight["Leg"]
+    )
+    assert near[GROUPS.index("Stomach")] / near[GROUPS.index("Chest")] == pytest.approx(
+        weight["Stomach"] / weight["Chest"]
+    )
 
 
 def test_rules_file_keeps_bullets_of_hurt_victims(tmp_path: Path) -> None:

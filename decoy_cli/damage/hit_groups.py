@@ -152,6 +152,16 @@ class HitGroupModel:
         return cls.from_dict(json.loads(text))
 
 
+HP_LOST_SPREAD = 0.15
+"""Relative spread of a hit's HP lost around what the rules give for its group when no group
+gives it exactly (the rules know neither the armour left nor a shot through thin cover, and a
+map's version may deal a little less; chosen a priori)."""
+
+MAX_MISS_SPREADS = 3.0
+"""A non-lethal hit further than this many spreads from every group's rule damage is left
+unexplained (a shot through something)."""
+
+
 def group_posterior(
     prior: HitGroupModel,
     weapon: str,
@@ -161,18 +171,30 @@ def group_posterior(
     armored: bool,
 ) -> np.ndarray | None:
     """(6,) P(group | a hit's HP lost) for a hit whose data records no hit group: the prior's
-    P(group | weapon, distance) times 1 where the rules (decoy_cli/damage/rules.py) explain the
-    HP lost and 0 elsewhere. A hit that left the victim alive lost what the rules give, within
-    1 HP; one that killed lost the victim's HP, so any group the rules give at least that much
-    explains it. None when no group explains it (a shot through something, armour that ran
-    out)."""
-    explained = np.zeros(len(GROUPS))
-    killed = hp_lost >= hp_before - 0.5
-    for g, name in enumerate(GROUPS):
-        health = shot_damage(weapon, name, distance_u, armor=100 if armored else 0, helmet=armored)
-        value = health.health
-        explained[g] = value >= hp_lost - 0.5 if killed else abs(value - hp_lost) <= 1.0
-    weights = prior.probabilities(weapon, distance_u) * explained
+    P(group | weapon, distance) times the likelihood of the HP lost under each group's rule
+    damage (decoy_cli/damage/rules.py). A hit that killed lost the victim's HP: any group the
+    rules give at least that much explains it. A hit that left the victim alive is explained
+    by the groups the rules give within 1 HP; when none does, by how close each comes (a normal
+    of `HP_LOST_SPREAD` relative width, up to `MAX_MISS_SPREADS`): keeping only exact matches
+    kept the kills, which any head shot explains, and dropped body hits the rules miss by a few
+    HP, leaning the groups toward the head. None when no group explains it."""
+    value = np.array(
+        [
+            shot_damage(
+                weapon, name, distance_u, armor=100 if armored else 0, helmet=armored
+            ).health
+            for name in GROUPS
+        ],
+        dtype=np.float64,
+    )
+    if hp_lost >= hp_before - 0.5:  # killed
+        likelihood = (value >= hp_lost - 0.5).astype(np.float64)
+    elif (np.abs(value - hp_lost) <= 1.0).any():
+        likelihood = (np.abs(value - hp_lost) <= 1.0).astype(np.float64)
+    else:
+        z = (value - hp_lost) / np.maximum(1.0, HP_LOST_SPREAD * value)
+        likelihood = np.where(np.abs(z) <= MAX_MISS_SPREADS, np.exp(-0.5 * z * z), 0.0)
+    weights = prior.probabilities(weapon, distance_u) * likelihood
     if weights.sum() <= 0:
         return None
     return weights / weights.sum()
