@@ -168,21 +168,23 @@ time in ticks."""
 
 
 @njit_cached
-def encode_into(
-    obs, masks, due, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates,
-    enemies, centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick, waiting,
-    hold_until, node, out_edges,
-):  # fmt: skip
+def encode_into(r, g, e, bomb, done, tick, out):
     """Write the observation vectors (N, size), action masks (N, 9) and due agents (N,) into
-    `obs`, `masks` and `due`: each agent's own entries, its teammate and enemy slots and the
-    bomb's offset at `starts` (`_PER_AGENT`), the round's entries at `bomb_starts` (`_BOMB`)
-    from `round_inputs` (`ROUND_INPUTS`) and the tick: the round's time left counts to the
-    plant once there is one, the bomb's while it is planted."""
+    `out`'s first three arrays (`ArrayStep`'s order), of the round `r` (`RoundState`), the
+    graph `g` (`GraphArrays`), the encoder's arrays in `e` (`kernel_arrays`' names) and `bomb`
+    (bomb state, carrier, bomb position, `round_inputs`): each agent's own entries, its teammate
+    and enemy slots and the bomb's offset at `e.starts` (`_PER_AGENT`), the round's entries at
+    `e.bomb_starts` (`_BOMB`) from the round inputs (`ROUND_INPUTS`) and the tick: the round's
+    time left counts to the plant once there is one, the bomb's while it is planted."""
+    obs, masks, due = out[0], out[1], out[2]
+    bomb_state, carrier, bomb_pos, round_inputs = bomb
+    pos, yaw, hp, alive, waiting, hold_until = r.pos, r.yaw, r.hp, r.alive, r.waiting, r.hold_until
+    mates, enemies, half, out_edges = e.mates, e.enemies, e.half, g.out_edges
     n = pos.shape[0]
     obs[:] = 0.0
     masks[:] = 0
-    p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = starts
-    state0, site0, plant0, defuse0, round0, timer0 = bomb_starts
+    p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = e.starts
+    state0, site0, plant0, defuse0, round0, timer0 = e.bomb_starts
     site = np.int64(round_inputs[0])
     planted_tick, round_ticks, bomb_ticks = round_inputs[3], round_inputs[5], round_inputs[6]
     clock = planted_tick if planted_tick >= 0 else tick
@@ -195,18 +197,18 @@ def encode_into(
         masks[i, out_edges.shape[1]] = 1  # STOP
         if due[i]:
             for action in range(out_edges.shape[1]):
-                masks[i, action] = 1 if out_edges[node[i], action] >= 0 else 0
+                masks[i, action] = 1 if out_edges[r.node[i], action] >= 0 else 0
         for axis in range(3):
-            v = (pos[i, axis] - centre[axis]) / half[axis]
+            v = (pos[i, axis] - e.centre[axis]) / half[axis]
             obs[i, p0 + axis] = min(1.0, max(-1.0, v))
         angle = math.radians(yaw[i])
         obs[i, y0], obs[i, y0 + 1] = math.sin(angle), math.cos(angle)
         obs[i, h0] = hp[i] / 100.0
-        obs[i, a0] = armor[i] / 100.0
-        obs[i, hel0] = 1.0 if helmet[i] else 0.0
-        obs[i, k0] = 1.0 if kit[i] else 0.0
+        obs[i, a0] = r.armor[i] / 100.0
+        obs[i, hel0] = 1.0 if r.helmet[i] else 0.0
+        obs[i, k0] = 1.0 if r.kit[i] else 0.0
         obs[i, b0] = 1.0 if i == carrier else 0.0
-        obs[i, c0] = 1.0 if is_ct[i] else 0.0
+        obs[i, c0] = 1.0 if e.is_ct[i] else 0.0
         obs[i, d0] = 1.0 if due[i] else 0.0
         for start, table in ((m0, mates), (e0, enemies)):
             for slot in range(table.shape[1]):
@@ -230,4 +232,3 @@ def encode_into(
         obs[i, defuse0] = round_inputs[2]
         obs[i, round0] = round_left
         obs[i, timer0] = bomb_left
-    return obs, masks, due

@@ -27,9 +27,11 @@ import numpy as np
 
 from decoy_cli.csgo import TICK_RATE, fall_damage
 from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.movement import KinematicMover, Mover, MoveStep
+from decoy_cli.sim.movement import KinematicMover, MoveStep
+from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.quiet_play import StretchEnd
+from decoy_cli.sim.round_state import GraphArrays, RoundState
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
@@ -77,7 +79,7 @@ class Simulator:
         self,
         graph: WaypointGraph,
         agents: Agents,
-        mover: Mover,
+        mover: MoverBase,
         policy: Policy,
         rules: BombRules,
         *,
@@ -102,20 +104,23 @@ class Simulator:
         self.events: list[SimEvent] = []
         self.outcome: RoundOutcome | None = None
         n = agents.count
-        self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
-        self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
-        self.goal_node = np.full(n, -1, dtype=np.int64)
-        self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
-        self._falling = 0  # how many agents are on such a drop
-        self._fall_killed = False  # a landing killed since the outcome was last judged
-        self.wants_plant = np.zeros(n, dtype=bool)
-        self.wants_defuse = np.zeros(n, dtype=bool)
-        self.decisions = np.zeros(n, dtype=np.int64)
-        self.decision_count = 0  # decisions.sum(), kept as they are made
-        self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
+        self.state = state = RoundState.open(agents, mover)
+        """The round's arrays as compiled code takes them; the engine's below are its own."""
+        self.graph_arrays = GraphArrays.of(graph)
+        self.waiting = state.waiting  # asks for a decision at the next tick
+        self.hold_until = state.hold_until  # end tick of a STOP
+        self.goal_node = state.goal_node
+        self.fall_m = state.fall_m  # depth of the damaging drop each agent is on (0: none)
+        self._falling = 0  # how many agents are on such a drop
+        self._fall_killed = False  # a landing killed since the outcome was last judged
+        self.wants_plant = state.wants_plant
+        self.wants_defuse = state.wants_defuse
+        self.decisions = state.decisions
+        self.decision_count = 0  # decisions.sum(), kept as they are made
+        self._deciding = -1  # the agent whose policy is deciding right now
         for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
             self.mover.remove(int(agent))
         self.bomb: Bomb = rules.start(agents, bomb_carrier)

@@ -23,12 +23,14 @@ from enum import IntEnum
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
+from numba.experimental import structref
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
+from decoy_cli.sim.round_state import StructBase, pack
 from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
@@ -95,6 +97,18 @@ class Choices:
     defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
     top_speeds: TopSpeeds = field(default_factory=TopSpeeds)
     _decisions: dict[tuple[bool, bool, int], Decision] = field(default_factory=dict)
+    _packed: tuple[tuple[object, ...], object] = ((), None)  # (made of, struct)
+
+    def packed(self, top: np.ndarray) -> object:
+        """These choices and the agents' full speeds `top` as one struct for `_play` (fields
+        `CHOICE_FIELDS`), made anew only when one of them was replaced."""
+        values = (self.given, self.draws, self.plant, self.defuse, top, self.hold_ticks)
+        made_of, struct = self._packed
+        same = len(made_of) == len(values)
+        if not same or any(a is not b for a, b in zip(values, made_of, strict=True)):
+            struct = pack(_choice_struct, CHOICE_FIELDS, values)
+            self._packed = (values, struct)
+        return struct
 
     def decision(self, agent: int, action: int) -> Decision:
         """The engine's `Decision` of `action` by `agent`, as `_play` takes it: a move at full
@@ -109,26 +123,41 @@ class Choices:
         return found
 
 
+CHOICE_FIELDS = ("given", "draws", "plant", "defuse", "top", "hold_ticks")
+"""The fields of `Choices.packed`: `Choices`' own and `top`, each agent's full speed (m/s)."""
+
+
+@structref.register
+class _ChoiceType(StructBase):
+    pass
+
+
+class ChoiceStruct(structref.StructRefProxy):
+    """`Choices.packed`: `CHOICE_FIELDS` as one numba struct."""
+
+
+structref.define_proxy(ChoiceStruct, _ChoiceType, list(CHOICE_FIELDS))
+
+
+@njit_cached
+def _choice_struct(*values):
+    """A `ChoiceStruct` made in compiled code, so that its constructor is cached with it."""
+    return ChoiceStruct(*values)
+
+
 def play_stretch(
     sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices
 ) -> int:
     """Play one quiet stretch of `sim` through at most `horizon` with `choices` (`_play`), hand
     what it did to the engine and return how it ended; `choices.next_draw` moves on."""
-    graph, agents, mover = sim.graph, sim.agents, sim.mover
-    if not isinstance(mover, KinematicMover):
+    if not isinstance(sim.mover, KinematicMover):
         raise TypeError("compiled stretches need the kinematic mover")
     if choices.hold_ticks < 1:
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
-    first, actions = graph.allowed_actions
-    pos, start, target, fv, iv, flags, params = mover.kernel_arrays()
-    top = choices.top_speeds.of(agents.weapon)
+    packed = choices.packed(choices.top_speeds.of(sim.agents.weapon))
     tick, used, made, falls, glide_end, status = _play(
-        sim.tick, horizon, choices.given, choices.draws, choices.next_draw, first, actions,
-        choices.hold_ticks, choices.plant, choices.defuse, max_decisions - sim.decision_count,
-        watch, top, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
-        graph.positions, agents.node, agents.alive, agents.yaw, sim.waiting, sim.hold_until,
-        sim.decisions, sim.wants_plant, sim.wants_defuse, sim.goal_node, sim.fall_m,
-        pos, start, target, fv, iv, flags, params, mover.jump_speed, mover.gravity,
+        sim.state.kernel, sim.graph_arrays.kernel, packed, sim.tick, horizon, choices.next_draw,
+        max_decisions - sim.decision_count, watch,
     )  # fmt: skip
     choices.next_draw = used
     sim.note_quiet_play(tick, made, falls, glide_end >= 0)
@@ -149,17 +178,15 @@ def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
 
 
 @njit_cached
-def _play(
-    tick, horizon, given, draws, next_draw, first, actions, hold_ticks, plant, defuse,
-    decisions_left, watch, top, out_edges, edge_target, edge_kind, edge_fall, positions,
-    node, alive, yaw, waiting, hold_until, decisions, wants_plant, wants_defuse, goal_node, fall_m,
-    pos, start, target, fv, iv, flags, prm, jump_speed, gravity,
-):  # fmt: skip
+def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
-    tick: at each tick the due agents (ascending) decide (`Choices`), then if the tick after
-    them is quiet the motion glides to the next arrival or decision or the horizon. A handed-in
-    action must be 0..8 (`Choices`). Returns (tick, next draw,
-    decisions made, damaging drops started, tick of the last glide's end or -1, status)."""
+    tick, on the round `r` (`RoundState`) and graph `g` (`GraphArrays`): at each tick the due
+    agents (ascending) decide (`c`: `Choices.packed`, draws from `next_draw` on), then if the
+    tick after them is quiet the motion glides to the next arrival or decision or the horizon.
+    A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
+    damaging drops started, tick of the last glide's end or -1, status)."""
+    given, draws, first, out_edges = c.given, c.draws, g.first, g.out_edges
+    node, alive, waiting, hold_until = r.node, r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0
     glide_end = -1
@@ -188,31 +215,33 @@ def _play(
             at = node[a]
             act = given[a]
             if act == DRAW:
-                act = actions[first[at] + np.int64(draws[next_draw] * (first[at + 1] - first[at]))]
+                pick = np.int64(draws[next_draw] * (first[at + 1] - first[at]))
+                act = g.actions[first[at] + pick]
                 next_draw += 1
             else:
                 given[a] = -1  # used: the agent's next turn stops the stretch
-            decisions[a] += 1
+            r.decisions[a] += 1
             made += 1
             stop = act == STOP_ACTION
-            wants_plant[a] = plant[a] and stop
-            wants_defuse[a] = defuse[a] and stop
-            if hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
+            r.wants_plant[a] = c.plant[a] and stop
+            r.wants_defuse[a] = c.defuse[a] and stop
+            if hands_back(a, act, at, watch, c.plant, c.defuse, out_edges, g.edge_fall):
                 hand_back = True
             if stop:
                 one[0] = a
-                stand_still(one, fv, iv)
-                hold_until[a] = tick + hold_ticks
+                stand_still(one, r.fv, r.iv)
+                hold_until[a] = tick + c.hold_ticks
                 continue
             edge = out_edges[at, act]
-            goal = edge_target[edge]
-            goal_node[a] = goal
-            if edge_fall[edge] > 0.0:
-                fall_m[a] = edge_fall[edge]
+            goal = g.edge_target[edge]
+            r.goal_node[a] = goal
+            if g.edge_fall[edge] > 0.0:
+                r.fall_m[a] = g.edge_fall[edge]
                 falls += 1
+            x, y, z = g.positions[goal, 0], g.positions[goal, 1], g.positions[goal, 2]
             if not begin_edge(
-                a, positions[goal, 0], positions[goal, 1], positions[goal, 2], edge_kind[edge],
-                top[a], top[a], jump_speed, gravity, pos, target, fv, iv,
+                a, x, y, z, g.edge_kind[edge], c.top[a], c.top[a], r.jump_speed, r.gravity,
+                r.mpos, r.target, r.fv, r.iv,
             ):  # fmt: skip
                 return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
@@ -221,11 +250,13 @@ def _play(
         last = min(horizon, due_at - 1)
         if due_at == tick or last < tick:
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
+        flags = r.flags
         flags[:] = False
-        ticks, _ = kinematic_glide(pos, start, target, fv, iv, flags, prm, last - tick + 1)
+        ticks, _ = kinematic_glide(r.mpos, r.start, r.target, r.fv, r.iv, flags, r.prm,
+                                   last - tick + 1)  # fmt: skip
         tick += ticks - 1
         glide_end = tick
         for i in range(n):
             if flags[R_MOVED, i]:
-                yaw[i] = fv[i, F_HEADING]
-        note_arrivals(flags[R_ARRIVED], alive, node, goal_node, waiting)
+                r.yaw[i] = r.fv[i, F_HEADING]
+        note_arrivals(flags[R_ARRIVED], alive, node, r.goal_node, waiting)
