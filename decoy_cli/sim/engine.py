@@ -26,7 +26,7 @@ from typing import Protocol
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE, fall_damage
-from decoy_cli.sim.decisions import Decision
+from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement import KinematicMover, MoveStep
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
@@ -35,7 +35,7 @@ from decoy_cli.sim.round_state import GraphArrays, RoundState
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
 
@@ -467,6 +467,8 @@ class Simulator:
         return due
 
     def _decide(self) -> None:
+        """The due agents (ascending) ask the policy and the round takes each decision
+        (`take_decision`) before the next agent is asked."""
         agents = self.agents
         for agent in due_agents(self.waiting, agents.alive, self.hold_until, self.tick).tolist():
             self.hold_until[agent] = 0
@@ -474,38 +476,31 @@ class Simulator:
             self._deciding = agent
             decision = self.policy.decide(self, agent)
             self._deciding = -1
-            self.decisions[agent] += 1
             self.decision_count += 1
-            self.wants_plant[agent] = decision.plant
-            self.wants_defuse[agent] = decision.defuse
-            if self.fall_m[agent]:
-                self._set_fall(agent, 0.0)
-            if decision.action == STOP_ACTION:
-                self.mover.clear_goal(agent)
-                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
-                continue
-            edge = int(self.graph.out_edges[agents.node[agent], decision.action])
-            if edge < 0:  # an impossible move: stand still for one decision period
-                self.mover.clear_goal(agent)
-                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
-                self.events.append(
-                    SimEvent(self.tick, "invalid_action", agent, data={"action": decision.action})
-                )
-                continue
-            target = int(self.graph.edge_target[edge])
-            top = (
-                max_speed_m_s(str(agents.weapon[agent]))
-                if decision.max_speed is None
-                else float(decision.max_speed)
-            )
+            top = decision.max_speed
+            top = max_speed_m_s(str(agents.weapon[agent])) if top is None else float(top)
             speed = top if decision.speed is None else min(float(decision.speed), top)
-            self.goal_node[agent] = target
-            depth = float(self.graph.fall_m[edge])
-            if depth:
-                self._set_fall(agent, depth)
-            self.mover.set_goal(
-                agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
-            )
+            taken, falls = take_decision(
+                self.state.kernel, self.graph_arrays.kernel, agent, decision.action, speed, top,
+                max(1, int(decision.hold_ticks)), decision.plant, decision.defuse, self.tick,
+            )  # fmt: skip
+            self._falling += falls
+            if taken > Taken.MOVING:
+                self._refused(agent, decision, taken)
+
+    def _refused(self, agent: int, decision: Decision, taken: int) -> None:
+        """A decision the round did not take as asked (`Taken`): an impossible move holds and
+        is recorded; anything else is an error."""
+        if taken == Taken.NO_EDGE:
+            data = {"action": decision.action}
+            self.events.append(SimEvent(self.tick, "invalid_action", agent, data=data))
+            return
+        problem = {
+            Taken.IN_THE_AIR: "is in the air; give it a goal once it lands",
+            Taken.REMOVED: "was removed",
+            Taken.BAD_SPEED: f"cannot move at {decision.speed!r} m/s (cap {decision.max_speed!r})",
+        }.get(Taken(taken), f"cannot take action {decision.action!r}")
+        raise ValueError(f"agent {agent} {problem}")
 
     def _record(self) -> None:
         rec = self.recording

@@ -26,9 +26,9 @@ import numpy as np
 from numba.experimental import structref
 
 from decoy_cli.compiled import njit_cached
-from decoy_cli.sim.decisions import Decision
+from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement import KinematicMover
-from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
+from decoy_cli.sim.movement.kernels import kinematic_glide
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
 from decoy_cli.sim.round_state import StructBase, pack
 from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
@@ -190,7 +190,6 @@ def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
     n = alive.shape[0]
     made = falls = 0
     glide_end = -1
-    one = np.empty(1, np.int64)
     while True:
         if tick + 1 > horizon:
             return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
@@ -220,29 +219,15 @@ def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
                 next_draw += 1
             else:
                 given[a] = -1  # used: the agent's next turn stops the stretch
-            r.decisions[a] += 1
             made += 1
             stop = act == STOP_ACTION
-            r.wants_plant[a] = c.plant[a] and stop
-            r.wants_defuse[a] = c.defuse[a] and stop
             if hands_back(a, act, at, watch, c.plant, c.defuse, out_edges, g.edge_fall):
                 hand_back = True
-            if stop:
-                one[0] = a
-                stand_still(one, r.fv, r.iv)
-                hold_until[a] = tick + c.hold_ticks
-                continue
-            edge = out_edges[at, act]
-            goal = g.edge_target[edge]
-            r.goal_node[a] = goal
-            if g.edge_fall[edge] > 0.0:
-                r.fall_m[a] = g.edge_fall[edge]
-                falls += 1
-            x, y, z = g.positions[goal, 0], g.positions[goal, 1], g.positions[goal, 2]
-            if not begin_edge(
-                a, x, y, z, g.edge_kind[edge], c.top[a], c.top[a], r.jump_speed, r.gravity,
-                r.mpos, r.target, r.fv, r.iv,
-            ):  # fmt: skip
+            plant, defuse = c.plant[a] and stop, c.defuse[a] and stop
+            top = c.top[a]
+            taken, fell = take_decision(r, g, a, act, top, top, c.hold_ticks, plant, defuse, tick)
+            falls += fell
+            if taken == Taken.IN_THE_AIR:
                 return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
@@ -252,8 +237,9 @@ def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
         flags = r.flags
         flags[:] = False
-        ticks, _ = kinematic_glide(r.mpos, r.start, r.target, r.fv, r.iv, flags, r.prm,
-                                   last - tick + 1)  # fmt: skip
+        ticks, _ = kinematic_glide(
+            r.mpos, r.start, r.target, r.fv, r.iv, flags, r.prm, last - tick + 1
+        )
         tick += ticks - 1
         glide_end = tick
         for i in range(n):
