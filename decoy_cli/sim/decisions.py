@@ -50,6 +50,15 @@ class Taken(IntEnum):
     """An action not 0..8."""
 
 
+REFUSED = {
+    Taken.IN_THE_AIR: "is in the air; give it a goal once it lands",
+    Taken.REMOVED: "was removed",
+    Taken.BAD_SPEED: "cannot move at a speed or cap not finite and >= 0 m/s",
+    Taken.BAD_ACTION: "has no such action (0..8)",
+}
+"""Why a decision the round could not take is an error (the engine raises it)."""
+
+
 @njit_cached
 def take_decision(r, g, a, act, speed, cap, hold_ticks, plant, defuse, tick):
     """Take agent a's decision at `tick` into the round `r` (`RoundState`) on the graph `g`

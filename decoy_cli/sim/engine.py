@@ -20,17 +20,17 @@ itself knows nothing of ESTA data (the replay is one policy among others).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE, fall_damage
-from decoy_cli.sim.decisions import Decision, Taken, take_decision
+from decoy_cli.sim.decisions import REFUSED, Decision, Taken, take_decision
 from decoy_cli.sim.movement import KinematicMover, MoveStep
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.quiet_play import StretchEnd
+from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, play_stretch
+from decoy_cli.sim.recording import Recorder, Recording
 from decoy_cli.sim.round_state import GraphArrays, RoundState
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
@@ -47,18 +47,6 @@ class Policy(Protocol):
 
 COMBAT_EVERY_TICKS = TICK_RATE // 2
 """Ticks between combat steps: the paper's 0.5 s."""
-
-
-@dataclass
-class Recording:
-    """Agent state sampled at requested ticks: arrays (S, N, ...) plus all events."""
-
-    ticks: np.ndarray
-    position: np.ndarray
-    yaw: np.ndarray
-    hp: np.ndarray
-    alive: np.ndarray
-    events: list[SimEvent] = field(default_factory=list)
 
 
 class CombatRunner(Protocol):
@@ -103,7 +91,6 @@ class Simulator:
         self.tick = start_tick
         self.events: list[SimEvent] = []
         self.outcome: RoundOutcome | None = None
-        n = agents.count
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
@@ -124,20 +111,10 @@ class Simulator:
         for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
             self.mover.remove(int(agent))
         self.bomb: Bomb = rules.start(agents, bomb_carrier)
-        self._record_at = np.asarray(sorted(set(int(t) for t in record_ticks)), dtype=np.int64)
-        s = len(self._record_at)
-        self.recording = Recording(
-            ticks=self._record_at,
-            position=np.full((s, n, 3), np.nan),
-            yaw=np.full((s, n), np.nan),
-            hp=np.zeros((s, n), dtype=np.int16),
-            alive=np.zeros((s, n), dtype=bool),
-            events=self.events,
-        )
-        self._next_record = 0
+        self.recorder = Recorder(record_ticks, agents.count, self.events)
+        self.recording = self.recorder.recording
         self._alive_judged = b""  # who was alive (as bytes) when the outcome was judged
         self._judged_as: tuple[BombStatus, bool] | None = None  # and the bomb and the clock
-        self._filled_after_end = False
         # every loop is bounded: the round's time limit plus the bomb timer after a plant
         self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
         self._record()
@@ -202,8 +179,7 @@ class Simulator:
         self.tick += 1
         self._decide()
         last = min(end, next_due(self.waiting, self.agents.alive, self.hold_until, self.tick) - 1)
-        if self._next_record < len(self._record_at):
-            last = min(last, int(self._record_at[self._next_record]) - 1)
+        last = min(last, self.recorder.next_tick - 1)
         ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
         self.tick += ticks - 1
         self._moved(moved)
@@ -232,9 +208,9 @@ class Simulator:
         tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
-        A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy) plays whole
-        quiet stretches of decisions and motion in compiled code when the mover is kinematic
-        and no `until` is given, with the same result."""
+        A `quiet_play.QuietPlayer` policy (the random policy) has whole quiet stretches of
+        decisions and motion played in compiled code (`_play_quiet`) when the mover is
+        kinematic and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 
@@ -243,7 +219,7 @@ class Simulator:
 
         quiet_player = None
         if until is None and isinstance(self.mover, KinematicMover):
-            quiet_player = getattr(self.policy, "play_quiet", None)
+            quiet_player = self.policy if isinstance(self.policy, QuietPlayer) else None
         while self.tick < end and not stop():
             if self.done:
                 if not (after_end and self.outcome is not None):
@@ -255,7 +231,8 @@ class Simulator:
                 if horizon > self.tick:
                     before = (self.tick, self.decision_count)
                     watched = self.rules.watched(self.agents, self.bomb)
-                    if quiet_player(self, horizon, limit, watched) == StretchEnd.DECIDED:
+                    status = self._play_quiet(quiet_player, horizon, limit, watched)
+                    if status == StretchEnd.DECIDED:
                         self._after_decisions(end, stop)
                         continue
                     if (self.tick, self.decision_count) != before:
@@ -276,6 +253,27 @@ class Simulator:
             self._glide(last)
         else:
             self._finish_tick(self._move())
+
+    def _play_quiet(
+        self, player: QuietPlayer, horizon: int, limit: int, watched: np.ndarray
+    ) -> StretchEnd:
+        """Play from this tick through at most `horizon` with `player`'s choices in compiled
+        code (`quiet_play.play_stretch`), up to `limit` decisions in all, refilling its draws
+        as it needs them; take over what it played and return how it ended."""
+        choices = player.choices_for(self.agents.count)
+        while True:
+            left = limit - self.decision_count
+            played = play_stretch(
+                self.state, self.graph_arrays, self.tick, horizon, left, watched, choices,
+                self.agents.weapon,
+            )  # fmt: skip
+            self.note_quiet_play(played.tick, played.made, played.falls, played.glided)
+            if played.status != StretchEnd.NEED_DRAWS:
+                break
+            player.refill()
+        if played.status == StretchEnd.AIRBORNE:
+            raise ValueError("an agent due for a decision is in the air")
+        return played.status
 
     def note_quiet_play(self, tick: int, made: int, falls: int, glided: bool) -> None:
         """Take over a quiet stretch a policy played itself (`run`): the tick it reached, the
@@ -388,8 +386,7 @@ class Simulator:
         last = min(end, self._max_tick - 1, rules)
         if self.combat is not None:
             last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
-        if self._next_record < len(self._record_at):
-            last = min(last, int(self._record_at[self._next_record]) - 1)
+        last = min(last, self.recorder.next_tick - 1)
         return max(tick, last)
 
     def _glide(self, last: int) -> None:
@@ -485,41 +482,11 @@ class Simulator:
                 max(1, int(decision.hold_ticks)), decision.plant, decision.defuse, self.tick,
             )  # fmt: skip
             self._falling += falls
-            if taken > Taken.MOVING:
-                self._refused(agent, decision, taken)
-
-    def _refused(self, agent: int, decision: Decision, taken: int) -> None:
-        """A decision the round did not take as asked (`Taken`): an impossible move holds and
-        is recorded; anything else is an error."""
-        if taken == Taken.NO_EDGE:
-            data = {"action": decision.action}
-            self.events.append(SimEvent(self.tick, "invalid_action", agent, data=data))
-            return
-        problem = {
-            Taken.IN_THE_AIR: "is in the air; give it a goal once it lands",
-            Taken.REMOVED: "was removed",
-            Taken.BAD_SPEED: f"cannot move at {decision.speed!r} m/s (cap {decision.max_speed!r})",
-        }.get(Taken(taken), f"cannot take action {decision.action!r}")
-        raise ValueError(f"agent {agent} {problem}")
+            if taken == Taken.NO_EDGE:  # held as a STOP, and recorded
+                data = {"action": decision.action}
+                self.events.append(SimEvent(self.tick, "invalid_action", agent, data=data))
+            elif taken > Taken.NO_EDGE:
+                raise ValueError(f"agent {agent} {REFUSED[Taken(taken)]}: {decision}")
 
     def _record(self) -> None:
-        rec = self.recording
-        while self._next_record < len(self._record_at) and (
-            self._record_at[self._next_record] <= self.tick
-        ):
-            k = self._next_record
-            if self._record_at[k] == self.tick:
-                rec.position[k] = self.agents.position
-                rec.yaw[k] = self.agents.yaw
-                rec.hp[k] = self.agents.hp
-                rec.alive[k] = self.agents.alive
-            self._next_record += 1
-        if self.done and not self._filled_after_end:
-            # the round ended: later samples keep the final state, unless the agents go on
-            # moving after the end (`step(after_end=True)`) and record over them
-            k = self._next_record
-            rec.position[k:] = self.agents.position
-            rec.yaw[k:] = self.agents.yaw
-            rec.hp[k:] = self.agents.hp
-            rec.alive[k:] = self.agents.alive
-            self._filled_after_end = True
+        self.recorder.take(self.tick, self.agents, self.done)

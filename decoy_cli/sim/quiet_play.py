@@ -13,30 +13,27 @@ decision, exactly as `Simulator.run` plays it tick by tick. Choices come from ei
 It hands back to Python when anything else may follow: a damaging drop, the decision limit,
 the stretch's end, or a STOP to plant or defuse by an agent the bomb rules watch (the carrier;
 everyone once the bomb is planted). The engine takes over what the loop did
-(`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives.
+(`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives. This module
+knows nothing of the engine: it works on the round's arrays (`round_state`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import TYPE_CHECKING, Protocol
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 from numba.experimental import structref
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision, Taken, take_decision
-from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.movement.kernels import kinematic_glide
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
-from decoy_cli.sim.round_state import StructBase, pack
+from decoy_cli.sim.round_state import GraphArrays, RoundState, StructBase, pack
 from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
-
-if TYPE_CHECKING:
-    from decoy_cli.sim.engine import Simulator
 
 
 class StretchEnd(IntEnum):
@@ -59,13 +56,17 @@ DRAW = -2
 """In `Choices.given`: the agent's action is drawn (-1: none handed in; 0..8: this action)."""
 
 
+@runtime_checkable
 class QuietPlayer(Protocol):
-    """A policy that plays quiet stretches itself (`Simulator.run` hands them over)."""
+    """A policy whose choices need no Python per decision: `Simulator.run` plays its quiet
+    stretches in compiled code (`play_stretch`) with its `Choices`."""
 
-    def play_quiet(
-        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
-    ) -> int:
-        """Play from `sim.tick` through at most `horizon`; returns how it ended (`_play`)."""
+    def choices_for(self, n: int) -> Choices:
+        """The choices of a round of `n` agents."""
+        ...
+
+    def refill(self) -> None:
+        """More draws after the rest of the current ones (`StretchEnd.NEED_DRAWS`)."""
         ...
 
 
@@ -145,25 +146,31 @@ def _choice_struct(*values):
     return ChoiceStruct(*values)
 
 
+class Stretch(NamedTuple):
+    """What `play_stretch` played, for the engine to take over (`Simulator.note_quiet_play`)."""
+
+    tick: int  # the tick it reached
+    made: int  # decisions made
+    falls: int  # damaging drops started
+    glided: bool  # whether the mover moved (the agents' positions are the mover's then)
+    status: StretchEnd
+
+
 def play_stretch(
-    sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices
-) -> int:
-    """Play one quiet stretch of `sim` through at most `horizon` with `choices` (`_play`), hand
-    what it did to the engine and return how it ended; `choices.next_draw` moves on."""
-    if not isinstance(sim.mover, KinematicMover):
-        raise TypeError("compiled stretches need the kinematic mover")
+    state: RoundState, graph: GraphArrays, tick: int, horizon: int, decisions_left: int,
+    watch: np.ndarray, choices: Choices, weapons: np.ndarray,
+) -> Stretch:  # fmt: skip
+    """Play the quiet stretch of a round with the kinematic mover after `tick` through at most
+    `horizon` with `choices` (`_play`) and the agents' `weapons` (their full speeds), making at
+    most `decisions_left` decisions; `choices.next_draw` moves on."""
     if choices.hold_ticks < 1:
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
-    packed = choices.packed(choices.top_speeds.of(sim.agents.weapon))
-    tick, used, made, falls, glide_end, status = _play(
-        sim.state.kernel, sim.graph_arrays.kernel, packed, sim.tick, horizon, choices.next_draw,
-        max_decisions - sim.decision_count, watch,
-    )  # fmt: skip
+    packed = choices.packed(choices.top_speeds.of(weapons))
+    reached, used, made, falls, glide_end, status = _play(
+        state.kernel, graph.kernel, packed, tick, horizon, choices.next_draw, decisions_left, watch
+    )
     choices.next_draw = used
-    sim.note_quiet_play(tick, made, falls, glide_end >= 0)
-    if status == StretchEnd.AIRBORNE:
-        raise ValueError("an agent due for a decision is in the air")
-    return status
+    return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
 
 
 @njit_cached
