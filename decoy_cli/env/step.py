@@ -312,10 +312,9 @@ def _quiet_step(r, g, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
     """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
     `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
-    where the step ends and its state is written as `_finish` writes it. After a glide the
-    agents' positions and a carried bomb's (`bomb`: `_BombInputs`) are taken over from the
-    mover. Returns how it ended, the bad or untaken agent (else -1), the tick reached and the
-    decisions made."""
+    where the step ends and its state is written as `_finish` writes it. After a glide a
+    carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended, the bad or
+    untaken agent (else -1), the tick reached and the decisions made."""
     if hand_in:
         bad = _hand_in(c, e, chosen)
         if bad >= 0:
@@ -323,11 +322,9 @@ def _quiet_step(r, g, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
         if _hands_back(r, g, c, e, chosen, watch):
             return StepEnd.LEFT_TO_RUN, -1, tick, 0
     reached, _, made, _, glide_end, status = _play(r, g, c, tick, horizon, 0, NEVER, watch)
-    if glide_end >= 0:  # as `Simulator.note_quiet_play` and `BombRules.follow` take them
-        r.pos[:] = r.mpos
-        carrier, bomb_pos = bomb[1], bomb[2]
-        if carrier >= 0:
-            bomb_pos[:] = r.pos[carrier]
+    carrier, bomb_pos = bomb[1], bomb[2]
+    if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
+        bomb_pos[:] = r.pos[carrier]
     if status == StretchEnd.AIRBORNE:
         return StepEnd.IN_THE_AIR, -1, reached, made
     if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played

@@ -31,9 +31,9 @@ from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, play_stretch
 from decoy_cli.sim.recording import Recorder, Recording
-from decoy_cli.sim.round_state import GraphArrays, RoundState
+from decoy_cli.sim.round_state import GraphArrays, RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
-from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
+from decoy_cli.sim.schedule import NEVER, due_agents, next_due
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -276,14 +276,13 @@ class Simulator:
         return played.status
 
     def note_quiet_play(self, tick: int, made: int, falls: int, glided: bool) -> None:
-        """Take over a quiet stretch a policy played itself (`run`): the tick it reached, the
-        decisions it made and the damaging drops they started; if it glided, the positions and
-        the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
+        """Take over a quiet stretch played in compiled code (`run`, the environment's steps):
+        the tick it reached, the decisions it made and the damaging drops they started; if it
+        glided, the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
         self.tick = tick
         self.decision_count += made
         self._falling += falls
         if glided:
-            self.agents.position[:] = self.mover.positions
             self.rules.follow(self.agents, self.bomb)
 
     def quiet_horizon(self) -> int:
@@ -342,13 +341,9 @@ class Simulator:
     def _moved(self, moved: MoveStep) -> np.ndarray:
         """Take over what the mover did (positions, yaw) and note the last tick's arrivals,
         stuck agents and teleports; returns the (N,) mask of the agents that moved then."""
-        agents = self.agents
-        agents.position[:] = self.mover.positions
-        np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
-        if moved.happened & ARRIVAL:
-            note_arrivals(moved.arrived, agents.alive, agents.node, self.goal_node, self.waiting)
-            if self._falling:
-                self._land(moved.arrived)
+        take_motion(self.state.kernel)
+        if moved.happened & ARRIVAL and self._falling:
+            self._land(moved.arrived)
         if moved.happened & STUCK:
             for agent in np.flatnonzero(moved.stuck).tolist():
                 self.events.append(SimEvent(self.tick, "stuck", agent))

@@ -29,9 +29,8 @@ from numba.experimental import structref
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement.kernels import kinematic_glide
-from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
-from decoy_cli.sim.round_state import GraphArrays, RoundState, StructBase, pack
-from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
+from decoy_cli.sim.round_state import GraphArrays, RoundState, StructBase, pack, take_motion
+from decoy_cli.sim.schedule import is_due, next_due
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
 
@@ -249,7 +248,4 @@ def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
         )
         tick += ticks - 1
         glide_end = tick
-        for i in range(n):
-            if flags[R_MOVED, i]:
-                r.yaw[i] = r.fv[i, F_HEADING]
-        note_arrivals(flags[R_ARRIVED], alive, node, r.goal_node, waiting)
+        take_motion(r)
