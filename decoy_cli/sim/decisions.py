@@ -32,22 +32,16 @@ class Decision:
 
 
 class Taken(IntEnum):
-    """How `take_decision` took a decision."""
+    """How `take_decision` took a decision: as asked (STOPPED, MOVING), held like a STOP for a
+    move no edge makes (NO_EDGE, which the engine records), or not at all (`REFUSED`)."""
 
     STOPPED = 0
-    """A STOP: the agent stands (or lands first) and holds."""
     MOVING = 1
-    """A move: the agent is on its way along the edge."""
     NO_EDGE = 2
-    """A move no edge makes: held like a STOP (the engine records the impossible move)."""
     IN_THE_AIR = 3
-    """A move by an agent in the air (it lands first): its motion is unchanged."""
     REMOVED = 4
-    """A move by an agent the mover removed (dead)."""
     BAD_SPEED = 5
-    """A move at a speed or cap not finite and >= 0."""
     BAD_ACTION = 6
-    """An action not 0..8."""
 
 
 REFUSED = {
@@ -56,7 +50,7 @@ REFUSED = {
     Taken.BAD_SPEED: "cannot move at a speed or cap not finite and >= 0 m/s",
     Taken.BAD_ACTION: "has no such action (0..8)",
 }
-"""Why a decision the round could not take is an error (the engine raises it)."""
+"""Why the round could not take a decision, which is an error (the engine raises it)."""
 
 
 @njit_cached
