@@ -168,10 +168,10 @@ time in ticks."""
 
 
 @njit_cached
-def encode_into(r, g, e, bomb, done, tick, out):
+def encode_into(r, e, bomb, done, tick, out):
     """Write the observation vectors (N, size), action masks (N, 9) and due agents (N,) into
-    `out`'s first three arrays (`ArrayStep`'s order), of the round `r` (`RoundState`), the
-    graph `g` (`GraphArrays`), the encoder's arrays in `e` (`kernel_arrays`' names) and `bomb`
+    `out`'s first three arrays (`ArrayStep`'s order), of the round `r` (`RoundState.kernel`),
+    the encoder's arrays in `e` (`kernel_arrays`' names) and `bomb`
     (bomb state, carrier, bomb position, `round_inputs`): each agent's own entries, its teammate
     and enemy slots and the bomb's offset at `e.starts` (`_PER_AGENT`), the round's entries at
     `e.bomb_starts` (`_BOMB`) from the round inputs (`ROUND_INPUTS`) and the tick: the round's
@@ -179,7 +179,7 @@ def encode_into(r, g, e, bomb, done, tick, out):
     obs, masks, due = out[0], out[1], out[2]
     bomb_state, carrier, bomb_pos, round_inputs = bomb
     pos, yaw, hp, alive, waiting, hold_until = r.pos, r.yaw, r.hp, r.alive, r.waiting, r.hold_until
-    mates, enemies, half, out_edges = e.mates, e.enemies, e.half, g.out_edges
+    mates, enemies, half, out_edges = e.mates, e.enemies, e.half, r.out_edges
     n = pos.shape[0]
     obs[:] = 0.0
     masks[:] = 0

@@ -8,8 +8,8 @@ step, no recorded tick, no bomb rule, no fall). `_quiet_step` plays such a stret
 step's rewards and observations, in one compiled call; `RoundSteps.play` plays a tick that is
 not quiet (a combat step, a plant, a fall) with `Simulator.step` and goes on.
 
-The arrays go to compiled code as four structs that hold them, not copies: the round's
-(`Simulator.state`), the graph's, the choices' and the environment's own (`EnvStruct`), since
+The arrays go to compiled code as three structs that hold them, not copies: the round's
+(`Simulator.state`), the choices' and the environment's own (`EnvStruct`), since
 numba's dispatch checks and converts every argument of every call, and a step is short.
 
 Why a quiet step may skip what `Simulator.run` asks before every stretch: the stretch's
@@ -64,8 +64,8 @@ class _EnvType(StructBase):
 
 
 class EnvStruct(structref.StructRefProxy):
-    """The arrays compiled steps take of the environment besides the round's (`RoundState`),
-    the graph's and the choices': the encoder's (`ObservationEncoder.kernel_arrays`), who is a
+    """The arrays compiled steps take of the environment besides the round's (`RoundState`)
+    and the choices': the encoder's (`ObservationEncoder.kernel_arrays`), who is a
     T, and its own `due` (whose actions the next step takes) and `active` (in the episode)."""
 
 
@@ -142,7 +142,7 @@ class RoundSteps:
         self._choices = choices.packed(choices.top_speeds.of(sim.agents.weapon))
         env = (is_t, *encoder.kernel_arrays(), np.zeros(n, np.bool_), np.ones(n, np.bool_))
         self._env = pack(_env_struct, ENV_FIELDS, env)
-        self._structs = (sim.state.kernel, sim.graph_arrays.kernel, self._choices, self._env)
+        self._structs = (sim.state.kernel, self._choices, self._env)
         self._quiet: _Quiet | None = None
 
     def state(self) -> ArrayStep:
@@ -269,7 +269,7 @@ def _hand_in(c, e, chosen):
 
 
 @njit_cached
-def _finish(r, g, c, e, winner, bomb, done, tick, out):
+def _finish(r, c, e, winner, bomb, done, tick, out):
     """After a step, into `out` (`ArrayStep`'s arrays) and `e`'s own `due` and `active`:
     rewards (+1/-1 by side to the agents active before it, once the round is won: `winner` 1 T,
     0 CT, -1 not yet), terminated, still active, and the observations, masks and due agents
@@ -289,26 +289,26 @@ def _finish(r, g, c, e, winner, bomb, done, tick, out):
         else:
             active[i] = was_active and r.alive[i]
         terminated[i] = was_active and not active[i]
-    encode_into(r, g, e, bomb, done, tick, out)
+    encode_into(r, e, bomb, done, tick, out)
     e.due[:] = due
     e.active[:] = active
     return unused
 
 
 @njit_cached
-def _hands_back(r, g, c, e, chosen, watch):
+def _hands_back(r, c, e, chosen, watch):
     """Whether an action handed in would end `_play`'s stretch with its first tick half played
     (`quiet_play.hands_back`). A move no edge makes `_play` leaves to Python before the tick."""
     for i in range(e.due.shape[0]):
         if e.due[i] and hands_back(
-            i, chosen[i], r.node[i], watch, c.plant, c.defuse, g.out_edges, g.edge_fall
+            i, chosen[i], r.node[i], watch, c.plant, c.defuse, r.out_edges, r.edge_fall
         ):
             return True
     return False
 
 
 @njit_cached
-def _quiet_step(r, g, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
+def _quiet_step(r, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
     """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
     `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
@@ -319,9 +319,9 @@ def _quiet_step(r, g, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
         bad = _hand_in(c, e, chosen)
         if bad >= 0:
             return StepEnd.BAD_ACTION, bad, tick, 0
-        if _hands_back(r, g, c, e, chosen, watch):
+        if _hands_back(r, c, e, chosen, watch):
             return StepEnd.LEFT_TO_RUN, -1, tick, 0
-    reached, _, made, _, glide_end, status = _play(r, g, c, tick, horizon, 0, NEVER, watch)
+    reached, _, made, _, glide_end, status = _play(r, c, tick, horizon, 0, NEVER, watch)
     carrier, bomb_pos = bomb[1], bomb[2]
     if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
         bomb_pos[:] = r.pos[carrier]
@@ -332,7 +332,7 @@ def _quiet_step(r, g, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
     # (an agent due with no action: Python says whom)
     if status != StretchEnd.DUE or reached == tick:
         return StepEnd.LEFT_TO_RUN, -1, reached, made
-    unused = _finish(r, g, c, e, -1, bomb, False, reached, out)
+    unused = _finish(r, c, e, -1, bomb, False, reached, out)
     if unused >= 0:
         return StepEnd.NOT_TAKEN, unused, reached, made
     return StepEnd.PLAYED, -1, reached, made

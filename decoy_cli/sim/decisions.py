@@ -54,13 +54,14 @@ REFUSED = {
 
 
 @njit_cached
-def take_decision(r, g, a, act, speed, cap, hold_ticks, plant, defuse, tick):
-    """Take agent a's decision at `tick` into the round `r` (`RoundState`) on the graph `g`
-    (`GraphArrays`): it counts, the agent wants to plant or defuse as told and leaves a damaging
-    drop; a STOP (or a move no edge makes) holds `hold_ticks`; a move starts the agent along its
-    edge at `speed`, its cap first set to `cap` (m/s). The one place both the engine's decisions
-    (`Simulator._decide`) and the compiled stretches' (`quiet_play._play`) are taken. Returns
-    how (`Taken`) and the change in the number of agents on a damaging drop."""
+def take_decision(r, a, act, speed, cap, hold_ticks, plant, defuse, tick):
+    """Take agent a's decision at `tick` into the round `r` (`RoundState.kernel`): it counts,
+    the agent wants to plant or defuse as told and leaves a damaging drop; a STOP (or a move no
+    edge makes) holds `hold_ticks`; a move starts the agent along its edge at `speed`, its cap
+    first set to `cap` (m/s). The one place both the engine's decisions (`Simulator._decide`)
+    and the compiled stretches' (`quiet_play._play`) are taken. Returns how (`Taken`, as an
+    int: an enum costs more to return) and the change in the number of agents on a damaging
+    drop."""
     r.decisions[a] += 1
     r.wants_plant[a] = plant
     r.wants_defuse[a] = defuse
@@ -69,27 +70,29 @@ def take_decision(r, g, a, act, speed, cap, hold_ticks, plant, defuse, tick):
         r.fall_m[a] = 0.0
         falls = -1
     if not 0 <= act <= STOP_ACTION:
-        return Taken.BAD_ACTION, falls
-    edge = -1 if act == STOP_ACTION else g.out_edges[r.node[a], act]
+        return Taken.BAD_ACTION.value, falls
+    edge = -1 if act == STOP_ACTION else r.out_edges[r.node[a], act]
     if edge < 0:
         if r.iv[a, I_PHASE] not in (RISE, GLIDE, FALL):  # one in the air lands first
             r.iv[a, I_PHASE] = IDLE
             r.fv[a, F_CARRY] = 0.0
         r.hold_until[a] = tick + hold_ticks
-        return Taken.STOPPED if act == STOP_ACTION else Taken.NO_EDGE, falls
+        if act == STOP_ACTION:
+            return Taken.STOPPED.value, falls
+        return Taken.NO_EDGE.value, falls
     if r.iv[a, I_ALIVE] == 0:
-        return Taken.REMOVED, falls
+        return Taken.REMOVED.value, falls
     if not (math.isfinite(speed) and speed >= 0.0 and cap >= 0.0):
-        return Taken.BAD_SPEED, falls
-    goal = g.edge_target[edge]
+        return Taken.BAD_SPEED.value, falls
+    goal = r.edge_target[edge]
     r.goal_node[a] = goal
-    if g.edge_fall[edge] > 0.0:
-        r.fall_m[a] = g.edge_fall[edge]
+    if r.edge_fall[edge] > 0.0:
+        r.fall_m[a] = r.edge_fall[edge]
         falls += 1
-    x, y, z = g.positions[goal, 0], g.positions[goal, 1], g.positions[goal, 2]
+    x, y, z = r.node_pos[goal, 0], r.node_pos[goal, 1], r.node_pos[goal, 2]
     if not begin_edge(
-        a, x, y, z, g.edge_kind[edge], speed, cap, r.jump_speed, r.gravity, r.mpos, r.target,
+        a, x, y, z, r.edge_kind[edge], speed, cap, r.jump_speed, r.gravity, r.mpos, r.target,
         r.fv, r.iv,
     ):  # fmt: skip
-        return Taken.IN_THE_AIR, falls
-    return Taken.MOVING, falls
+        return Taken.IN_THE_AIR.value, falls
+    return Taken.MOVING.value, falls

@@ -31,7 +31,7 @@ from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, play_stretch
 from decoy_cli.sim.recording import Recorder, Recording
-from decoy_cli.sim.round_state import GraphArrays, RoundState, take_motion
+from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER, due_agents, next_due
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
@@ -94,9 +94,8 @@ class Simulator:
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
-        self.state = state = RoundState.open(agents, mover)
+        self.state = state = RoundState.open(agents, mover, graph)
         """The round's arrays as compiled code takes them; the engine's below are its own."""
-        self.graph_arrays = GraphArrays.of(graph)
         self.waiting = state.waiting  # asks for a decision at the next tick
         self.hold_until = state.hold_until  # end tick of a STOP
         self.goal_node = state.goal_node
@@ -264,8 +263,7 @@ class Simulator:
         while True:
             left = limit - self.decision_count
             played = play_stretch(
-                self.state, self.graph_arrays, self.tick, horizon, left, watched, choices,
-                self.agents.weapon,
+                self.state, self.tick, horizon, left, watched, choices, self.agents.weapon
             )  # fmt: skip
             self.note_quiet_play(played.tick, played.made, played.falls, played.glided)
             if played.status != StretchEnd.NEED_DRAWS:
@@ -473,7 +471,7 @@ class Simulator:
             top = max_speed_m_s(str(agents.weapon[agent])) if top is None else float(top)
             speed = top if decision.speed is None else min(float(decision.speed), top)
             taken, falls = take_decision(
-                self.state.kernel, self.graph_arrays.kernel, agent, decision.action, speed, top,
+                self.state.kernel, agent, decision.action, speed, top,
                 max(1, int(decision.hold_ticks)), decision.plant, decision.defuse, self.tick,
             )  # fmt: skip
             self._falling += falls

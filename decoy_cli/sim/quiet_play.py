@@ -29,7 +29,7 @@ from numba.experimental import structref
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement.kernels import kinematic_glide
-from decoy_cli.sim.round_state import GraphArrays, RoundState, StructBase, pack, take_motion
+from decoy_cli.sim.round_state import RoundState, StructBase, pack, take_motion
 from decoy_cli.sim.schedule import is_due, next_due
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
@@ -156,8 +156,8 @@ class Stretch(NamedTuple):
 
 
 def play_stretch(
-    state: RoundState, graph: GraphArrays, tick: int, horizon: int, decisions_left: int,
-    watch: np.ndarray, choices: Choices, weapons: np.ndarray,
+    state: RoundState, tick: int, horizon: int, decisions_left: int, watch: np.ndarray,
+    choices: Choices, weapons: np.ndarray,
 ) -> Stretch:  # fmt: skip
     """Play the quiet stretch of a round with the kinematic mover after `tick` through at most
     `horizon` with `choices` (`_play`) and the agents' `weapons` (their full speeds), making at
@@ -166,7 +166,7 @@ def play_stretch(
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
     packed = choices.packed(choices.top_speeds.of(weapons))
     reached, used, made, falls, glide_end, status = _play(
-        state.kernel, graph.kernel, packed, tick, horizon, choices.next_draw, decisions_left, watch
+        state.kernel, packed, tick, horizon, choices.next_draw, decisions_left, watch
     )
     choices.next_draw = used
     return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
@@ -184,14 +184,14 @@ def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
 
 
 @njit_cached
-def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
+def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
-    tick, on the round `r` (`RoundState`) and graph `g` (`GraphArrays`): at each tick the due
+    tick, on the round `r` (`RoundState.kernel`): at each tick the due
     agents (ascending) decide (`c`: `Choices.packed`, draws from `next_draw` on), then if the
     tick after them is quiet the motion glides to the next arrival or decision or the horizon.
     A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
     damaging drops started, tick of the last glide's end or -1, status)."""
-    given, draws, first, out_edges = c.given, c.draws, g.first, g.out_edges
+    given, draws, first, out_edges = c.given, c.draws, r.first, r.out_edges
     node, alive, waiting, hold_until = r.node, r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0
@@ -221,17 +221,17 @@ def _play(r, g, c, tick, horizon, next_draw, decisions_left, watch):
             act = given[a]
             if act == DRAW:
                 pick = np.int64(draws[next_draw] * (first[at + 1] - first[at]))
-                act = g.actions[first[at] + pick]
+                act = r.actions[first[at] + pick]
                 next_draw += 1
             else:
                 given[a] = -1  # used: the agent's next turn stops the stretch
             made += 1
             stop = act == STOP_ACTION
-            if hands_back(a, act, at, watch, c.plant, c.defuse, out_edges, g.edge_fall):
+            if hands_back(a, act, at, watch, c.plant, c.defuse, out_edges, r.edge_fall):
                 hand_back = True
             plant, defuse = c.plant[a] and stop, c.defuse[a] and stop
             top = c.top[a]
-            taken, fell = take_decision(r, g, a, act, top, top, c.hold_ticks, plant, defuse, tick)
+            taken, fell = take_decision(r, a, act, top, top, c.hold_ticks, plant, defuse, tick)
             falls += fell
             if taken == Taken.IN_THE_AIR:
                 return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE

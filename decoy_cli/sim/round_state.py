@@ -1,11 +1,11 @@
-"""The round's state as compiled code takes it: one `RoundState` and one `GraphArrays`.
+"""The round's state as compiled code takes it: one `RoundState`.
 
 `RoundState` is built once when a simulator opens its round. It holds the agents' arrays, the
-engine's decision arrays (which it allocates, and the engine uses as its own) and the mover's
-packed slots: the very arrays, not copies, so what compiled code writes the engine, the agents
-and the mover see. `GraphArrays` holds what compiled decisions read of the waypoint graph.
+engine's decision arrays (which it allocates, and the engine uses as its own), the mover's
+packed slots and what decisions read of the waypoint graph: the very arrays, not copies, so
+what compiled code writes the engine, the agents and the mover see.
 
-Each goes to compiled code as ONE argument, a numba struct (`structref`) built once (`kernel`):
+It goes to compiled code as ONE argument, a numba struct (`structref`) built once (`kernel`):
 numba's dispatch checks and converts every argument of every call, a struct costs one, and a
 kernel reads its fields by name instead of taking dozens of positional arrays. With numba's JIT
 disabled (kernels run as Python) the struct is a plain namespace of the same fields.
@@ -42,17 +42,8 @@ class _RoundType(StructBase):
     pass
 
 
-@structref.register
-class _GraphType(StructBase):
-    pass
-
-
 class RoundStruct(structref.StructRefProxy):
     """`RoundState`'s arrays as one numba struct (fields: `RoundState`'s, in its order)."""
-
-
-class GraphStruct(structref.StructRefProxy):
-    """`GraphArrays`' arrays as one numba struct."""
 
 
 def pack(make: Callable[..., object], names: Sequence[str], values: Sequence[object]) -> object:
@@ -66,7 +57,8 @@ def pack(make: Callable[..., object], names: Sequence[str], values: Sequence[obj
 @dataclass(slots=True)
 class RoundState:
     """One round's per-agent arrays (N rows each), as the engine, the agents and the mover share
-    them; `kernel` is the same arrays as one struct for compiled code (module docstring)."""
+    them, and its graph's; `kernel` is the same arrays as one struct for compiled code (module
+    docstring)."""
 
     # the agents' (`Agents`)
     pos: np.ndarray  # (N, 3) float64, feet
@@ -95,23 +87,34 @@ class RoundState:
     prm: np.ndarray
     jump_speed: float
     gravity: float
+    # the graph's (`WaypointGraph`), read only
+    first: np.ndarray  # (nodes + 1,) and ...
+    actions: np.ndarray  # ... each node's possible actions (`WaypointGraph.allowed_actions`)
+    out_edges: np.ndarray  # (nodes, 8) int64
+    edge_target: np.ndarray
+    edge_kind: np.ndarray
+    edge_fall: np.ndarray  # `WaypointGraph.fall_m`
+    node_pos: np.ndarray  # (nodes, 3) `WaypointGraph.positions`
     kernel: object = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.kernel = pack(_round_struct, ROUND_FIELDS, [getattr(self, n) for n in ROUND_FIELDS])
 
     @classmethod
-    def open(cls, agents: Agents, mover: MoverBase) -> RoundState:
-        """The state of a round of `agents` moved by `mover` (already reset to them): the engine's
-        decision arrays new, everyone waiting for a first decision."""
+    def open(cls, agents: Agents, mover: MoverBase, graph: WaypointGraph) -> RoundState:
+        """The state of a round of `agents` moved by `mover` (already reset to them) on `graph`:
+        the engine's decision arrays new, everyone waiting for a first decision."""
         n = agents.count
         mpos, start, target, fv, iv, flags, prm = mover.kernel_arrays()
+        first, actions = graph.allowed_actions
         return cls(
             agents.position, agents.yaw, agents.hp, agents.armor, agents.helmet,
             agents.has_defuser, agents.alive, agents.node,
             np.ones(n, bool), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, bool),
             np.zeros(n, bool), np.full(n, -1, np.int64), np.zeros(n),
             mpos, start, target, fv, iv, flags, prm, mover.jump_speed, mover.gravity,
+            first, actions, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
+            graph.positions,
         )  # fmt: skip
 
 
@@ -121,47 +124,10 @@ ROUND_FIELDS = tuple(f.name for f in fields(RoundState) if f.name != "kernel")
 structref.define_proxy(RoundStruct, _RoundType, list(ROUND_FIELDS))
 
 
-@dataclass(slots=True)
-class GraphArrays:
-    """What compiled decisions read of a waypoint graph; `kernel` is them as one struct."""
-
-    first: np.ndarray  # (nodes + 1,) and ...
-    actions: np.ndarray  # ... each node's possible actions (`WaypointGraph.allowed_actions`)
-    out_edges: np.ndarray  # (nodes, 8) int64
-    edge_target: np.ndarray
-    edge_kind: np.ndarray
-    edge_fall: np.ndarray  # `WaypointGraph.fall_m`
-    positions: np.ndarray  # (nodes, 3)
-    kernel: object = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        self.kernel = pack(_graph_struct, GRAPH_FIELDS, [getattr(self, n) for n in GRAPH_FIELDS])
-
-    @classmethod
-    def of(cls, graph: WaypointGraph) -> GraphArrays:
-        first, actions = graph.allowed_actions
-        return cls(
-            first, actions, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
-            graph.positions,
-        )  # fmt: skip
-
-
-GRAPH_FIELDS = tuple(f.name for f in fields(GraphArrays) if f.name != "kernel")
-"""`GraphStruct`'s fields, in order."""
-
-structref.define_proxy(GraphStruct, _GraphType, list(GRAPH_FIELDS))
-
-
 @njit_cached
 def _round_struct(*values):
     """A `RoundStruct` made in compiled code, so that its constructor is cached with it."""
     return RoundStruct(*values)
-
-
-@njit_cached
-def _graph_struct(*values):
-    """A `GraphStruct` made in compiled code."""
-    return GraphStruct(*values)
 
 
 @njit_cached
