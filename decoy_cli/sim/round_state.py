@@ -24,7 +24,6 @@ from numba.experimental import structref
 from decoy_cli.compiled import jit_enabled, njit_cached
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
-from decoy_cli.sim.schedule import note_arrivals
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import WaypointGraph
 
@@ -133,11 +132,14 @@ def _round_struct(*values):
 @njit_cached
 def take_motion(r):
     """Take over what the mover's last call did (`r`: `RoundState.kernel`): the agents stand
-    where the mover has them, those that moved face their heading, and those that arrived stand
-    on their goal node and wait for a decision (`note_arrivals`). The one place both the engine
+    where the mover has them, those that moved face their heading, and the alive ones that
+    arrived stand on their goal node and wait for a decision. The one place both the engine
     (`Simulator._moved`) and the compiled stretches (`quiet_play._play`) take motion over."""
     r.pos[:] = r.mpos
     for i in range(r.yaw.shape[0]):
         if r.flags[R_MOVED, i]:
             r.yaw[i] = r.fv[i, F_HEADING]
-    note_arrivals(r.flags[R_ARRIVED], r.alive, r.node, r.goal_node, r.waiting)
+        if r.flags[R_ARRIVED, i] and r.alive[i]:
+            r.node[i] = r.goal_node[i]
+            r.goal_node[i] = -1
+            r.waiting[i] = True
