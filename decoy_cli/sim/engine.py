@@ -29,7 +29,7 @@ from decoy_cli.sim.decisions import REFUSED, Decision, Taken, take_decision
 from decoy_cli.sim.movement import KinematicMover, MoveStep
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, play_stretch
+from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick, play_stretch
 from decoy_cli.sim.recording import Recorder, Recording
 from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
@@ -107,6 +107,7 @@ class Simulator:
         self.decisions = state.decisions
         self.decision_count = 0  # decisions.sum(), kept as they are made
         self._deciding = -1  # the agent whose policy is deciding right now
+        self._player = policy if isinstance(policy, QuietPlayer) else None  # decides compiled
         for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
             self.mover.remove(int(agent))
         self.bomb: Bomb = rules.start(agents, bomb_carrier)
@@ -218,7 +219,7 @@ class Simulator:
 
         quiet_player = None
         if until is None and isinstance(self.mover, KinematicMover):
-            quiet_player = self.policy if isinstance(self.policy, QuietPlayer) else None
+            quiet_player = self._player
         while self.tick < end and not stop():
             if self.done:
                 if not (after_end and self.outcome is not None):
@@ -458,8 +459,13 @@ class Simulator:
 
     def _decide(self) -> None:
         """The due agents (ascending) ask the policy and the round takes each decision
-        (`take_decision`) before the next agent is asked."""
+        (`take_decision`) before the next agent is asked; a `QuietPlayer`'s in compiled code."""
         agents = self.agents
+        if self._player is not None:
+            made, falls = decide_tick(self.state, self.tick, self._player, agents.weapon)
+            self.decision_count += made
+            self._falling += falls
+            return
         for agent in due_agents(self.waiting, agents.alive, self.hold_until, self.tick).tolist():
             self.hold_until[agent] = 0
             self.waiting[agent] = False

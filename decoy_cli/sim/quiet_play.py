@@ -172,6 +172,27 @@ def play_stretch(
     return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
 
 
+def decide_tick(
+    state: RoundState, tick: int, player: QuietPlayer, weapons: np.ndarray
+) -> tuple[int, int]:
+    """The decisions of the agents due at `tick` with `player`'s choices, in compiled code
+    (`decide_due`), for a tick the engine plays itself; returns the decisions made and the
+    change in the number of agents on a damaging drop."""
+    n = len(weapons)
+    choices = player.choices_for(n)
+    if len(choices.draws) - choices.next_draw < n:
+        player.refill()
+    packed = choices.packed(choices.top_speeds.of(weapons))
+    nobody = np.zeros(n, np.bool_)  # no stretch to hand back
+    used, made, falls, _, airborne = decide_due(
+        state.kernel, packed, tick, choices.next_draw, nobody
+    )
+    choices.next_draw = used
+    if airborne:
+        raise ValueError("an agent due for a decision is in the air")
+    return made, falls
+
+
 @njit_cached
 def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
     """Whether agent a's decision `act` at node `at` ends a quiet stretch with its tick half
@@ -184,15 +205,51 @@ def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
 
 
 @njit_cached
+def decide_due(r, c, tick, next_draw, watch):
+    """The decisions of the agents due at `tick` (ascending) on the round `r`
+    (`RoundState.kernel`), from `c` (`Choices.packed`: draws from `next_draw` on, which must
+    last), each taken as it is made (`take_decision`). Returns (next draw, decisions made,
+    change in the number of agents on a damaging drop, whether one hands back (`hands_back`),
+    whether an agent asked to move is in the air, where it stops)."""
+    made = falls = 0
+    hand_back = False
+    first = r.first
+    for a in range(r.alive.shape[0]):
+        if not is_due(a, r.waiting, r.alive, r.hold_until, tick):
+            continue
+        r.hold_until[a] = 0
+        r.waiting[a] = False
+        at = r.node[a]
+        act = c.given[a]
+        if act == DRAW:
+            pick = np.int64(c.draws[next_draw] * (first[at + 1] - first[at]))
+            act = r.actions[first[at] + pick]
+            next_draw += 1
+        else:
+            c.given[a] = -1  # used: the agent's next turn stops a stretch
+        made += 1
+        stop = act == STOP_ACTION
+        if hands_back(a, act, at, watch, c.plant, c.defuse, r.out_edges, r.edge_fall):
+            hand_back = True
+        plant, defuse = c.plant[a] and stop, c.defuse[a] and stop
+        top = c.top[a]
+        taken, fell = take_decision(r, a, act, top, top, c.hold_ticks, plant, defuse, tick)
+        falls += fell
+        if taken == Taken.IN_THE_AIR:
+            return next_draw, made, falls, hand_back, True
+    return next_draw, made, falls, hand_back, False
+
+
+@njit_cached
 def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
-    tick, on the round `r` (`RoundState.kernel`): at each tick the due
-    agents (ascending) decide (`c`: `Choices.packed`, draws from `next_draw` on), then if the
-    tick after them is quiet the motion glides to the next arrival or decision or the horizon.
+    tick, on the round `r` (`RoundState.kernel`): at each tick the due agents decide
+    (`decide_due`, `c`: `Choices.packed`, draws from `next_draw` on), then if the tick after
+    them is quiet the motion glides to the next arrival or decision or the horizon.
     A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
     damaging drops started, tick of the last glide's end or -1, status)."""
-    given, draws, first, out_edges = c.given, c.draws, r.first, r.out_edges
-    node, alive, waiting, hold_until = r.node, r.alive, r.waiting, r.hold_until
+    given, draws, node, out_edges = c.given, c.draws, r.node, r.out_edges
+    alive, waiting, hold_until = r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0
     glide_end = -1
@@ -211,30 +268,11 @@ def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
         if drawn > draws.shape[0] - next_draw:
             return tick, next_draw, made, falls, glide_end, StretchEnd.NEED_DRAWS
         tick += 1
-        hand_back = False
-        for a in range(n):
-            if not is_due(a, waiting, alive, hold_until, tick):
-                continue
-            hold_until[a] = 0
-            waiting[a] = False
-            at = node[a]
-            act = given[a]
-            if act == DRAW:
-                pick = np.int64(draws[next_draw] * (first[at + 1] - first[at]))
-                act = r.actions[first[at] + pick]
-                next_draw += 1
-            else:
-                given[a] = -1  # used: the agent's next turn stops the stretch
-            made += 1
-            stop = act == STOP_ACTION
-            if hands_back(a, act, at, watch, c.plant, c.defuse, out_edges, r.edge_fall):
-                hand_back = True
-            plant, defuse = c.plant[a] and stop, c.defuse[a] and stop
-            top = c.top[a]
-            taken, fell = take_decision(r, a, act, top, top, c.hold_ticks, plant, defuse, tick)
-            falls += fell
-            if taken == Taken.IN_THE_AIR:
-                return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
+        next_draw, now, fell, hand_back, airborne = decide_due(r, c, tick, next_draw, watch)
+        made += now
+        falls += fell
+        if airborne:
+            return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
         due_at = next_due(waiting, alive, hold_until, tick - 1)
