@@ -178,8 +178,10 @@ def encode_into(r, e, bomb, done, tick, out):
     time left counts to the plant once there is one, the bomb's while it is planted."""
     obs, masks, due = out[0], out[1], out[2]
     bomb_state, carrier, bomb_pos, round_inputs = bomb
+    # the fields read per agent, taken out of the structs once
     pos, yaw, hp, alive, waiting, hold_until = r.pos, r.yaw, r.hp, r.alive, r.waiting, r.hold_until
-    mates, enemies, half, out_edges = e.mates, e.enemies, e.half, r.out_edges
+    armor, helmet, kit, node, out_edges = r.armor, r.helmet, r.kit, r.node, r.out_edges
+    mates, enemies, half, centre, is_ct = e.mates, e.enemies, e.half, e.centre, e.is_ct
     n = pos.shape[0]
     obs[:] = 0.0
     masks[:] = 0
@@ -197,18 +199,18 @@ def encode_into(r, e, bomb, done, tick, out):
         masks[i, out_edges.shape[1]] = 1  # STOP
         if due[i]:
             for action in range(out_edges.shape[1]):
-                masks[i, action] = 1 if out_edges[r.node[i], action] >= 0 else 0
+                masks[i, action] = 1 if out_edges[node[i], action] >= 0 else 0
         for axis in range(3):
-            v = (pos[i, axis] - e.centre[axis]) / half[axis]
+            v = (pos[i, axis] - centre[axis]) / half[axis]
             obs[i, p0 + axis] = min(1.0, max(-1.0, v))
         angle = math.radians(yaw[i])
         obs[i, y0], obs[i, y0 + 1] = math.sin(angle), math.cos(angle)
         obs[i, h0] = hp[i] / 100.0
-        obs[i, a0] = r.armor[i] / 100.0
-        obs[i, hel0] = 1.0 if r.helmet[i] else 0.0
-        obs[i, k0] = 1.0 if r.kit[i] else 0.0
+        obs[i, a0] = armor[i] / 100.0
+        obs[i, hel0] = 1.0 if helmet[i] else 0.0
+        obs[i, k0] = 1.0 if kit[i] else 0.0
         obs[i, b0] = 1.0 if i == carrier else 0.0
-        obs[i, c0] = 1.0 if e.is_ct[i] else 0.0
+        obs[i, c0] = 1.0 if is_ct[i] else 0.0
         obs[i, d0] = 1.0 if due[i] else 0.0
         for start, table in ((m0, mates), (e0, enemies)):
             for slot in range(table.shape[1]):

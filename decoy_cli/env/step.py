@@ -8,8 +8,8 @@ step, no recorded tick, no bomb rule, no fall). `_quiet_step` plays such a stret
 step's rewards and observations, in one compiled call; `RoundSteps.play` plays a tick that is
 not quiet (a combat step, a plant, a fall) with `Simulator.step` and goes on.
 
-The arrays go to compiled code as three structs that hold them, not copies: the round's
-(`Simulator.state`), the choices' and the environment's own (`EnvStruct`), since
+The arrays go to compiled code as one struct that holds them, not copies (`EnvStruct`: the
+round's, `Simulator.state`, the choices' and the environment's own), since
 numba's dispatch checks and converts every argument of every call, and a step is short.
 
 Why a quiet step may skip what `Simulator.run` asks before every stretch: the stretch's
@@ -64,13 +64,15 @@ class _EnvType(StructBase):
 
 
 class EnvStruct(structref.StructRefProxy):
-    """The arrays compiled steps take of the environment besides the round's (`RoundState`)
-    and the choices': the encoder's (`ObservationEncoder.kernel_arrays`), who is a
-    T, and its own `due` (whose actions the next step takes) and `active` (in the episode)."""
+    """What compiled steps take of one round of the environment, as one struct: the round's
+    (`round`: `RoundState.kernel`), the choices' (`Choices.arrays`), the encoder's
+    (`ObservationEncoder.kernel_arrays`), who is a T, and its own `due` (whose actions the next
+    step takes) and `active` (in the episode)."""
 
 
-ENV_FIELDS = ("is_t", "starts", "bomb_starts", "is_ct", "mates", "enemies", "centre", "half",
-              "due", "active")  # fmt: skip
+ENV_FIELDS = ("round", "given", "draws", "plant", "defuse", "top", "hold_ticks", "is_t",
+              "starts", "bomb_starts", "is_ct", "mates", "enemies", "centre", "half", "due",
+              "active")  # fmt: skip
 """`EnvStruct`'s fields, in order."""
 
 structref.define_proxy(EnvStruct, _EnvType, list(ENV_FIELDS))
@@ -139,10 +141,13 @@ class RoundSteps:
         n = sim.agents.count
         self._shapes = ((n, encoder.size), (n, NUM_ACTIONS), n)  # vectors, masks, the rest
         self._dtypes = (np.dtype(np.float32), np.dtype(np.bool_), np.dtype(np.int8))
-        self._choices = choices.packed(choices.top_speeds.of(sim.agents.weapon))
-        env = (is_t, *encoder.kernel_arrays(), np.zeros(n, np.bool_), np.ones(n, np.bool_))
+        top = choices.top_speeds.of(sim.agents.weapon)
+        env = (
+            sim.state.kernel, choices.given, choices.draws, choices.plant, choices.defuse, top,
+            choices.hold_ticks, is_t, *encoder.kernel_arrays(), np.zeros(n, np.bool_),
+            np.ones(n, np.bool_),
+        )  # fmt: skip
         self._env = pack(_env_struct, ENV_FIELDS, env)
-        self._structs = (sim.state.kernel, self._choices, self._env)
         self._quiet: _Quiet | None = None
 
     def state(self) -> ArrayStep:
@@ -165,14 +170,14 @@ class RoundSteps:
             quiet = self._quiet_from_here()
             if quiet is None:
                 if hand_in:
-                    self._check(_hand_in(self._choices, self._env, chosen), chosen)
+                    self._check(_hand_in(self._env, chosen), chosen)
                     hand_in = False
                 sim.step()
                 continue
             out = self._outputs()
             start = sim.tick
             inputs = (chosen, hand_in, start, quiet.horizon, quiet.watched, quiet.bomb, out)
-            status, agent, tick, made = _quiet_step(*self._structs, *inputs)
+            status, agent, tick, made = _quiet_step(self._env, *inputs)
             if status == StepEnd.BAD_ACTION:
                 self._check(agent, chosen)
             hand_in = False
@@ -220,7 +225,7 @@ class RoundSteps:
         state, carrier, inputs = self.encoder.round_inputs(sim)
         bomb = (state, carrier, sim.bomb.position, inputs)
         out = self._outputs()
-        unused = _finish(*self._structs, winner, bomb, sim.done, sim.tick, out)
+        unused = _finish(self._env, winner, bomb, sim.done, sim.tick, out)
         if unused >= 0:
             raise _not_taken(unused)
         if outcome is None:
@@ -256,38 +261,41 @@ def _not_taken(agent: int) -> RuntimeError:
 
 
 @njit_cached
-def _hand_in(c, e, chosen):
-    """Put the actions of the due agents (`e.due`) into `c.given` (-1 for the others); the
+def _hand_in(e, chosen):
+    """Put the actions of the due agents (`e.due`) into `e.given` (-1 for the others); the
     first due agent whose action is not 0..8, or -1."""
-    for i in range(e.due.shape[0]):
-        c.given[i] = -1
-        if e.due[i]:
+    given, due = e.given, e.due
+    for i in range(due.shape[0]):
+        given[i] = -1
+        if due[i]:
             if not 0 <= chosen[i] < NUM_ACTIONS:
                 return i
-            c.given[i] = chosen[i]
+            given[i] = chosen[i]
     return -1
 
 
 @njit_cached
-def _finish(r, c, e, winner, bomb, done, tick, out):
+def _finish(e, winner, bomb, done, tick, out):
     """After a step, into `out` (`ArrayStep`'s arrays) and `e`'s own `due` and `active`:
     rewards (+1/-1 by side to the agents active before it, once the round is won: `winner` 1 T,
     0 CT, -1 not yet), terminated, still active, and the observations, masks and due agents
     (`encode_into`). Returns an agent whose handed-in action the simulator did not take, or
     -1."""
     _, _, due, rewards, terminated, active = out
+    r = e.round
+    given, was, is_t, alive = e.given, e.active, e.is_t, r.alive
     unused = -1
-    for i in range(c.given.shape[0]):
-        if c.given[i] >= 0:
+    for i in range(given.shape[0]):
+        if given[i] >= 0:
             unused = i
-        was_active = e.active[i]
+        was_active = was[i]
         rewards[i] = 0.0
         active[i] = False
         if winner >= 0:
             if was_active:
-                rewards[i] = 1.0 if e.is_t[i] == (winner == 1) else -1.0
+                rewards[i] = 1.0 if is_t[i] == (winner == 1) else -1.0
         else:
-            active[i] = was_active and r.alive[i]
+            active[i] = was_active and alive[i]
         terminated[i] = was_active and not active[i]
     encode_into(r, e, bomb, done, tick, out)
     e.due[:] = due
@@ -296,19 +304,20 @@ def _finish(r, c, e, winner, bomb, done, tick, out):
 
 
 @njit_cached
-def _hands_back(r, c, e, chosen, watch):
+def _hands_back(e, chosen, watch):
     """Whether an action handed in would end `_play`'s stretch with its first tick half played
     (`quiet_play.hands_back`). A move no edge makes `_play` leaves to Python before the tick."""
-    for i in range(e.due.shape[0]):
-        if e.due[i] and hands_back(
-            i, chosen[i], r.node[i], watch, c.plant, c.defuse, r.out_edges, r.edge_fall
+    r, due = e.round, e.due
+    for i in range(due.shape[0]):
+        if due[i] and hands_back(
+            i, chosen[i], r.node[i], watch, e.plant, e.defuse, r.out_edges, r.edge_fall
         ):
             return True
     return False
 
 
 @njit_cached
-def _quiet_step(r, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
+def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
     `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
@@ -316,11 +325,13 @@ def _quiet_step(r, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
     carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended, the bad or
     untaken agent (else -1), the tick reached and the decisions made."""
     if hand_in:
-        bad = _hand_in(c, e, chosen)
+        bad = _hand_in(e, chosen)
         if bad >= 0:
             return StepEnd.BAD_ACTION, bad, tick, 0
-        if _hands_back(r, c, e, chosen, watch):
+        if _hands_back(e, chosen, watch):
             return StepEnd.LEFT_TO_RUN, -1, tick, 0
+    r = e.round
+    c = (e.given, e.draws, e.plant, e.defuse, e.top, e.hold_ticks)
     reached, _, made, _, glide_end, status = _play(r, c, tick, horizon, 0, NEVER, watch)
     carrier, bomb_pos = bomb[1], bomb[2]
     if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
@@ -332,7 +343,7 @@ def _quiet_step(r, c, e, chosen, hand_in, tick, horizon, watch, bomb, out):
     # (an agent due with no action: Python says whom)
     if status != StretchEnd.DUE or reached == tick:
         return StepEnd.LEFT_TO_RUN, -1, reached, made
-    unused = _finish(r, c, e, -1, bomb, False, reached, out)
+    unused = _finish(e, -1, bomb, False, reached, out)
     if unused >= 0:
         return StepEnd.NOT_TAKEN, unused, reached, made
     return StepEnd.PLAYED, -1, reached, made

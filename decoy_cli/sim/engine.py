@@ -461,12 +461,13 @@ class Simulator:
         """The due agents (ascending) ask the policy and the round takes each decision
         (`take_decision`) before the next agent is asked; a `QuietPlayer`'s in compiled code."""
         agents = self.agents
-        if self._player is not None:
+        due = due_agents(self.waiting, agents.alive, self.hold_until, self.tick)
+        if self._player is not None and len(due):
             made, falls = decide_tick(self.state, self.tick, self._player, agents.weapon)
             self.decision_count += made
             self._falling += falls
             return
-        for agent in due_agents(self.waiting, agents.alive, self.hold_until, self.tick).tolist():
+        for agent in due.tolist():
             self.hold_until[agent] = 0
             self.waiting[agent] = False
             self._deciding = agent

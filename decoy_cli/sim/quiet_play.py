@@ -24,12 +24,11 @@ from enum import IntEnum
 from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
-from numba.experimental import structref
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement.kernels import kinematic_glide
-from decoy_cli.sim.round_state import RoundState, StructBase, pack, take_motion
+from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.schedule import is_due, next_due
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
@@ -97,18 +96,10 @@ class Choices:
     defuse: np.ndarray  # bool: a STOP of this agent wants to defuse
     top_speeds: TopSpeeds = field(default_factory=TopSpeeds)
     _decisions: dict[tuple[bool, bool, int], Decision] = field(default_factory=dict)
-    _packed: tuple[tuple[object, ...], object] = ((), None)  # (made of, struct)
 
-    def packed(self, top: np.ndarray) -> object:
-        """These choices and the agents' full speeds `top` as one struct for `_play` (fields
-        `CHOICE_FIELDS`), made anew only when one of them was replaced."""
-        values = (self.given, self.draws, self.plant, self.defuse, top, self.hold_ticks)
-        made_of, struct = self._packed
-        same = len(made_of) == len(values)
-        if not same or any(a is not b for a, b in zip(values, made_of, strict=True)):
-            struct = pack(_choice_struct, CHOICE_FIELDS, values)
-            self._packed = (values, struct)
-        return struct
+    def arrays(self, top: np.ndarray) -> ChoiceArrays:
+        """These choices and the agents' full speeds `top` (m/s) as compiled code takes them."""
+        return self.given, self.draws, self.plant, self.defuse, top, self.hold_ticks
 
     def decision(self, agent: int, action: int) -> Decision:
         """The engine's `Decision` of `action` by `agent`, as `_play` takes it: a move at full
@@ -123,26 +114,9 @@ class Choices:
         return found
 
 
-CHOICE_FIELDS = ("given", "draws", "plant", "defuse", "top", "hold_ticks")
-"""The fields of `Choices.packed`: `Choices`' own and `top`, each agent's full speed (m/s)."""
-
-
-@structref.register
-class _ChoiceType(StructBase):
-    pass
-
-
-class ChoiceStruct(structref.StructRefProxy):
-    """`Choices.packed`: `CHOICE_FIELDS` as one numba struct."""
-
-
-structref.define_proxy(ChoiceStruct, _ChoiceType, list(CHOICE_FIELDS))
-
-
-@njit_cached
-def _choice_struct(*values):
-    """A `ChoiceStruct` made in compiled code, so that its constructor is cached with it."""
-    return ChoiceStruct(*values)
+ChoiceArrays = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]
+"""`Choices.arrays`: given, draws, plant, defuse, top, hold_ticks (a tuple costs numba less to
+take than a struct, and the draws are replaced as they run out)."""
 
 
 class Stretch(NamedTuple):
@@ -164,9 +138,9 @@ def play_stretch(
     most `decisions_left` decisions; `choices.next_draw` moves on."""
     if choices.hold_ticks < 1:
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
-    packed = choices.packed(choices.top_speeds.of(weapons))
+    c = choices.arrays(choices.top_speeds.of(weapons))
     reached, used, made, falls, glide_end, status = _play(
-        state.kernel, packed, tick, horizon, choices.next_draw, decisions_left, watch
+        state.kernel, c, tick, horizon, choices.next_draw, decisions_left, watch
     )
     choices.next_draw = used
     return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
@@ -182,11 +156,9 @@ def decide_tick(
     choices = player.choices_for(n)
     if len(choices.draws) - choices.next_draw < n:
         player.refill()
-    packed = choices.packed(choices.top_speeds.of(weapons))
-    nobody = np.zeros(n, np.bool_)  # no stretch to hand back
-    used, made, falls, _, airborne = decide_due(
-        state.kernel, packed, tick, choices.next_draw, nobody
-    )
+    c = choices.arrays(choices.top_speeds.of(weapons))
+    unwatched = np.zeros(n, np.bool_)  # no stretch to hand back
+    used, made, falls, _, airborne = decide_due(state.kernel, c, tick, choices.next_draw, unwatched)
     choices.next_draw = used
     if airborne:
         raise ValueError("an agent due for a decision is in the air")
@@ -207,33 +179,44 @@ def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
 @njit_cached
 def decide_due(r, c, tick, next_draw, watch):
     """The decisions of the agents due at `tick` (ascending) on the round `r`
-    (`RoundState.kernel`), from `c` (`Choices.packed`: draws from `next_draw` on, which must
+    (`RoundState.kernel`), from `c` (`Choices.arrays`: draws from `next_draw` on, which must
     last), each taken as it is made (`take_decision`). Returns (next draw, decisions made,
     change in the number of agents on a damaging drop, whether one hands back (`hands_back`),
     whether an agent asked to move is in the air, where it stops)."""
     made = falls = 0
     hand_back = False
-    first = r.first
-    for a in range(r.alive.shape[0]):
-        if not is_due(a, r.waiting, r.alive, r.hold_until, tick):
+    # the fields read per agent, taken out of the structs once
+    waiting, alive, hold_until, node, first, actions = (
+        r.waiting,
+        r.alive,
+        r.hold_until,
+        r.node,
+        r.first,
+        r.actions,
+    )
+    given, draws, plant, defuse, top, hold_ticks = c
+    for a in range(alive.shape[0]):
+        if not is_due(a, waiting, alive, hold_until, tick):
             continue
-        r.hold_until[a] = 0
-        r.waiting[a] = False
-        at = r.node[a]
-        act = c.given[a]
+        hold_until[a] = 0
+        waiting[a] = False
+        at = node[a]
+        act = given[a]
         if act == DRAW:
-            pick = np.int64(c.draws[next_draw] * (first[at + 1] - first[at]))
-            act = r.actions[first[at] + pick]
+            pick = np.int64(draws[next_draw] * (first[at + 1] - first[at]))
+            act = actions[first[at] + pick]
             next_draw += 1
         else:
-            c.given[a] = -1  # used: the agent's next turn stops a stretch
+            given[a] = -1  # used: the agent's next turn stops a stretch
         made += 1
         stop = act == STOP_ACTION
-        if hands_back(a, act, at, watch, c.plant, c.defuse, r.out_edges, r.edge_fall):
+        if hands_back(a, act, at, watch, plant, defuse, r.out_edges, r.edge_fall):
             hand_back = True
-        plant, defuse = c.plant[a] and stop, c.defuse[a] and stop
-        top = c.top[a]
-        taken, fell = take_decision(r, a, act, top, top, c.hold_ticks, plant, defuse, tick)
+        wants_plant, wants_defuse = plant[a] and stop, defuse[a] and stop
+        speed = top[a]
+        taken, fell = take_decision(
+            r, a, act, speed, speed, hold_ticks, wants_plant, wants_defuse, tick
+        )
         falls += fell
         if taken == Taken.IN_THE_AIR:
             return next_draw, made, falls, hand_back, True
@@ -244,11 +227,11 @@ def decide_due(r, c, tick, next_draw, watch):
 def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
     tick, on the round `r` (`RoundState.kernel`): at each tick the due agents decide
-    (`decide_due`, `c`: `Choices.packed`, draws from `next_draw` on), then if the tick after
+    (`decide_due`, `c`: `Choices.arrays`, draws from `next_draw` on), then if the tick after
     them is quiet the motion glides to the next arrival or decision or the horizon.
     A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
     damaging drops started, tick of the last glide's end or -1, status)."""
-    given, draws, node, out_edges = c.given, c.draws, r.node, r.out_edges
+    given, draws, node, out_edges = c[0], c[1], r.node, r.out_edges
     alive, waiting, hold_until = r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0

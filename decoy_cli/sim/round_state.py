@@ -136,10 +136,11 @@ def take_motion(r):
     arrived stand on their goal node and wait for a decision. The one place both the engine
     (`Simulator._moved`) and the compiled stretches (`quiet_play._play`) take motion over."""
     r.pos[:] = r.mpos
-    for i in range(r.yaw.shape[0]):
-        if r.flags[R_MOVED, i]:
-            r.yaw[i] = r.fv[i, F_HEADING]
-        if r.flags[R_ARRIVED, i] and r.alive[i]:
-            r.node[i] = r.goal_node[i]
-            r.goal_node[i] = -1
+    flags, yaw, fv, alive, node, goal_node = r.flags, r.yaw, r.fv, r.alive, r.node, r.goal_node
+    for i in range(yaw.shape[0]):
+        if flags[R_MOVED, i]:
+            yaw[i] = fv[i, F_HEADING]
+        if flags[R_ARRIVED, i] and alive[i]:
+            node[i] = goal_node[i]
+            goal_node[i] = -1
             r.waiting[i] = True
