@@ -14,7 +14,9 @@ It hands back to Python when anything else may follow: a damaging drop, the deci
 the stretch's end, or a STOP to plant or defuse by an agent the bomb rules watch (the carrier;
 everyone once the bomb is planted). The engine takes over what the loop did
 (`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives. This module
-knows nothing of the engine: it works on the round's arrays (`round_state`).
+knows nothing of the engine: it works on the round's arrays (`round_state`). The same
+decisions (`decide_due`) serve the ticks the engine plays itself (`decide_tick`), with either
+mover.
 """
 
 from __future__ import annotations

@@ -2,10 +2,10 @@
 
 `RandomPolicy` picks a uniformly random possible action (`WaypointGraph.allowed_actions`) for
 each agent asked; a STOP holds `hold_ticks` and, if told, plants or defuses (the bomb rules
-let only a T carrier plant and a CT defuse). With the kinematic mover the engine plays its
-whole quiet stretches in compiled code (`quiet_play.QuietPlayer`); its draws come from the
-generator in blocks, used in the same order either way, so the round is the same as deciding
-one agent at a time.
+let only a T carrier plant and a CT defuse). The engine makes its decisions in compiled code
+(`quiet_play.QuietPlayer`), with the kinematic mover whole quiet stretches of them; its draws
+come from the generator in blocks, used in the same order by `decide` (one agent at a time in
+Python, the reference the tests compare with), so the round is the same either way.
 """
 
 from __future__ import annotations
