@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M, TICK_RATE
-from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
+from decoy_cli.sim.movement import KinematicMover, MoverBase, PhysicsMover
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import nav_world
@@ -44,7 +44,7 @@ def start_nodes(graph: WaypointGraph, agents: int, start: str, rng: np.random.Ge
 
 
 def random_walk(
-    mover: Mover, graph: WaypointGraph, agents: int, start: str, ticks: int, seed: int
+    mover: MoverBase, graph: WaypointGraph, agents: int, start: str, ticks: int, seed: int
 ) -> tuple[float, float, dict[str, int]]:
     """Run a random walk; (seconds in step(), seconds in total, counts)."""
     rng = np.random.default_rng(seed)
@@ -101,7 +101,7 @@ def main() -> None:
     )
     print(header)
     with PhysicsWorld(world) as physics:
-        movers: dict[str, Mover] = {
+        movers: dict[str, MoverBase] = {
             "kinematic": KinematicMover(),
             "physics": PhysicsMover(physics),
         }

@@ -315,6 +315,20 @@ def test_an_impossible_move_holds_and_is_recorded() -> None:
     assert sim.agents.node[0] == 0
 
 
+@pytest.mark.parametrize(
+    ("decision", "why"),
+    [
+        (walk(E, speed=float("nan")), "cannot move at a speed"),
+        (walk(E, max_speed=-1.0), "cannot move at a speed"),
+        (Decision(9), "has no such action"),
+    ],
+)
+def test_a_decision_the_round_cannot_take_is_an_error(decision: Decision, why: str) -> None:
+    sim = make_sim(t_and_ct(), policy=Script({0: [decision]}))
+    with pytest.raises(ValueError, match=f"agent 0 {why}"):
+        sim.step()
+
+
 class RelocatesFirst(Script):
     """Puts agent 0 on node 3 at its first decision (as a replay crosses a graph gap)."""
 

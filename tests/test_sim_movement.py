@@ -31,7 +31,7 @@ from decoy_cli.csgo import GRAVITY_M_S2, JUMP_SPEED_M_S, PLAYER_HEIGHT_M, TICK_R
 from decoy_cli.sim.movement import (
     DEFAULT_MAX_SPEED_M_S,
     KinematicMover,
-    Mover,
+    MoverBase,
     MoveStep,
     PhysicsMover,
     layout,
@@ -84,7 +84,7 @@ def world_graph(name: str) -> tuple[World, WaypointGraph]:
 
 
 @contextmanager
-def mover_in(kind: str, world: World, **options: float) -> Iterator[Mover]:
+def mover_in(kind: str, world: World, **options: float) -> Iterator[MoverBase]:
     """A mover of the given kind; the physics one lives in a fresh pybullet client."""
     with PhysicsWorld(world) as physics:
         yield KinematicMover() if kind == "kinematic" else PhysicsMover(physics, **options)
@@ -97,7 +97,7 @@ def node_at(graph: WaypointGraph, point: tuple[float, float, float]) -> int:
 
 
 def drive(
-    mover: Mover,
+    mover: MoverBase,
     graph: WaypointGraph,
     paths: list[list[int]],
     speed: float,
@@ -501,7 +501,7 @@ def test_rays_hit_agents_only_when_asked() -> None:
 # ---- determinism and the real map ---------------------------------------------------------------
 
 
-def random_walk(graph: WaypointGraph, mover: Mover, agents: int, ticks: int, seed: int):
+def random_walk(graph: WaypointGraph, mover: MoverBase, agents: int, ticks: int, seed: int):
     rng = np.random.default_rng(seed)
     node = rng.choice(graph.num_nodes, size=agents, replace=False)
     mover.reset(graph.positions[node])
@@ -582,7 +582,7 @@ def test_physics_agents_on_the_real_map_stay_out_of_walls_and_each_other() -> No
 
 
 def random_walk_from(
-    graph: WaypointGraph, mover: Mover, start: np.ndarray, ticks: int
+    graph: WaypointGraph, mover: MoverBase, start: np.ndarray, ticks: int
 ) -> np.ndarray:
     rng = np.random.default_rng(7)
     node = np.asarray(start).copy()

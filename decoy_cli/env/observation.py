@@ -168,21 +168,25 @@ time in ticks."""
 
 
 @njit_cached
-def encode_into(
-    obs, masks, due, starts, bomb_starts, pos, yaw, hp, armor, helmet, kit, is_ct, alive, mates,
-    enemies, centre, half, bomb_pos, bomb_state, carrier, round_inputs, done, tick, waiting,
-    hold_until, node, out_edges,
-):  # fmt: skip
+def encode_into(r, e, bomb, done, tick, out):
     """Write the observation vectors (N, size), action masks (N, 9) and due agents (N,) into
-    `obs`, `masks` and `due`: each agent's own entries, its teammate and enemy slots and the
-    bomb's offset at `starts` (`_PER_AGENT`), the round's entries at `bomb_starts` (`_BOMB`)
-    from `round_inputs` (`ROUND_INPUTS`) and the tick: the round's time left counts to the
-    plant once there is one, the bomb's while it is planted."""
+    `out`'s first three arrays (`ArrayStep`'s order), of the round `r` (`RoundState.kernel`),
+    the encoder's arrays in `e` (`kernel_arrays`' names) and `bomb`
+    (bomb state, carrier, bomb position, `round_inputs`): each agent's own entries, its teammate
+    and enemy slots and the bomb's offset at `e.starts` (`_PER_AGENT`), the round's entries at
+    `e.bomb_starts` (`_BOMB`) from the round inputs (`ROUND_INPUTS`) and the tick: the round's
+    time left counts to the plant once there is one, the bomb's while it is planted."""
+    obs, masks, due = out[0], out[1], out[2]
+    bomb_state, carrier, bomb_pos, round_inputs = bomb
+    # the fields read per agent, taken out of the structs once
+    pos, yaw, hp, alive, waiting, hold_until = r.pos, r.yaw, r.hp, r.alive, r.waiting, r.hold_until
+    armor, helmet, kit, node, out_edges = r.armor, r.helmet, r.kit, r.node, r.out_edges
+    mates, enemies, half, centre, is_ct = e.mates, e.enemies, e.half, e.centre, e.is_ct
     n = pos.shape[0]
     obs[:] = 0.0
     masks[:] = 0
-    p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = starts
-    state0, site0, plant0, defuse0, round0, timer0 = bomb_starts
+    p0, y0, h0, a0, hel0, k0, b0, c0, d0, m0, e0, o0 = e.starts
+    state0, site0, plant0, defuse0, round0, timer0 = e.bomb_starts
     site = np.int64(round_inputs[0])
     planted_tick, round_ticks, bomb_ticks = round_inputs[3], round_inputs[5], round_inputs[6]
     clock = planted_tick if planted_tick >= 0 else tick
@@ -230,4 +234,3 @@ def encode_into(
         obs[i, defuse0] = round_inputs[2]
         obs[i, round0] = round_left
         obs[i, timer0] = bomb_left
-    return obs, masks, due

@@ -8,9 +8,9 @@ step, no recorded tick, no bomb rule, no fall). `_quiet_step` plays such a stret
 step's rewards and observations, in one compiled call; `RoundSteps.play` plays a tick that is
 not quiet (a combat step, a plant, a fall) with `Simulator.step` and goes on.
 
-The round's arrays (the simulator's, the mover's, the graph's, the encoder's) go to compiled
-code as one `RoundArrays` struct that holds them, not copies: numba's dispatch checks and
-converts every argument of every call, and a step is short.
+The arrays go to compiled code as one struct that holds them, not copies (`EnvStruct`: the
+round's, `Simulator.state`, the choices' and the environment's own), since
+numba's dispatch checks and converts every argument of every call, and a step is short.
 
 Why a quiet step may skip what `Simulator.run` asks before every stretch: the stretch's
 horizon (`Simulator.quiet_horizon`), the agents the bomb rules watch and the round's observation
@@ -23,17 +23,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
-from types import SimpleNamespace
 
 import numpy as np
-from numba.core import types
 from numba.experimental import structref
 
-from decoy_cli.compiled import jit_enabled, njit_cached
+from decoy_cli.compiled import njit_cached
 from decoy_cli.env.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.quiet_play import Choices, StretchEnd, _play, hands_back
+from decoy_cli.sim.round_state import StructBase, pack
 from decoy_cli.sim.schedule import NEVER
 
 
@@ -57,58 +55,33 @@ class StepEnd(IntEnum):
     """The stretch handed back with its tick half played."""
 
 
-# ---- the round's arrays as one struct ---------------------------------------------------------
+# ---- the environment's arrays as one struct ---------------------------------------------------
 
 
 @structref.register
-class _RoundArraysType(types.StructRef):
-    def preprocess_fields(self, fields: tuple) -> tuple:
-        return tuple((name, types.unliteral(kind)) for name, kind in fields)
+class _EnvType(StructBase):
+    pass
 
 
-class RoundArrays(structref.StructRefProxy):
-    """The arrays of one round that compiled steps read and write, held (not copied) in one
-    numba struct: `Choices`, graph, agents, simulator, kinematic mover, encoder, and the
-    environment's own `due` (whose actions the next step takes) and `active` (in the episode)."""
+class EnvStruct(structref.StructRefProxy):
+    """What compiled steps take of one round of the environment, as one struct: the round's
+    (`round`: `RoundState.kernel`), the choices' (`Choices.arrays`), the encoder's
+    (`ObservationEncoder.kernel_arrays`), who is a T, and its own `due` (whose actions the next
+    step takes) and `active` (in the episode)."""
 
 
-ROUND_FIELDS = (
-    "given", "draws", "first", "actions", "hold_ticks", "plant", "defuse", "top",
-    "out_edges", "edge_target", "edge_kind", "edge_fall", "positions",
-    "node", "alive", "yaw", "hp", "armor", "helmet", "kit", "pos",
-    "waiting", "hold_until", "decisions", "wants_plant", "wants_defuse", "goal_node", "fall_m",
-    "mpos", "start", "target", "fv", "iv", "flags", "prm", "jump_speed", "gravity",
-    "is_t", "starts", "bomb_starts", "is_ct", "mates", "enemies", "centre", "half",
-    "due", "active",
-)  # fmt: skip
-"""`RoundArrays`' fields in the order `_round_arrays` takes them (`mpos`: the mover's
-positions; `pos`: the agents')."""
+ENV_FIELDS = ("round", "given", "draws", "plant", "defuse", "top", "hold_ticks", "is_t",
+              "starts", "bomb_starts", "is_ct", "mates", "enemies", "centre", "half", "due",
+              "active")  # fmt: skip
+"""`EnvStruct`'s fields, in order."""
 
-structref.define_proxy(RoundArrays, _RoundArraysType, list(ROUND_FIELDS))
+structref.define_proxy(EnvStruct, _EnvType, list(ENV_FIELDS))
 
 
 @njit_cached
-def _round_arrays(
-    given, draws, first, actions, hold_ticks, plant, defuse, top, out_edges, edge_target,
-    edge_kind, edge_fall, positions, node, alive, yaw, hp, armor, helmet, kit, pos, waiting,
-    hold_until, decisions, wants_plant, wants_defuse, goal_node, fall_m, mpos, start, target, fv,
-    iv, flags, prm, jump_speed, gravity, is_t, starts, bomb_starts, is_ct, mates, enemies,
-    centre, half, due, active,
-):  # fmt: skip
-    """A `RoundArrays` made in compiled code, so that its constructor is cached with it."""
-    return RoundArrays(
-        given, draws, first, actions, hold_ticks, plant, defuse, top, out_edges, edge_target,
-        edge_kind, edge_fall, positions, node, alive, yaw, hp, armor, helmet, kit, pos, waiting,
-        hold_until, decisions, wants_plant, wants_defuse, goal_node, fall_m, mpos, start, target,
-        fv, iv, flags, prm, jump_speed, gravity, is_t, starts, bomb_starts, is_ct, mates,
-        enemies, centre, half, due, active,
-    )  # fmt: skip
-
-
-def _plain_round_arrays(*arrays: object) -> SimpleNamespace:
-    """`RoundArrays`' fields on a plain object, for the kernels run as Python (numba's JIT
-    disabled), where numba's struct cannot be made."""
-    return SimpleNamespace(**dict(zip(ROUND_FIELDS, arrays, strict=True)))
+def _env_struct(*values):
+    """An `EnvStruct` made in compiled code, so that its constructor is cached with it."""
+    return EnvStruct(*values)
 
 
 # ---- the steps --------------------------------------------------------------------------------
@@ -135,17 +108,18 @@ class _Quiet:
 
     tick: int  # the tick it holds at, moved on by each quiet step
     events: int  # how many events the round had then
-    arrays: tuple[int, np.ndarray, int, int, np.ndarray, np.ndarray]  # `_quiet_step`'s horizon,
-    # watched agents, bomb state, carrier, bomb position (the simulator's own array, which a
-    # carried bomb's moves update) and round inputs
-
-    @property
-    def horizon(self) -> int:
-        return self.arrays[0]
+    horizon: int  # the stretch's last quiet tick (`Simulator.quiet_horizon`)
+    watched: np.ndarray  # the agents the bomb rules watch
+    bomb: _BombInputs
 
     @property
     def bomb_position(self) -> np.ndarray:
-        return self.arrays[4]
+        return self.bomb[2]
+
+
+_BombInputs = tuple[int, int, np.ndarray, np.ndarray]
+"""What `encode_into` takes of the bomb and the round: the bomb state, its carrier, its position
+(the simulator's own array, which a carried bomb's moves update) and the round inputs."""
 
 
 class RoundSteps:
@@ -164,24 +138,16 @@ class RoundSteps:
         self.encoder = encoder
         self.choices = choices
         self.names = names
-        graph, agents, mover = sim.graph, sim.agents, sim.mover
-        if not isinstance(mover, MoverBase):
-            raise TypeError("the environment's steps need one of the package's movers")
-        first, actions = graph.allowed_actions
-        n = agents.count
+        n = sim.agents.count
         self._shapes = ((n, encoder.size), (n, NUM_ACTIONS), n)  # vectors, masks, the rest
         self._dtypes = (np.dtype(np.float32), np.dtype(np.bool_), np.dtype(np.int8))
-        make = _round_arrays if jit_enabled() else _plain_round_arrays
-        self._arrays = make(
-            choices.given, choices.draws, first, actions, choices.hold_ticks, choices.plant,
-            choices.defuse, choices.top_speeds.of(agents.weapon), graph.out_edges,
-            graph.edge_target, graph.edge_kind, graph.fall_m, graph.positions, agents.node,
-            agents.alive, agents.yaw, agents.hp, agents.armor, agents.helmet, agents.has_defuser,
-            agents.position, sim.waiting, sim.hold_until, sim.decisions, sim.wants_plant,
-            sim.wants_defuse, sim.goal_node, sim.fall_m, *mover.kernel_arrays(),
-            mover.jump_speed, mover.gravity, is_t, *encoder.kernel_arrays(),
-            np.zeros(n, np.bool_), np.ones(n, np.bool_),
+        top = choices.top_speeds.of(sim.agents.weapon)
+        env = (
+            sim.state.kernel, choices.given, choices.draws, choices.plant, choices.defuse, top,
+            choices.hold_ticks, is_t, *encoder.kernel_arrays(), np.zeros(n, np.bool_),
+            np.ones(n, np.bool_),
         )  # fmt: skip
+        self._env = pack(_env_struct, ENV_FIELDS, env)
         self._quiet: _Quiet | None = None
 
     def state(self) -> ArrayStep:
@@ -204,15 +170,14 @@ class RoundSteps:
             quiet = self._quiet_from_here()
             if quiet is None:
                 if hand_in:
-                    self._check(_hand_in(self._arrays, chosen), chosen)
+                    self._check(_hand_in(self._env, chosen), chosen)
                     hand_in = False
                 sim.step()
                 continue
             out = self._outputs()
             start = sim.tick
-            status, agent, tick, made = _quiet_step(
-                self._arrays, chosen, hand_in, start, *quiet.arrays, *out
-            )
+            inputs = (chosen, hand_in, start, quiet.horizon, quiet.watched, quiet.bomb, out)
+            status, agent, tick, made = _quiet_step(self._env, *inputs)
             if status == StepEnd.BAD_ACTION:
                 self._check(agent, chosen)
             hand_in = False
@@ -245,8 +210,8 @@ class RoundSteps:
                 return None
             watched = sim.rules.watched(sim.agents, sim.bomb)
             state, carrier, inputs = self.encoder.round_inputs(sim)
-            arrays = (horizon, watched, state, carrier, sim.bomb.position, inputs)
-            self._quiet = quiet = _Quiet(sim.tick, len(sim.events), arrays)
+            bomb = (state, carrier, sim.bomb.position, inputs)
+            self._quiet = quiet = _Quiet(sim.tick, len(sim.events), horizon, watched, bomb)
         if quiet.horizon <= sim.tick or quiet.bomb_position is not sim.bomb.position:
             return None
         return quiet
@@ -258,11 +223,9 @@ class RoundSteps:
         outcome = sim.outcome
         winner = -1 if outcome is None else int(outcome.winner == "T")
         state, carrier, inputs = self.encoder.round_inputs(sim)
+        bomb = (state, carrier, sim.bomb.position, inputs)
         out = self._outputs()
-        unused = _finish(
-            self._arrays, winner, state, carrier, sim.bomb.position, inputs, sim.done, sim.tick,
-            *out,
-        )  # fmt: skip
+        unused = _finish(self._env, winner, bomb, sim.done, sim.tick, out)
         if unused >= 0:
             raise _not_taken(unused)
         if outcome is None:
@@ -298,91 +261,81 @@ def _not_taken(agent: int) -> RuntimeError:
 
 
 @njit_cached
-def _hand_in(r, chosen):
-    """Put the actions of the due agents (`r.due`) into `r.given` (-1 for the others); the
+def _hand_in(e, chosen):
+    """Put the actions of the due agents (`e.due`) into `e.given` (-1 for the others); the
     first due agent whose action is not 0..8, or -1."""
-    for i in range(r.due.shape[0]):
-        r.given[i] = -1
-        if r.due[i]:
+    given, due = e.given, e.due
+    for i in range(due.shape[0]):
+        given[i] = -1
+        if due[i]:
             if not 0 <= chosen[i] < NUM_ACTIONS:
                 return i
-            r.given[i] = chosen[i]
+            given[i] = chosen[i]
     return -1
 
 
 @njit_cached
-def _finish(
-    r, winner, bomb_state, carrier, bomb_pos, round_inputs, done, tick, obs, masks, due,
-    rewards, terminated, active,
-):  # fmt: skip
-    """After a step, into the arrays given and the struct's own `due` and `active`: rewards
-    (+1/-1 by side to the agents active before it, once the round is won: `winner` 1 T, 0 CT,
-    -1 not yet), terminated, still active, and the observations, masks and due agents
+def _finish(e, winner, bomb, done, tick, out):
+    """After a step, into `out` (`ArrayStep`'s arrays) and `e`'s own `due` and `active`:
+    rewards (+1/-1 by side to the agents active before it, once the round is won: `winner` 1 T,
+    0 CT, -1 not yet), terminated, still active, and the observations, masks and due agents
     (`encode_into`). Returns an agent whose handed-in action the simulator did not take, or
     -1."""
+    _, _, due, rewards, terminated, active = out
+    r = e.round
+    given, was, is_t, alive = e.given, e.active, e.is_t, r.alive
     unused = -1
-    for i in range(r.given.shape[0]):
-        if r.given[i] >= 0:
+    for i in range(given.shape[0]):
+        if given[i] >= 0:
             unused = i
-        was_active = r.active[i]
+        was_active = was[i]
         rewards[i] = 0.0
         active[i] = False
         if winner >= 0:
             if was_active:
-                rewards[i] = 1.0 if r.is_t[i] == (winner == 1) else -1.0
+                rewards[i] = 1.0 if is_t[i] == (winner == 1) else -1.0
         else:
-            active[i] = was_active and r.alive[i]
+            active[i] = was_active and alive[i]
         terminated[i] = was_active and not active[i]
-    encode_into(
-        obs, masks, due, r.starts, r.bomb_starts, r.pos, r.yaw, r.hp, r.armor, r.helmet, r.kit,
-        r.is_ct, r.alive, r.mates, r.enemies, r.centre, r.half, bomb_pos, bomb_state, carrier,
-        round_inputs, done, tick, r.waiting, r.hold_until, r.node, r.out_edges,
-    )  # fmt: skip
-    r.due[:] = due
-    r.active[:] = active
+    encode_into(r, e, bomb, done, tick, out)
+    e.due[:] = due
+    e.active[:] = active
     return unused
 
 
 @njit_cached
-def _hands_back(r, chosen, watch):
+def _hands_back(e, chosen, watch):
     """Whether an action handed in would end `_play`'s stretch with its first tick half played
     (`quiet_play.hands_back`). A move no edge makes `_play` leaves to Python before the tick."""
-    for i in range(r.due.shape[0]):
-        if r.due[i] and hands_back(
-            i, chosen[i], r.node[i], watch, r.plant, r.defuse, r.out_edges, r.edge_fall
+    r, due = e.round, e.due
+    for i in range(due.shape[0]):
+        if due[i] and hands_back(
+            i, chosen[i], r.node[i], watch, e.plant, e.defuse, r.out_edges, r.edge_fall
         ):
             return True
     return False
 
 
 @njit_cached
-def _quiet_step(
-    r, chosen, hand_in, tick, horizon, watch, bomb_state, carrier, bomb_pos, round_inputs, obs,
-    masks, due, rewards, terminated, active,
-):  # fmt: skip
+def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
     `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
-    where the step ends and its state is written as `_finish` writes it. After a glide the
-    agents' positions and a carried bomb's are taken over from the mover. Returns how it
-    ended, the bad or untaken agent (else -1), the tick reached and the decisions made."""
+    where the step ends and its state is written as `_finish` writes it. After a glide a
+    carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended, the bad or
+    untaken agent (else -1), the tick reached and the decisions made."""
     if hand_in:
-        bad = _hand_in(r, chosen)
+        bad = _hand_in(e, chosen)
         if bad >= 0:
             return StepEnd.BAD_ACTION, bad, tick, 0
-        if _hands_back(r, chosen, watch):
+        if _hands_back(e, chosen, watch):
             return StepEnd.LEFT_TO_RUN, -1, tick, 0
-    reached, _, made, _, glide_end, status = _play(
-        tick, horizon, r.given, r.draws, 0, r.first, r.actions, r.hold_ticks, r.plant,
-        r.defuse, NEVER, watch, r.top, r.out_edges, r.edge_target, r.edge_kind, r.edge_fall,
-        r.positions, r.node, r.alive, r.yaw, r.waiting, r.hold_until, r.decisions,
-        r.wants_plant, r.wants_defuse, r.goal_node, r.fall_m, r.mpos, r.start, r.target, r.fv,
-        r.iv, r.flags, r.prm, r.jump_speed, r.gravity,
-    )  # fmt: skip
-    if glide_end >= 0:  # as `Simulator.note_quiet_play` and `BombRules.follow` take them
-        r.pos[:] = r.mpos
-        if carrier >= 0:
-            bomb_pos[:] = r.pos[carrier]
+    r = e.round
+    c = (e.given, e.draws, e.plant, e.defuse, e.top, e.hold_ticks)
+    reached, _, made, _, glide_end, status = _play(r, c, tick, horizon, 0, NEVER, watch)
+    carrier, bomb_pos = bomb[1], bomb[2]
+    if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
+        bomb_pos[:] = r.pos[carrier]
     if status == StretchEnd.AIRBORNE:
         return StepEnd.IN_THE_AIR, -1, reached, made
     if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played
@@ -390,10 +343,7 @@ def _quiet_step(
     # (an agent due with no action: Python says whom)
     if status != StretchEnd.DUE or reached == tick:
         return StepEnd.LEFT_TO_RUN, -1, reached, made
-    unused = _finish(
-        r, -1, bomb_state, carrier, bomb_pos, round_inputs, False, reached, obs, masks, due,
-        rewards, terminated, active,
-    )  # fmt: skip
+    unused = _finish(e, -1, bomb, False, reached, out)
     if unused >= 0:
         return StepEnd.NOT_TAKEN, unused, reached, made
     return StepEnd.PLAYED, -1, reached, made

@@ -52,7 +52,7 @@ from decoy_cli.replay.plans import PlayerPlan
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
-from decoy_cli.sim.engine import Recording
+from decoy_cli.sim.recording import Recording
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import MoverName, OpenRound, RoundSetup, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent

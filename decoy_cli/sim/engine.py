@@ -20,20 +20,22 @@ itself knows nothing of ESTA data (the replay is one policy among others).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 
 from decoy_cli.csgo import TICK_RATE, fall_damage
-from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.movement import KinematicMover, Mover, MoveStep
+from decoy_cli.sim.decisions import REFUSED, Decision, Taken, take_decision
+from decoy_cli.sim.movement import KinematicMover, MoveStep
+from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.quiet_play import StretchEnd
+from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick, play_stretch
+from decoy_cli.sim.recording import Recorder, Recording
+from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
-from decoy_cli.sim.schedule import NEVER, due_agents, next_due, note_arrivals
+from decoy_cli.sim.schedule import NEVER, due_agents, next_due
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
-from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
 
@@ -45,18 +47,6 @@ class Policy(Protocol):
 
 COMBAT_EVERY_TICKS = TICK_RATE // 2
 """Ticks between combat steps: the paper's 0.5 s."""
-
-
-@dataclass
-class Recording:
-    """Agent state sampled at requested ticks: arrays (S, N, ...) plus all events."""
-
-    ticks: np.ndarray
-    position: np.ndarray
-    yaw: np.ndarray
-    hp: np.ndarray
-    alive: np.ndarray
-    events: list[SimEvent] = field(default_factory=list)
 
 
 class CombatRunner(Protocol):
@@ -77,7 +67,7 @@ class Simulator:
         self,
         graph: WaypointGraph,
         agents: Agents,
-        mover: Mover,
+        mover: MoverBase,
         policy: Policy,
         rules: BombRules,
         *,
@@ -101,38 +91,30 @@ class Simulator:
         self.tick = start_tick
         self.events: list[SimEvent] = []
         self.outcome: RoundOutcome | None = None
-        n = agents.count
-        self.waiting = np.ones(n, dtype=bool)  # asks for a decision at the next tick
-        self.hold_until = np.zeros(n, dtype=np.int64)  # end tick of a STOP
-        self.goal_node = np.full(n, -1, dtype=np.int64)
-        self.fall_m = np.zeros(n)  # depth of the damaging drop each agent is on (0: none)
-        self._falling = 0  # how many agents are on such a drop
-        self._fall_killed = False  # a landing killed since the outcome was last judged
-        self.wants_plant = np.zeros(n, dtype=bool)
-        self.wants_defuse = np.zeros(n, dtype=bool)
-        self.decisions = np.zeros(n, dtype=np.int64)
-        self.decision_count = 0  # decisions.sum(), kept as they are made
-        self._deciding = -1  # the agent whose policy is deciding right now
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
+        self.state = state = RoundState.open(agents, mover, graph)
+        """The round's arrays as compiled code takes them; the engine's below are its own."""
+        self.waiting = state.waiting  # asks for a decision at the next tick
+        self.hold_until = state.hold_until  # end tick of a STOP
+        self.goal_node = state.goal_node
+        self.fall_m = state.fall_m  # depth of the damaging drop each agent is on (0: none)
+        self._falling = 0  # how many agents are on such a drop
+        self._fall_killed = False  # a landing killed since the outcome was last judged
+        self.wants_plant = state.wants_plant
+        self.wants_defuse = state.wants_defuse
+        self.decisions = state.decisions
+        self.decision_count = 0  # decisions.sum(), kept as they are made
+        self._deciding = -1  # the agent whose policy is deciding right now
+        self._player = policy if isinstance(policy, QuietPlayer) else None  # decides compiled
         for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
             self.mover.remove(int(agent))
         self.bomb: Bomb = rules.start(agents, bomb_carrier)
-        self._record_at = np.asarray(sorted(set(int(t) for t in record_ticks)), dtype=np.int64)
-        s = len(self._record_at)
-        self.recording = Recording(
-            ticks=self._record_at,
-            position=np.full((s, n, 3), np.nan),
-            yaw=np.full((s, n), np.nan),
-            hp=np.zeros((s, n), dtype=np.int16),
-            alive=np.zeros((s, n), dtype=bool),
-            events=self.events,
-        )
-        self._next_record = 0
+        self.recorder = Recorder(record_ticks, agents.count, self.events)
+        self.recording = self.recorder.recording
         self._alive_judged = b""  # who was alive (as bytes) when the outcome was judged
         self._judged_as: tuple[BombStatus, bool] | None = None  # and the bomb and the clock
-        self._filled_after_end = False
         # every loop is bounded: the round's time limit plus the bomb timer after a plant
         self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
         self._record()
@@ -197,8 +179,7 @@ class Simulator:
         self.tick += 1
         self._decide()
         last = min(end, next_due(self.waiting, self.agents.alive, self.hold_until, self.tick) - 1)
-        if self._next_record < len(self._record_at):
-            last = min(last, int(self._record_at[self._next_record]) - 1)
+        last = min(last, self.recorder.next_tick - 1)
         ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
         self.tick += ticks - 1
         self._moved(moved)
@@ -227,9 +208,9 @@ class Simulator:
         tick stepping would. Motion alone (positions, the tick) changes inside a glide unseen:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
-        A policy with `play_quiet` (`quiet_play.QuietPlayer`: the random policy) plays whole
-        quiet stretches of decisions and motion in compiled code when the mover is kinematic
-        and no `until` is given, with the same result."""
+        A `quiet_play.QuietPlayer` policy (the random policy) has whole quiet stretches of
+        decisions and motion played in compiled code (`_play_quiet`) when the mover is
+        kinematic and no `until` is given, with the same result."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 
@@ -238,7 +219,7 @@ class Simulator:
 
         quiet_player = None
         if until is None and isinstance(self.mover, KinematicMover):
-            quiet_player = getattr(self.policy, "play_quiet", None)
+            quiet_player = self._player
         while self.tick < end and not stop():
             if self.done:
                 if not (after_end and self.outcome is not None):
@@ -250,7 +231,8 @@ class Simulator:
                 if horizon > self.tick:
                     before = (self.tick, self.decision_count)
                     watched = self.rules.watched(self.agents, self.bomb)
-                    if quiet_player(self, horizon, limit, watched) == StretchEnd.DECIDED:
+                    status = self._play_quiet(quiet_player, horizon, limit, watched)
+                    if status == StretchEnd.DECIDED:
                         self._after_decisions(end, stop)
                         continue
                     if (self.tick, self.decision_count) != before:
@@ -272,15 +254,34 @@ class Simulator:
         else:
             self._finish_tick(self._move())
 
+    def _play_quiet(
+        self, player: QuietPlayer, horizon: int, limit: int, watched: np.ndarray
+    ) -> StretchEnd:
+        """Play from this tick through at most `horizon` with `player`'s choices in compiled
+        code (`quiet_play.play_stretch`), up to `limit` decisions in all, refilling its draws
+        as it needs them; take over what it played and return how it ended."""
+        choices = player.choices_for(self.agents.count)
+        while True:
+            left = limit - self.decision_count
+            played = play_stretch(
+                self.state, self.tick, horizon, left, watched, choices, self.agents.weapon
+            )  # fmt: skip
+            self.note_quiet_play(played.tick, played.made, played.falls, played.glided)
+            if played.status != StretchEnd.NEED_DRAWS:
+                break
+            player.refill()
+        if played.status == StretchEnd.AIRBORNE:
+            raise ValueError("an agent due for a decision is in the air")
+        return played.status
+
     def note_quiet_play(self, tick: int, made: int, falls: int, glided: bool) -> None:
-        """Take over a quiet stretch a policy played itself (`run`): the tick it reached, the
-        decisions it made and the damaging drops they started; if it glided, the positions and
-        the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
+        """Take over a quiet stretch played in compiled code (`run`, the environment's steps):
+        the tick it reached, the decisions it made and the damaging drops they started; if it
+        glided, the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
         self.tick = tick
         self.decision_count += made
         self._falling += falls
         if glided:
-            self.agents.position[:] = self.mover.positions
             self.rules.follow(self.agents, self.bomb)
 
     def quiet_horizon(self) -> int:
@@ -339,13 +340,9 @@ class Simulator:
     def _moved(self, moved: MoveStep) -> np.ndarray:
         """Take over what the mover did (positions, yaw) and note the last tick's arrivals,
         stuck agents and teleports; returns the (N,) mask of the agents that moved then."""
-        agents = self.agents
-        agents.position[:] = self.mover.positions
-        np.copyto(agents.yaw, self.mover.heading, where=moved.moved)
-        if moved.happened & ARRIVAL:
-            note_arrivals(moved.arrived, agents.alive, agents.node, self.goal_node, self.waiting)
-            if self._falling:
-                self._land(moved.arrived)
+        take_motion(self.state.kernel)
+        if moved.happened & ARRIVAL and self._falling:
+            self._land(moved.arrived)
         if moved.happened & STUCK:
             for agent in np.flatnonzero(moved.stuck).tolist():
                 self.events.append(SimEvent(self.tick, "stuck", agent))
@@ -383,8 +380,7 @@ class Simulator:
         last = min(end, self._max_tick - 1, rules)
         if self.combat is not None:
             last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
-        if self._next_record < len(self._record_at):
-            last = min(last, int(self._record_at[self._next_record]) - 1)
+        last = min(last, self.recorder.next_tick - 1)
         return max(tick, last)
 
     def _glide(self, last: int) -> None:
@@ -462,64 +458,35 @@ class Simulator:
         return due
 
     def _decide(self) -> None:
+        """The due agents (ascending) ask the policy and the round takes each decision
+        (`take_decision`) before the next agent is asked; a `QuietPlayer`'s in compiled code."""
         agents = self.agents
-        for agent in due_agents(self.waiting, agents.alive, self.hold_until, self.tick).tolist():
+        due = due_agents(self.waiting, agents.alive, self.hold_until, self.tick)
+        if self._player is not None and len(due):
+            made, falls = decide_tick(self.state, self.tick, self._player, agents.weapon)
+            self.decision_count += made
+            self._falling += falls
+            return
+        for agent in due.tolist():
             self.hold_until[agent] = 0
             self.waiting[agent] = False
             self._deciding = agent
             decision = self.policy.decide(self, agent)
             self._deciding = -1
-            self.decisions[agent] += 1
             self.decision_count += 1
-            self.wants_plant[agent] = decision.plant
-            self.wants_defuse[agent] = decision.defuse
-            if self.fall_m[agent]:
-                self._set_fall(agent, 0.0)
-            if decision.action == STOP_ACTION:
-                self.mover.clear_goal(agent)
-                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
-                continue
-            edge = int(self.graph.out_edges[agents.node[agent], decision.action])
-            if edge < 0:  # an impossible move: stand still for one decision period
-                self.mover.clear_goal(agent)
-                self.hold_until[agent] = self.tick + max(1, int(decision.hold_ticks))
-                self.events.append(
-                    SimEvent(self.tick, "invalid_action", agent, data={"action": decision.action})
-                )
-                continue
-            target = int(self.graph.edge_target[edge])
-            top = (
-                max_speed_m_s(str(agents.weapon[agent]))
-                if decision.max_speed is None
-                else float(decision.max_speed)
-            )
+            top = decision.max_speed
+            top = max_speed_m_s(str(agents.weapon[agent])) if top is None else float(top)
             speed = top if decision.speed is None else min(float(decision.speed), top)
-            self.goal_node[agent] = target
-            depth = float(self.graph.fall_m[edge])
-            if depth:
-                self._set_fall(agent, depth)
-            self.mover.set_goal(
-                agent, self.graph.positions[target], int(self.graph.edge_kind[edge]), speed, top
-            )
+            taken, falls = take_decision(
+                self.state.kernel, agent, decision.action, speed, top,
+                max(1, int(decision.hold_ticks)), decision.plant, decision.defuse, self.tick,
+            )  # fmt: skip
+            self._falling += falls
+            if taken == Taken.NO_EDGE:  # held as a STOP, and recorded
+                data = {"action": decision.action}
+                self.events.append(SimEvent(self.tick, "invalid_action", agent, data=data))
+            elif taken > Taken.NO_EDGE:
+                raise ValueError(f"agent {agent} {REFUSED[Taken(taken)]}: {decision}")
 
     def _record(self) -> None:
-        rec = self.recording
-        while self._next_record < len(self._record_at) and (
-            self._record_at[self._next_record] <= self.tick
-        ):
-            k = self._next_record
-            if self._record_at[k] == self.tick:
-                rec.position[k] = self.agents.position
-                rec.yaw[k] = self.agents.yaw
-                rec.hp[k] = self.agents.hp
-                rec.alive[k] = self.agents.alive
-            self._next_record += 1
-        if self.done and not self._filled_after_end:
-            # the round ended: later samples keep the final state, unless the agents go on
-            # moving after the end (`step(after_end=True)`) and record over them
-            k = self._next_record
-            rec.position[k:] = self.agents.position
-            rec.yaw[k:] = self.agents.yaw
-            rec.hp[k:] = self.agents.hp
-            rec.alive[k:] = self.agents.alive
-            self._filled_after_end = True
+        self.recorder.take(self.tick, self.agents, self.done)

@@ -13,28 +13,27 @@ decision, exactly as `Simulator.run` plays it tick by tick. Choices come from ei
 It hands back to Python when anything else may follow: a damaging drop, the decision limit,
 the stretch's end, or a STOP to plant or defuse by an agent the bomb rules watch (the carrier;
 everyone once the bomb is planted). The engine takes over what the loop did
-(`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives.
+(`Simulator.note_quiet_play`), so the round is tick for tick what stepping gives. This module
+knows nothing of the engine: it works on the round's arrays (`round_state`). The same
+decisions (`decide_due`) serve the ticks the engine plays itself (`decide_tick`), with either
+mover.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import TYPE_CHECKING, Protocol
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 
 from decoy_cli.compiled import njit_cached
-from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.movement import KinematicMover
-from decoy_cli.sim.movement.kernels import begin_edge, kinematic_glide, stand_still
-from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
-from decoy_cli.sim.schedule import is_due, next_due, note_arrivals
+from decoy_cli.sim.decisions import Decision, Taken, take_decision
+from decoy_cli.sim.movement.kernels import kinematic_glide
+from decoy_cli.sim.round_state import RoundState, take_motion
+from decoy_cli.sim.schedule import is_due, next_due
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
-
-if TYPE_CHECKING:
-    from decoy_cli.sim.engine import Simulator
 
 
 class StretchEnd(IntEnum):
@@ -57,13 +56,17 @@ DRAW = -2
 """In `Choices.given`: the agent's action is drawn (-1: none handed in; 0..8: this action)."""
 
 
+@runtime_checkable
 class QuietPlayer(Protocol):
-    """A policy that plays quiet stretches itself (`Simulator.run` hands them over)."""
+    """A policy whose choices need no Python per decision: `Simulator.run` plays its quiet
+    stretches in compiled code (`play_stretch`) with its `Choices`."""
 
-    def play_quiet(
-        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
-    ) -> int:
-        """Play from `sim.tick` through at most `horizon`; returns how it ended (`_play`)."""
+    def choices_for(self, n: int) -> Choices:
+        """The choices of a round of `n` agents."""
+        ...
+
+    def refill(self) -> None:
+        """More draws after the rest of the current ones (`StretchEnd.NEED_DRAWS`)."""
         ...
 
 
@@ -96,6 +99,10 @@ class Choices:
     top_speeds: TopSpeeds = field(default_factory=TopSpeeds)
     _decisions: dict[tuple[bool, bool, int], Decision] = field(default_factory=dict)
 
+    def arrays(self, top: np.ndarray) -> ChoiceArrays:
+        """These choices and the agents' full speeds `top` (m/s) as compiled code takes them."""
+        return self.given, self.draws, self.plant, self.defuse, top, self.hold_ticks
+
     def decision(self, agent: int, action: int) -> Decision:
         """The engine's `Decision` of `action` by `agent`, as `_play` takes it: a move at full
         speed, or a STOP of `hold_ticks` that plants or defuses as the agent's flags say."""
@@ -109,32 +116,55 @@ class Choices:
         return found
 
 
+ChoiceArrays = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]
+"""`Choices.arrays`: given, draws, plant, defuse, top, hold_ticks (a tuple costs numba less to
+take than a struct, and the draws are replaced as they run out)."""
+
+
+class Stretch(NamedTuple):
+    """What `play_stretch` played, for the engine to take over (`Simulator.note_quiet_play`)."""
+
+    tick: int  # the tick it reached
+    made: int  # decisions made
+    falls: int  # damaging drops started
+    glided: bool  # whether the mover moved (the agents' positions are the mover's then)
+    status: StretchEnd
+
+
 def play_stretch(
-    sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray, choices: Choices
-) -> int:
-    """Play one quiet stretch of `sim` through at most `horizon` with `choices` (`_play`), hand
-    what it did to the engine and return how it ended; `choices.next_draw` moves on."""
-    graph, agents, mover = sim.graph, sim.agents, sim.mover
-    if not isinstance(mover, KinematicMover):
-        raise TypeError("compiled stretches need the kinematic mover")
+    state: RoundState, tick: int, horizon: int, decisions_left: int, watch: np.ndarray,
+    choices: Choices, weapons: np.ndarray,
+) -> Stretch:  # fmt: skip
+    """Play the quiet stretch of a round with the kinematic mover after `tick` through at most
+    `horizon` with `choices` (`_play`) and the agents' `weapons` (their full speeds), making at
+    most `decisions_left` decisions; `choices.next_draw` moves on."""
     if choices.hold_ticks < 1:
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
-    first, actions = graph.allowed_actions
-    pos, start, target, fv, iv, flags, params = mover.kernel_arrays()
-    top = choices.top_speeds.of(agents.weapon)
-    tick, used, made, falls, glide_end, status = _play(
-        sim.tick, horizon, choices.given, choices.draws, choices.next_draw, first, actions,
-        choices.hold_ticks, choices.plant, choices.defuse, max_decisions - sim.decision_count,
-        watch, top, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
-        graph.positions, agents.node, agents.alive, agents.yaw, sim.waiting, sim.hold_until,
-        sim.decisions, sim.wants_plant, sim.wants_defuse, sim.goal_node, sim.fall_m,
-        pos, start, target, fv, iv, flags, params, mover.jump_speed, mover.gravity,
-    )  # fmt: skip
+    c = choices.arrays(choices.top_speeds.of(weapons))
+    reached, used, made, falls, glide_end, status = _play(
+        state.kernel, c, tick, horizon, choices.next_draw, decisions_left, watch
+    )
     choices.next_draw = used
-    sim.note_quiet_play(tick, made, falls, glide_end >= 0)
-    if status == StretchEnd.AIRBORNE:
+    return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
+
+
+def decide_tick(
+    state: RoundState, tick: int, player: QuietPlayer, weapons: np.ndarray
+) -> tuple[int, int]:
+    """The decisions of the agents due at `tick` with `player`'s choices, in compiled code
+    (`decide_due`), for a tick the engine plays itself; returns the decisions made and the
+    change in the number of agents on a damaging drop."""
+    n = len(weapons)
+    choices = player.choices_for(n)
+    if len(choices.draws) - choices.next_draw < n:
+        player.refill()
+    c = choices.arrays(choices.top_speeds.of(weapons))
+    unwatched = np.zeros(n, np.bool_)  # no stretch to hand back
+    used, made, falls, _, airborne = decide_due(state.kernel, c, tick, choices.next_draw, unwatched)
+    choices.next_draw = used
+    if airborne:
         raise ValueError("an agent due for a decision is in the air")
-    return status
+    return made, falls
 
 
 @njit_cached
@@ -149,21 +179,65 @@ def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
 
 
 @njit_cached
-def _play(
-    tick, horizon, given, draws, next_draw, first, actions, hold_ticks, plant, defuse,
-    decisions_left, watch, top, out_edges, edge_target, edge_kind, edge_fall, positions,
-    node, alive, yaw, waiting, hold_until, decisions, wants_plant, wants_defuse, goal_node, fall_m,
-    pos, start, target, fv, iv, flags, prm, jump_speed, gravity,
-):  # fmt: skip
+def decide_due(r, c, tick, next_draw, watch):
+    """The decisions of the agents due at `tick` (ascending) on the round `r`
+    (`RoundState.kernel`), from `c` (`Choices.arrays`: draws from `next_draw` on, which must
+    last), each taken as it is made (`take_decision`). Returns (next draw, decisions made,
+    change in the number of agents on a damaging drop, whether one hands back (`hands_back`),
+    whether an agent asked to move is in the air, where it stops)."""
+    made = falls = 0
+    hand_back = False
+    # the fields read per agent, taken out of the structs once
+    waiting, alive, hold_until, node, first, actions = (
+        r.waiting,
+        r.alive,
+        r.hold_until,
+        r.node,
+        r.first,
+        r.actions,
+    )
+    given, draws, plant, defuse, top, hold_ticks = c
+    for a in range(alive.shape[0]):
+        if not is_due(a, waiting, alive, hold_until, tick):
+            continue
+        hold_until[a] = 0
+        waiting[a] = False
+        at = node[a]
+        act = given[a]
+        if act == DRAW:
+            pick = np.int64(draws[next_draw] * (first[at + 1] - first[at]))
+            act = actions[first[at] + pick]
+            next_draw += 1
+        else:
+            given[a] = -1  # used: the agent's next turn stops a stretch
+        made += 1
+        stop = act == STOP_ACTION
+        if hands_back(a, act, at, watch, plant, defuse, r.out_edges, r.edge_fall):
+            hand_back = True
+        wants_plant, wants_defuse = plant[a] and stop, defuse[a] and stop
+        speed = top[a]
+        taken, fell = take_decision(
+            r, a, act, speed, speed, hold_ticks, wants_plant, wants_defuse, tick
+        )
+        falls += fell
+        if taken == Taken.IN_THE_AIR:
+            return next_draw, made, falls, hand_back, True
+    return next_draw, made, falls, hand_back, False
+
+
+@njit_cached
+def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
-    tick: at each tick the due agents (ascending) decide (`Choices`), then if the tick after
-    them is quiet the motion glides to the next arrival or decision or the horizon. A handed-in
-    action must be 0..8 (`Choices`). Returns (tick, next draw,
-    decisions made, damaging drops started, tick of the last glide's end or -1, status)."""
+    tick, on the round `r` (`RoundState.kernel`): at each tick the due agents decide
+    (`decide_due`, `c`: `Choices.arrays`, draws from `next_draw` on), then if the tick after
+    them is quiet the motion glides to the next arrival or decision or the horizon.
+    A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
+    damaging drops started, tick of the last glide's end or -1, status)."""
+    given, draws, node, out_edges = c[0], c[1], r.node, r.out_edges
+    alive, waiting, hold_until = r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0
     glide_end = -1
-    one = np.empty(1, np.int64)
     while True:
         if tick + 1 > horizon:
             return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
@@ -179,53 +253,22 @@ def _play(
         if drawn > draws.shape[0] - next_draw:
             return tick, next_draw, made, falls, glide_end, StretchEnd.NEED_DRAWS
         tick += 1
-        hand_back = False
-        for a in range(n):
-            if not is_due(a, waiting, alive, hold_until, tick):
-                continue
-            hold_until[a] = 0
-            waiting[a] = False
-            at = node[a]
-            act = given[a]
-            if act == DRAW:
-                act = actions[first[at] + np.int64(draws[next_draw] * (first[at + 1] - first[at]))]
-                next_draw += 1
-            else:
-                given[a] = -1  # used: the agent's next turn stops the stretch
-            decisions[a] += 1
-            made += 1
-            stop = act == STOP_ACTION
-            wants_plant[a] = plant[a] and stop
-            wants_defuse[a] = defuse[a] and stop
-            if hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
-                hand_back = True
-            if stop:
-                one[0] = a
-                stand_still(one, fv, iv)
-                hold_until[a] = tick + hold_ticks
-                continue
-            edge = out_edges[at, act]
-            goal = edge_target[edge]
-            goal_node[a] = goal
-            if edge_fall[edge] > 0.0:
-                fall_m[a] = edge_fall[edge]
-                falls += 1
-            if not begin_edge(
-                a, positions[goal, 0], positions[goal, 1], positions[goal, 2], edge_kind[edge],
-                top[a], top[a], jump_speed, gravity, pos, target, fv, iv,
-            ):  # fmt: skip
-                return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
+        next_draw, now, fell, hand_back, airborne = decide_due(r, c, tick, next_draw, watch)
+        made += now
+        falls += fell
+        if airborne:
+            return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
         due_at = next_due(waiting, alive, hold_until, tick - 1)
         last = min(horizon, due_at - 1)
         if due_at == tick or last < tick:
             return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
+        flags = r.flags
         flags[:] = False
-        ticks, _ = kinematic_glide(pos, start, target, fv, iv, flags, prm, last - tick + 1)
+        ticks, _ = kinematic_glide(
+            r.mpos, r.start, r.target, r.fv, r.iv, flags, r.prm, last - tick + 1
+        )
         tick += ticks - 1
         glide_end = tick
-        for i in range(n):
-            if flags[R_MOVED, i]:
-                yaw[i] = fv[i, F_HEADING]
-        note_arrivals(flags[R_ARRIVED], alive, node, goal_node, waiting)
+        take_motion(r)

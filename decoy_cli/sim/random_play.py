@@ -2,9 +2,10 @@
 
 `RandomPolicy` picks a uniformly random possible action (`WaypointGraph.allowed_actions`) for
 each agent asked; a STOP holds `hold_ticks` and, if told, plants or defuses (the bomb rules
-let only a T carrier plant and a CT defuse). With the kinematic mover it plays whole quiet
-stretches in compiled code (`quiet_play`); its draws come from the generator in blocks, used in
-the same order either way, so the round is the same as deciding one agent at a time.
+let only a T carrier plant and a CT defuse). The engine makes its decisions in compiled code
+(`quiet_play.QuietPlayer`), with the kinematic mover whole quiet stretches of them; its draws
+come from the generator in blocks, used in the same order by `decide` (one agent at a time in
+Python, the reference the tests compare with), so the round is the same either way.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from decoy_cli.sim.decisions import Decision
-from decoy_cli.sim.quiet_play import DRAW, Choices, StretchEnd, play_stretch
+from decoy_cli.sim.quiet_play import DRAW, Choices
 
 if TYPE_CHECKING:
     from decoy_cli.sim.engine import Simulator
@@ -40,26 +41,15 @@ class RandomPolicy:
     def decide(self, sim: Simulator, agent: int) -> Decision:
         first, actions = sim.graph.allowed_actions
         node = int(sim.agents.node[agent])
-        choices = self._sized(sim.agents.count)
+        choices = self.choices_for(sim.agents.count)
         if choices.next_draw == len(choices.draws):
-            self._refill()
+            self.refill()
         count = int(first[node + 1] - first[node])
         pick = int(choices.draws[choices.next_draw] * count)
         choices.next_draw += 1
         return choices.decision(agent, int(actions[first[node] + pick]))
 
-    def play_quiet(
-        self, sim: Simulator, horizon: int, max_decisions: int, watch: np.ndarray
-    ) -> int:
-        """Play from `sim.tick` through at most `horizon` (`quiet_play.play_stretch`)."""
-        choices = self._sized(sim.agents.count)
-        while True:
-            status = play_stretch(sim, horizon, max_decisions, watch, choices)
-            if status != StretchEnd.NEED_DRAWS:
-                return status
-            self._refill()
-
-    def _sized(self, n: int) -> Choices:
+    def choices_for(self, n: int) -> Choices:
         """The choices for `n` agents: every action drawn, every STOP alike."""
         choices = self._choices
         if len(choices.given) != n:
@@ -68,7 +58,7 @@ class RandomPolicy:
             choices.defuse = np.full(n, self.defuse)
         return choices
 
-    def _refill(self) -> None:
+    def refill(self) -> None:
         """A new block after what is left of the current one."""
         choices = self._choices
         rest = choices.draws[choices.next_draw :]

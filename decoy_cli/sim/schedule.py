@@ -47,13 +47,3 @@ def next_due(waiting, alive, hold_until, tick):
         if 0 < hold_until[i] < first:
             first = hold_until[i]
     return max(first, tick + 1)
-
-
-@njit_cached
-def note_arrivals(arrived, alive, node, goal_node, waiting):
-    """Alive agents that arrived now stand on their goal node and wait for a decision."""
-    for i in range(arrived.shape[0]):
-        if arrived[i] and alive[i]:
-            node[i] = goal_node[i]
-            goal_node[i] = -1
-            waiting[i] = True

@@ -24,7 +24,8 @@ from typing import TYPE_CHECKING, Literal, get_args
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
 from decoy_cli.sim.engine import COMBAT_EVERY_TICKS, Policy, Simulator
-from decoy_cli.sim.movement import KinematicMover, Mover, PhysicsMover
+from decoy_cli.sim.movement import KinematicMover, PhysicsMover
+from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -136,7 +137,7 @@ def open_round(
         if setup.needs_physics and physics is None:
             physics = setup.open_physics()
             stack.callback(physics.close)
-        mover: Mover
+        mover: MoverBase
         if setup.mover == "physics":
             assert physics is not None
             physical = PhysicsMover(physics)

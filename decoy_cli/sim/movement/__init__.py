@@ -1,8 +1,8 @@
 """Moving agents along waypoint-graph edges, one physics tick at a time.
 
 The engine gives an agent a goal, one edge from the node it stands on to a neighbour, with the
-edge's kind and a speed, and calls `step()` once per tick. Two movers share one interface
-(`Mover`) and one edge-motion computation (`kernels.advance`, compiled with numba):
+edge's kind and a speed, and calls `step()` once per tick. Two movers share one interface and
+state (`MoverBase`) and one edge-motion computation (`kernels.advance`, compiled with numba):
 
 * `KinematicMover`: no collisions. Walk and step edges move the feet along the straight 3-D
   line from node to node (the height follows the ramp or climbs the ledge) at the speed, so the
@@ -28,16 +28,16 @@ floor passes under a bridge; floors of one cell are at least a player height apa
 vertically because the feet follow the edge line exactly and only a ramp's pursuit after a
 sidestep can leave them off it by a few centimetres.
 
-Modules: `interface` (`Mover`, `MoveStep`), `layout` (names of the packed state's slots),
-`kernels` (the shared edge motion, numba), `base` (state and goals both movers share),
+Modules: `interface` (`MoveStep`), `layout` (names of the packed state's slots), `kernels`
+(the shared edge motion, numba), `base` (`MoverBase`: the interface, state and goals),
 `kinematic` (`KinematicMover`), `collision` (the physics mover's agent-agent pass, numba),
 `physics` (`PhysicsMover`: pybullet bodies, world tests). Import the public names from here.
 """
 
 from __future__ import annotations
 
-from decoy_cli.sim.movement.base import DEFAULT_MAX_SPEED_M_S, LOOKAHEAD_M, ON_LINE_M
-from decoy_cli.sim.movement.interface import Mover, MoveStep
+from decoy_cli.sim.movement.base import DEFAULT_MAX_SPEED_M_S, LOOKAHEAD_M, ON_LINE_M, MoverBase
+from decoy_cli.sim.movement.interface import MoveStep
 from decoy_cli.sim.movement.kinematic import KinematicMover
 from decoy_cli.sim.movement.physics import ARRIVE_XY_M, ARRIVE_Z_M, PhysicsMover
 
@@ -49,6 +49,6 @@ __all__ = [
     "ON_LINE_M",
     "KinematicMover",
     "MoveStep",
-    "Mover",
+    "MoverBase",
     "PhysicsMover",
 ]

@@ -54,7 +54,8 @@ ON_LINE_M = 0.01
 
 
 class MoverBase:
-    """State and goal handling shared by both movers (one row per agent in every array)."""
+    """What every mover does, and the state and goal handling both share (one row per agent in
+    every array); the engine works on their packed state (`kernel_arrays`)."""
 
     def __init__(self, tick_rate: int = TICK_RATE) -> None:
         if tick_rate <= 0:
@@ -230,11 +231,15 @@ class MoverBase:
         return flags, out
 
     def step(self) -> MoveStep:
-        """Advance every agent by one tick."""
+        """Advance every agent by one tick. The `MoveStep` is the mover's own: the next `step`
+        or `glide` overwrites it (copy what you keep)."""
         return self.glide(1)[1]
 
     def glide(self, max_ticks: int) -> tuple[int, MoveStep]:
-        """Up to `max_ticks` ticks in one call (see `Mover.glide`); each mover computes it."""
+        """Advance up to `max_ticks` ticks in one call, stopping after the first tick in which an
+        agent arrives, is declared stuck or is teleported; returns the ticks advanced and that
+        last tick's `MoveStep` (`moved`: over all of them). Each tick is computed exactly as
+        `step` computes it; each mover computes it."""
         raise NotImplementedError
 
 

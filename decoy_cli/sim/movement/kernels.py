@@ -208,14 +208,3 @@ def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target
         fv[i, F_HEADING] = math.degrees(math.atan2(dy, dx))
     iv[i, I_RECOVER], iv[i, I_BLOCKED], iv[i, I_ATTEMPTS] = 0, 0, 0
     return True
-
-
-@njit_cached
-def stand_still(agents, fv, iv):
-    """The agents stop where they are, except those on a jump or drop edge, which land first
-    (`MoverBase.clear_goal` for several agents)."""
-    for k in range(agents.shape[0]):
-        i = agents[k]
-        if iv[i, I_PHASE] not in (RISE, GLIDE, FALL):
-            iv[i, I_PHASE] = IDLE
-            fv[i, F_CARRY] = 0.0
