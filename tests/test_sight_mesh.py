@@ -15,14 +15,14 @@ from both_teams import BothTeams, Mate
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
-from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.esta import read_match
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import CombatBatch, DamageResult
-from decoy_cli.sim.sight import read_sight_mesh
-from decoy_cli.waypoints.build import builtin_graph
-from decoy_cli.world.occlusion import OcclusionScene
+from decoy_cli.waypoints.build import builtin_graph, graph_world
+from decoy_cli.world.meshfile import write_obj
+from decoy_cli.world.occlusion import read_sight_scene
+from decoy_cli.world.world import World
 
 
 class AlwaysGrazes:
@@ -44,49 +44,28 @@ def facing() -> tuple[BothTeams, np.ndarray, np.ndarray]:
     return doc, graph.positions[int(a[0])], graph.positions[int(a[3])]
 
 
-def quad(corners: list[np.ndarray]) -> list[str]:
-    """Two triangles of an .obj face, corners in metres written in Hammer units."""
-    return [f"v {' '.join(f'{c / HAMMER_TO_M:.3f}' for c in corner)}" for corner in corners]
-
-
 def write_mesh(path: Path, wall_between: tuple[np.ndarray, np.ndarray] | None) -> Path:
-    """A floor 50 m under the map spanning its waypoints, and a wall across the middle of the
-    segment between two feet when given."""
-    positions = builtin_graph().positions
-    low, high = positions.min(axis=0) - 5.0, positions.max(axis=0) + 5.0
-    z = low[2] - 50.0
-    vertices = quad(
-        [
-            np.array(c)
-            for c in [
-                (low[0], low[1], z),
-                (high[0], low[1], z),
-                (high[0], high[1], z),
-                (low[0], high[1], z),
-            ]
-        ]
-    )
+    """The graph's own nav world as an .obj in Hammer units, with a wall 40 m wide and tall
+    across the middle of the segment between two feet when given."""
+    triangles = graph_world(builtin_graph()).triangles
     if wall_between is not None:
         a, b = wall_between
         middle = (a + b) / 2
         across = np.array([-(b - a)[1], (b - a)[0], 0.0])
         across = 20.0 * across / np.linalg.norm(across)
         up = np.array([0.0, 0.0, 20.0])
-        vertices += quad(
-            [middle - across - up, middle + across - up, middle + across + up, middle - across + up]
-        )
-    faces = [
-        f"f {4 * q + 1} {4 * q + 2} {4 * q + 3}\nf {4 * q + 1} {4 * q + 3} {4 * q + 4}"
-        for q in range(len(vertices) // 4)
-    ]
-    path.write_text("\n".join([*vertices, *faces]) + "\n")
+        corners = [middle - across - up, middle + across - up, middle + across + up]
+        far = middle - across + up
+        wall = np.array([corners, [corners[0], corners[2], far]])
+        triangles = np.concatenate([triangles, wall])
+    write_obj(World(triangles, name="test", source=str(path)), path)
     return path
 
 
 def hits(doc: BothTeams, tmp_path: Path, mesh: Path | None) -> int:
     round_ = read_match(doc.write(tmp_path / "m.json")).rounds[0]
     graph = builtin_graph()
-    scene = OcclusionScene(read_sight_mesh(mesh, graph)) if mesh is not None else None
+    scene = read_sight_scene(mesh, graph.positions, "de_dust2") if mesh is not None else None
     options = ReplayOptions(damage_model=AlwaysGrazes(), bomb=False, sight=scene)
     result = replay_round(round_, graph, options)
     return sum(e.kind == "damage" for e in result.events)
@@ -101,11 +80,23 @@ def test_a_wall_of_the_sight_mesh_blocks_what_the_nav_world_sees(tmp_path: Path)
     assert hits(doc, tmp_path, walled) == 0
 
 
-def test_a_mesh_that_does_not_span_the_map_is_refused(tmp_path: Path) -> None:
+def test_a_mesh_of_another_place_or_size_is_refused(tmp_path: Path) -> None:
+    feet = builtin_graph().positions
     small = tmp_path / "small.obj"
     small.write_text("v 0 0 0\nv 10 0 0\nv 0 10 0\nf 1 2 3\n")
-    with pytest.raises(WorldError, match="spans 0% of de_dust2's waypoints"):
-        read_sight_mesh(small, builtin_graph())
+    with pytest.raises(WorldError, match="a floor under 0% of de_dust2's waypoints"):
+        read_sight_scene(small, feet, "de_dust2")
+    huge = tmp_path / "huge.obj"
+    huge.write_text("v -1e30 -1e30 0\nv 1e30 -1e30 0\nv 0 1e30 0\nf 1 2 3\n")
+    with pytest.raises(WorldError, match="too large for a map"):
+        read_sight_scene(huge, feet, "de_dust2")
+    moved = tmp_path / "moved.obj"  # the right map, 10 m too high (another offset or version)
+    world = graph_world(builtin_graph())
+    write_obj(
+        World(world.triangles + np.array([0.0, 0.0, 10.0]), name="m", source=str(moved)), moved
+    )
+    with pytest.raises(WorldError, match="a floor under 0%"):
+        read_sight_scene(moved, feet, "de_dust2")
 
 
 def test_the_commands_take_it_name_it_and_refuse_a_bad_one(tmp_path: Path) -> None:
@@ -119,14 +110,20 @@ def test_the_commands_take_it_name_it_and_refuse_a_bad_one(tmp_path: Path) -> No
     )
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["line_of_sight_in"] == str(walled)
+    assert summary["line_of_sight_in"].startswith(f"{walled.resolve()} (sha256 ")
     small = tmp_path / "small.obj"
     small.write_text("v 0 0 0\nv 10 0 0\nv 0 10 0\nf 1 2 3\n")
     for command in (["replay", f"{match}:5"], ["evaluate", str(match)]):
         result = runner.invoke(app, [*command, "--sight-mesh", str(small), "--out", str(out)])
         assert result.exit_code == 1
         assert result.output.startswith("error: ") and result.output.count("\n") == 1
-        assert "spans 0%" in result.output
+        assert "a floor under 0%" in result.output
+    for command in (["replay", f"{match}:5"], ["evaluate", str(match)]):  # nothing to see for
+        for off in (["--no-combat"], ["--models", "none"]):
+            result = runner.invoke(app, [*command, *off, "--sight-mesh", str(walled)])
+            errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+            assert result.exit_code == 1 and len(errors) == 1
+            assert errors[0].startswith("error: a sight mesh is where line of sight")
     evaluated = tmp_path / "evaluated"
     result = runner.invoke(
         app,

@@ -34,7 +34,7 @@ from decoy_cli.evaluate.record import RoundRecord, build_record
 from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import PlaceFinder
-from decoy_cli.world.occlusion import OcclusionScene
+from decoy_cli.world.occlusion import OcclusionScene, read_sight_scene
 
 if TYPE_CHECKING:
     from decoy_cli.replay.replayer import ReplayResult
@@ -155,11 +155,9 @@ def run_sight(settings: EvalSettings, graph: WaypointGraph) -> OcclusionScene | 
     file the run hashed), else None (the graph's world)."""
     if not settings.sight_mesh:
         return None
-    from decoy_cli.sim.sight import read_sight_mesh
-
     if file_sha256(Path(settings.sight_mesh)) != settings.sight_mesh_sha:
         raise DecoyError(f"{settings.sight_mesh}: the mesh changed while the evaluation ran")
-    return OcclusionScene(read_sight_mesh(Path(settings.sight_mesh), graph))
+    return read_sight_scene(Path(settings.sight_mesh), graph.positions, settings.map_name)
 
 
 def worker_key(settings: EvalSettings) -> tuple[str, ...]:

@@ -86,14 +86,19 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
     warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
     if warnings:
         lines["model warnings"] = "; ".join(warnings)
-    if settings.models_fingerprint:
-        lines["line of sight in"] = (
-            f"{settings.sight_mesh} (sha256 {settings.sight_mesh_sha[:12]})"
-            if settings.sight_mesh
-            else "the nav world the graph was built on (approximate: no windows, props or low "
-            "cover; --sight-mesh gives the map's geometry)"
-        )
     return lines
+
+
+def sight_line(settings: EvalSettings) -> str | None:
+    """Where line of sight was tested, in words (None without shooting)."""
+    if not settings.models_fingerprint:
+        return None
+    if settings.sight_mesh:
+        return f"{settings.sight_mesh} (sha256 {settings.sight_mesh_sha[:12]})"
+    return (
+        "the nav world the graph was built on (approximate: no windows, props or low cover; "
+        "--sight-mesh gives the map's geometry)"
+    )
 
 
 def command_line(
@@ -276,6 +281,7 @@ def report_markdown(
         ],
         ["mechanics", mechanics(evaluation.settings)],
         *([name, text] for name, text in model_lines(settings).items()),
+        *([["line of sight in", sight]] if (sight := sight_line(settings)) else []),
         ["mover, seed", f"{settings.mover}, {settings.seed}"],
         ["ran on", f"{info.backend}; {info.machine}"],
         ["wall time", f"{evaluation.wall_seconds:.1f} s (before writing the outputs)"],

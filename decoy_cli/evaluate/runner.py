@@ -54,9 +54,10 @@ from decoy_cli.evaluate.settings import (
 from decoy_cli.evaluate.tables import Accumulator
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
-from decoy_cli.sim.setup import MoverName
+from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING, MoverName
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import place_names
+from decoy_cli.world.occlusion import read_sight_scene
 
 
 class Backend(Protocol):
@@ -143,14 +144,6 @@ def make_settings(
         graph_map = str(WaypointGraph.load(graph_path).meta.get("map", ""))
         if graph_map != name:
             raise GraphError(f"{graph}: a graph of {graph_map or 'no map'}, not {name} (--map)")
-    sight_path, sight_sha = "", ""
-    if sight_mesh is not None and combat:  # checked here: a wrong mesh fails once, at once
-        from decoy_cli.sim.sight import read_sight_mesh
-
-        sight_path = str(sight_mesh.expanduser().resolve())
-        sight_sha = file_sha256(Path(sight_path))
-        graph_of_run = WaypointGraph.load(graph_path) if graph_path else builtin_graph(name)
-        read_sight_mesh(Path(sight_path), graph_of_run)
     models_fingerprint = ""
     if combat:
         from decoy_cli.damage import SHIPPED_CHOICES, load_damage_model, resolve_models
@@ -159,6 +152,13 @@ def make_settings(
             models = str(resolve_models(models).resolve())
         if load_damage_model(models) is not None:
             models_fingerprint = folder_fingerprint(resolve_models(models))
+    sight_path, sight_sha = "", ""
+    if sight_mesh is not None:  # checked here: a wrong mesh fails once, at once
+        if not models_fingerprint:
+            raise DecoyError(SIGHT_WITHOUT_SHOOTING)
+        sight_path = str(sight_mesh.expanduser().resolve())
+        graph_of_run = WaypointGraph.load(graph_path) if graph_path else builtin_graph(name)
+        sight_sha = read_sight_scene(Path(sight_path), graph_of_run.positions, name).sha256
     return EvalSettings(
         map_name=name,
         combat=combat,

@@ -25,11 +25,11 @@ from decoy_cli.files import staged
 from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
-from decoy_cli.sim.sight import read_sight_mesh
+from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
-from decoy_cli.world.occlusion import OcclusionScene
+from decoy_cli.world.occlusion import read_sight_scene
 
 DEFAULT_REPLAY_OUT = Path("decoy-out") / "replay"
 
@@ -63,7 +63,7 @@ def replay_address(
     `models` names the damage models in the summary (None: no shooting). The round is replayed
     on its own map (the file's `mapName`); `map_name`, when given, must agree with it, and so
     must the map a `graph_file` was built for. `sight_mesh`: the map's geometry line of sight
-    is tested in when shooting (`read_sight_mesh`).
+    is tested in when shooting (`read_sight_scene`); without shooting it is an error.
     """
     if map_name is not None:
         map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
@@ -74,9 +74,12 @@ def replay_address(
     if graph_map and graph_map != map_id:
         raise DecoyError(f"{address}: a {map_id} round, but the graph {graph_file} is {graph_map}")
     sight = "the graph's world"
-    if sight_mesh is not None and options.combat:
-        options = replace(options, sight=OcclusionScene(read_sight_mesh(sight_mesh, graph)))
-        sight = str(sight_mesh)
+    if sight_mesh is not None:
+        if not options.combat:
+            raise DecoyError(SIGHT_WITHOUT_SHOOTING)
+        scene = read_sight_scene(sight_mesh, graph.positions, map_id)
+        options = replace(options, sight=scene)
+        sight = f"{sight_mesh.resolve()} (sha256 {scene.sha256[:12]})"
     started = time.perf_counter()
     result = replay_round(round_, graph, options)
     seconds = time.perf_counter() - started

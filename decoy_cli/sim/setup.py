@@ -41,6 +41,12 @@ and "physics" (pybullet capsules that block each other)."""
 MOVERS: tuple[MoverName, ...] = get_args(MoverName)
 
 
+SIGHT_WITHOUT_SHOOTING = (
+    "a sight mesh is where line of sight is tested for shooting: it needs combat and a damage "
+    "model (not --no-combat or --models none)"
+)
+
+
 class SetupError(DecoyError, ValueError):
     """A round setup that cannot be played (an unknown mover, a combat cadence below one tick)."""
 
@@ -66,7 +72,7 @@ class RoundSetup:
     in a replay whose deaths follow the data (`--deaths data`, the paper's protocol)."""
     world: World | None = None
     sight: OcclusionScene | None = None
-    """Geometry line of sight is tested in (a map's full geometry, `read_sight_mesh`); None:
+    """Geometry line of sight is tested in (a map's own geometry, `read_sight_scene`); None:
     the pybullet client's world."""
     rules: RulesConfig | None = None
     zones: SiteZones | None = None

@@ -28,19 +28,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M
-from decoy_cli.errors import WorldError
 from decoy_cli.sim.state import Agents
-from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.world.meshfile import read_mesh
 from decoy_cli.world.occlusion import OcclusionScene
 from decoy_cli.world.physics import WORLD_GROUP, PhysicsWorld
-from decoy_cli.world.world import World
 
 LOS_GROUP = 4
 """Collision group of the line-of-sight capsules: hit by this module's rays, touching nothing."""
@@ -60,35 +55,13 @@ class VisiblePairs:
         return len(self.attacker)
 
 
-SIGHT_MESH_COVERAGE = 0.99
-"""Share of a map's waypoints a sight mesh must span (horizontally) to be taken for that map."""
-
-
-def read_sight_mesh(path: Path, graph: WaypointGraph) -> World:
-    """A map's geometry for line of sight: an awpy-style `.tri` or an `.obj` in Hammer units,
-    z up (`read_mesh`), refused (`WorldError`) when it does not span the graph's waypoints, as
-    a mesh of another map or in other units would not. The nav world sight is tested in by
-    default lacks windows, props and low cover; real geometry sees what the players saw."""
-    world = read_mesh(path)
-    low, high = world.bounds
-    feet = graph.positions[:, :2]
-    inside = float(np.mean(np.all((feet >= low[:2]) & (feet <= high[:2]), axis=1)))
-    if inside < SIGHT_MESH_COVERAGE:
-        name = graph.meta.get("map") or "the map"
-        raise WorldError(
-            f"{path}: spans {inside:.0%} of {name}'s waypoints: a mesh of another map, or not "
-            "in Hammer units with z up"
-        )
-    return world
-
-
 class LineOfSight:
     """Eye-to-eye visibility of alive enemies, blocked by the world and by other agents' bodies.
 
     Holds `count` upright capsules (radius and full height in metres, standing on the feet) in
     the physics client, one per agent; eyes are `eye_height` above the feet, inside the capsule.
     `scene` tests the world part of a sight line against other geometry than the physics
-    client's (a map's full geometry: `read_sight_mesh`); None: the physics world's.
+    client's (a map's own geometry: `read_sight_scene`); None: the physics world's.
     """
 
     def __init__(

@@ -16,11 +16,19 @@ precision (`benchmarks/occlusion_agreement.py` measures how often).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 from decoy_cli.compiled import njit_cached
+from decoy_cli.errors import WorldError
+from decoy_cli.world.meshfile import MAX_EXTENT_M, read_mesh
 from decoy_cli.world.world import World
+
+SIGHT_FLOOR_SHARE = 0.8
+"""Share of a map's waypoints a sight mesh must have a floor under (from 0.5 m above the feet
+to 1 m below) to be taken for that map's geometry: chosen, not measured; a mesh of the map in
+its units has nearly every waypoint on its floors, one of another map or in other units few."""
 
 
 class OcclusionScene:
@@ -31,6 +39,8 @@ class OcclusionScene:
         from embreex.mesh_construction import TriangleMesh
 
         low, high = world.bounds
+        self.source = world.source
+        self.sha256 = str(world.meta.get("file_sha256", ""))
         self.origin = (low + high) / 2.0
         self._scene = rtcore_scene.EmbreeScene()
         TriangleMesh(self._scene, (world.triangles - self.origin).astype(np.float32))
@@ -48,6 +58,27 @@ class OcclusionScene:
         origins, directions, lengths = _rays(starts, ends, self.origin)
         occluded = self._scene.run(origins, directions, dists=lengths, query="OCCLUDED")
         return np.asarray(occluded) == -1
+
+
+def read_sight_scene(path: Path, feet: np.ndarray, map_name: str) -> OcclusionScene:
+    """A map's own geometry for line of sight, from an awpy-style `.tri` or an `.obj` in Hammer
+    units, z up (`read_mesh`). Refused (`WorldError`) when it is larger than a map or when fewer
+    than `SIGHT_FLOOR_SHARE` of the map's waypoints (`feet`, metres) have a floor of it under
+    them, as a mesh of another map or in other units would not."""
+    world = read_mesh(path)
+    low, high = world.bounds
+    width = float(np.max(high[:2] - low[:2]))
+    if width > MAX_EXTENT_M:
+        raise WorldError(f"{path}: the mesh is {width:.4g} m across, too large for a map")
+    scene = OcclusionScene(world)
+    up, down = np.array([0.0, 0.0, 0.5]), np.array([0.0, 0.0, 1.0])
+    share = float(np.mean(~scene.clear(feet + up, feet - down))) if len(feet) else 0.0
+    if share < SIGHT_FLOOR_SHARE:
+        raise WorldError(
+            f"{path}: a floor under {share:.0%} of {map_name}'s waypoints: a mesh of another "
+            "map, or not in Hammer units with z up"
+        )
+    return scene
 
 
 @njit_cached
