@@ -231,7 +231,7 @@ def test_hit_group_from_hp_lost_by_the_rules() -> None:
     np.testing.assert_allclose(kill[:5], p[:5] / p[:5].sum())
     assert group_posterior(prior, "AK-47", 0.0, 10, 100, armored=False) is None
     # 33 HP: no group within 1 HP; weighed by closeness (15% of the rule damage per spread):
-    # 36 (neck, chest, arm) is 0.56 spreads off, 27 (leg) 1.48, 45 (stomach) 2.67, 144 beyond 3
+    # 36 (neck, chest, arm) is 0.56 spreads off, 27 (leg) 1.48, 45 (stomach) 1.78, 144 beyond 3
     near = group_posterior(prior, "AK-47", 0.0, 33, 100, armored=False)
     assert near is not None and near[GROUPS.index("Head")] == 0
     z = {"Chest": 3 / (0.15 * 36), "Leg": 6 / (0.15 * 27), "Stomach": 12 / (0.15 * 45)}

@@ -71,7 +71,8 @@ def test_the_shipped_choices_decide_by_the_dip_of_the_map(shipped: Path, choice:
     for elsewhere in ("de_ancient", "de_nuke"):  # the map-independent one never does
         result = model(on_map(elsewhere), rng)
         assert not result.hit.any() and not result.damage.any()
-    assert dip_for_map(choice, "de_dust2") == dip_for_map(choice, "de_dust2")
+    unarmed = dataclasses.replace(on_map("de_dust2"), attacker_weapon=np.full(12, "", dtype=object))
+    assert not model(unarmed, rng).hit.any()  # a DIP that always fires: no weapon, no hit
     assert dip_for_map(choice, "de_dust2").folder == shipped
     assert dip_for_map(choice, "de_ancient").folder == shipped / ANY_MAP
 

@@ -127,13 +127,11 @@ def load_damage_model(choice: str) -> DamageModel | None:
     folder = resolve_models(choice)
     from decoy_cli.damage.combat import LearnedDamage, StandIn
     from decoy_cli.damage.model_folder import load_dip, load_dog
-    from decoy_cli.damage.model_maps import any_map_folder, trained_maps
+    from decoy_cli.damage.model_maps import stand_in_of
     from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
-    stand_in = None
-    fallback = any_map_folder()
-    if choice in SHIPPED_CHOICES and fallback is not None:
-        stand_in = StandIn(load_dip(fallback), frozenset(trained_maps(folder, "dip") or []))
+    found = stand_in_of(choice)
+    stand_in = StandIn(load_dip(found[0]), found[1]) if found is not None else None
     if damages_by_rules(choice, folder):
         return RulesDamage(load_dip(folder), RulesFile.load(folder), stand_in=stand_in)
     return LearnedDamage(load_dip(folder), load_dog(folder), stand_in=stand_in)

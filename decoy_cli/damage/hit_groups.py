@@ -159,7 +159,7 @@ map's version may deal a little less; chosen a priori)."""
 
 MAX_MISS_SPREADS = 3.0
 """A non-lethal hit further than this many spreads from every group's rule damage is left
-unexplained (a shot through something)."""
+unexplained (a shot through something; chosen a priori)."""
 
 
 def group_posterior(

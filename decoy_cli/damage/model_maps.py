@@ -40,19 +40,30 @@ def any_map_folder() -> Path | None:
     return folder if (folder / "dip.json").is_file() else None
 
 
+def stand_in_of(choice: str) -> tuple[Path, frozenset[str]] | None:
+    """(the folder of the DIP that stands in off the choice's own DIP's maps, those maps) for
+    the shipped choices when the map-independent DIP (`ANY_MAP`) is installed; None otherwise
+    (a user's folder keeps its DIP everywhere). The one rule `dip_for_map` and the loaded
+    models (`load_damage_model`) follow."""
+    from decoy_cli.damage import SHIPPED_CHOICES, resolve_models
+
+    fallback = any_map_folder()
+    if choice not in SHIPPED_CHOICES or fallback is None:
+        return None
+    return fallback, frozenset(trained_maps(resolve_models(choice), "dip") or [])
+
+
 def dip_for_map(choice: str, map_name: str) -> MapDip:
     """The DIP that decides hits on `map_name` for a `--models` choice (not "none"): the
-    choice's own; for the shipped choices on a map their DIP was not trained on, the
-    map-independent one (`ANY_MAP`) when it is installed."""
-    from decoy_cli.damage import SHIPPED_CHOICES, SHIPPED_MODELS, resolve_models
+    choice's own, or off its maps the stand-in (`stand_in_of`)."""
+    from decoy_cli.damage import SHIPPED_MODELS, resolve_models
 
     folder = resolve_models(choice)
-    if choice in SHIPPED_CHOICES:
-        fallback = any_map_folder()
-        if fallback is not None and map_name not in (trained_maps(folder, "dip") or []):
-            return MapDip(
-                fallback, f"the map-independent DIP of the shipped models ({ANY_MAP})", True
-            )
+    stand_in = stand_in_of(choice)
+    if stand_in is not None and map_name not in stand_in[1]:
+        return MapDip(
+            stand_in[0], f"the map-independent DIP of the shipped models ({ANY_MAP})", True
+        )
     name = "the shipped models" if folder == SHIPPED_MODELS else str(folder)
     return MapDip(folder, f"the DIP of {name}", False)
 
