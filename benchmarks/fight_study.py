@@ -1,6 +1,7 @@
 """Where the simulated fights of real rounds of both teams part from the real ones.
 
     python benchmarks/fight_study.py FILE|FOLDER... [--models rules] [--mesh MESH.tri] [--seed S]
+        [--sight-mesh MESH.tri]
 
 For every real firearm kill of the rounds (both teams in the frames):
 
@@ -48,6 +49,7 @@ from decoy_cli.sim.setup import open_round
 from decoy_cli.waypoints.build import builtin_graph, graph_world
 from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.meshfile import read_mesh
+from decoy_cli.world.occlusion import read_sight_scene
 from decoy_cli.world.physics import PhysicsWorld
 
 EYE = np.array([0.0, 0.0, EYE_HEIGHT_M])
@@ -75,7 +77,7 @@ def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:
     return bool(model.decision.hit_probability(batch)[0] >= model.decision.threshold)
 
 
-def sightings(round_, graph, model) -> list[tuple[float, set[tuple[int, int]]]]:
+def sightings(round_, graph, model, sight) -> list[tuple[float, set[tuple[int, int]]]]:
     """(seconds, visible ordered pairs) of every combat step of a replay of `round_` whose
     deaths follow the data."""
     steps: list[tuple[float, set[tuple[int, int]]]] = []
@@ -99,7 +101,7 @@ def sightings(round_, graph, model) -> list[tuple[float, set[tuple[int, int]]]]:
                 sim.combat.run = run
             yield sim
 
-    options = ReplayOptions(damage_model=model, deaths="data")
+    options = ReplayOptions(damage_model=model, deaths="data", sight=sight)
     replay_round(round_, graph, options, open_sim=watching)
     return steps
 
@@ -110,8 +112,12 @@ def main() -> None:
     parser.add_argument("--models", default="rules")
     parser.add_argument("--mesh", type=Path)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--sight-mesh", type=Path, help="line of sight of the replays in it")
     args = parser.parse_args()
     graph = builtin_graph()
+    sight = None
+    if args.sight_mesh:  # the replays' line of sight (evaluate's --sight-mesh)
+        sight = read_sight_scene(args.sight_mesh, graph.positions, "de_dust2")
     zones = SiteZones.from_graph(graph)
     model = load_damage_model(args.models)
     worlds = {"nav world": PhysicsWorld(graph_world(graph))}
@@ -130,7 +136,7 @@ def main() -> None:
         if isinstance(round_, RoundFailure) or len(round_.side_indices("CT")) == 0:
             continue
         filled = fill_missing(round_, zones, RulesConfig(), "infer").round
-        options = ReplayOptions(damage_model=model, seed=args.seed)
+        options = ReplayOptions(damage_model=model, seed=args.seed, sight=sight)
         result = replay_round(round_, graph, options)
         truth = result.data_deaths
         replay = replay_deaths(result.events, round_.num_players)
@@ -139,7 +145,7 @@ def main() -> None:
             if event.kind == "damage":
                 hit_at.setdefault((event.agent, event.other), event.tick / 60)
         rows = {p.name: i for i, p in enumerate(round_.players)}
-        steps = sightings(round_, graph, model)
+        steps = sightings(round_, graph, model, sight)
         for kill in round_.kills.itertuples():
             a, v = rows.get(kill.attackerName, -1), rows.get(kill.victimName, -1)
             if a < 0 or v < 0 or kill.weapon not in FIREARMS:
