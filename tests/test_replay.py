@@ -25,14 +25,9 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round, RoundClock
 from decoy_cli.esta.frames import PlayerInfo
 from decoy_cli.metrics import METRIC_NAMES, METRIC_NAMES_CLOCK, player_metrics
+from decoy_cli.replay.lateness import LATE_CAUSES, stretch_causes
 from decoy_cli.replay.plans import PlayerPlan
-from decoy_cli.replay.replayer import (
-    LATE_CAUSES,
-    ReplayOptions,
-    ReplayResult,
-    replay_round,
-    stretch_causes,
-)
+from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
 from decoy_cli.replay.snapping import SnapStatus
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import BOMB_TARGET_BOXES, RulesConfig, SiteZones
