@@ -155,9 +155,10 @@ def run_sight(settings: EvalSettings, graph: WaypointGraph) -> OcclusionScene | 
     file the run hashed), else None (the graph's world)."""
     if not settings.sight_mesh:
         return None
-    if file_sha256(Path(settings.sight_mesh)) != settings.sight_mesh_sha:
+    scene = read_sight_scene(Path(settings.sight_mesh), graph.positions, settings.map_name)
+    if scene.sha256 != settings.sight_mesh_sha:
         raise DecoyError(f"{settings.sight_mesh}: the mesh changed while the evaluation ran")
-    return read_sight_scene(Path(settings.sight_mesh), graph.positions, settings.map_name)
+    return scene
 
 
 def worker_key(settings: EvalSettings) -> tuple[str, ...]:

@@ -138,10 +138,12 @@ def make_settings(
 
     name = canonical_map(map_name)
     graph_path, graph_sha = "", ""
+    graph_of_run = None
     if graph is not None:  # absolute, for workers elsewhere; its map must be the run's
         graph_path = str(graph.expanduser().resolve())
         graph_sha = file_sha256(Path(graph_path))
-        graph_map = str(WaypointGraph.load(graph_path).meta.get("map", ""))
+        graph_of_run = WaypointGraph.load(graph_path)
+        graph_map = str(graph_of_run.meta.get("map", ""))
         if graph_map != name:
             raise GraphError(f"{graph}: a graph of {graph_map or 'no map'}, not {name} (--map)")
     models_fingerprint = ""
@@ -157,8 +159,8 @@ def make_settings(
         if not models_fingerprint:
             raise DecoyError(SIGHT_WITHOUT_SHOOTING)
         sight_path = str(sight_mesh.expanduser().resolve())
-        graph_of_run = WaypointGraph.load(graph_path) if graph_path else builtin_graph(name)
-        sight_sha = read_sight_scene(Path(sight_path), graph_of_run.positions, name).sha256
+        feet = (graph_of_run or builtin_graph(name)).positions
+        sight_sha = read_sight_scene(Path(sight_path), feet, name).sha256
     return EvalSettings(
         map_name=name,
         combat=combat,

@@ -259,6 +259,7 @@ def replay_round(
     weapon_frames = np.asarray(round_.weapon)
     kit_frames = np.asarray(round_.has_defuser, dtype=bool)
     present = np.asarray(round_.present, dtype=bool)
+    alive_frames = np.asarray(round_.alive, dtype=bool)
     frame_of_tick = {int(t): f for f, t in enumerate(frame_ticks)}
     end_tick = int(frame_ticks[-1])
     with open_sim(
@@ -281,7 +282,6 @@ def replay_round(
         dying = [i for i, p in enumerate(plan.plans) if p.death_frame >= 0]
         deaths = {i: tick_at(truth.seconds[i] + grace) for i in dying}
         disarm = {i: tick_at(truth.seconds[i]) for i in dying} if grace else {}
-        unarmed: set[int] = set()
         # The replay follows the data to its last frame: a round the rules end earlier (the
         # clock, the bomb) goes on moving through the round-end delay, as the real players
         # did, with the outcome as decided (`Simulator.step(after_end=True)`).
@@ -295,9 +295,8 @@ def replay_round(
                     sim.kill(i, "scripted")
                     scripted[i] = True
             for i, tick in disarm.items():
-                if tick <= sim.tick + 1 and i not in unarmed:
+                if tick <= sim.tick + 1:
                     agents.weapon[i] = NO_WEAPON
-                    unarmed.add(i)
             stop = int(frame_ticks[np.searchsorted(frame_ticks, sim.tick, side="right")])
             for i, tick in [*deaths.items(), *disarm.items()]:
                 if agents.alive[i] and tick > sim.tick + 1:
@@ -311,7 +310,7 @@ def replay_round(
                     i = int(alive)
                     if present[i, f]:
                         agents.has_defuser[i] = kit_frames[i, f]
-                    if weapon_frames[i, f] and i not in unarmed:
+                    if weapon_frames[i, f] and alive_frames[i, f]:  # the dead hold nothing
                         agents.weapon[i] = weapon_frames[i, f]
                         sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
         played_from = sim.tick
