@@ -68,10 +68,15 @@ def dip_for_map(choice: str, map_name: str) -> MapDip:
     return MapDip(folder, f"the DIP of {name}", False)
 
 
+def part_file(folder: Path, part: str) -> Path:
+    """The file of a model folder's `part` ("dip", "dog" or "rules")."""
+    return folder / (RULES_FILE if part == "rules" else f"{part}.json")
+
+
 def trained_maps(folder: Path, part: str) -> list[str] | None:
     """The maps the folder's `part` ("dip", "dog" or "rules") was trained on; None when its
     file does not say (or cannot be read: loading it reports that)."""
-    path = folder / (RULES_FILE if part == "rules" else f"{part}.json")
+    path = part_file(folder, part)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
         maps = data["provenance" if part == "rules" else "metadata"]["maps"]
@@ -100,7 +105,7 @@ def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
         parts["dog"] = "DOG (how much damage)"
     lines = _fallback_lines(choice, used)
     for part, what in parts.items():
-        if not (folder / (RULES_FILE if part == "rules" else f"{part}.json")).is_file():
+        if not part_file(folder, part).is_file():
             continue
         # the maps where the part is used: the DIP's are not those where another stands in
         where = [m for m in used if part != "dip" or not dip_for_map(choice, m).fallback]
