@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING
 import msgspec
 import numpy as np
 
+from decoy_cli.compiled import njit_cached
+
 if TYPE_CHECKING:
     from decoy_cli.esta import Round
     from decoy_cli.replay.replayer import ReplayResult
@@ -76,19 +78,32 @@ def thin(times: np.ndarray, points: np.ndarray, tolerance: float = THIN_M) -> np
     n = len(times)
     if n <= 2:
         return np.arange(n)
-    keep = [0]
+    keep = _thin(np.asarray(times, np.float64), np.asarray(points, np.float64), float(tolerance))
+    return np.flatnonzero(keep)
+
+
+@njit_cached
+def _thin(times, points, tolerance):
+    """`thin`'s greedy sweep, compiled: a player standing still for long makes the window from
+    the last kept frame long, and each step checks every frame in it."""
+    n = times.shape[0]
+    keep = np.zeros(n, np.bool_)
+    keep[0] = True
+    keep[n - 1] = True
     anchor = 0
-    end = 2
-    while end < n:
-        inner = np.arange(anchor + 1, end)
-        share = (times[inner] - times[anchor]) / max(times[end] - times[anchor], 1e-9)
-        guess = points[anchor] + share[:, None] * (points[end] - points[anchor])
-        if np.max(np.linalg.norm(points[inner] - guess, axis=1)) > tolerance:
-            anchor = end - 1
-            keep.append(anchor)
-        end += 1
-    keep.append(n - 1)
-    return np.asarray(keep)
+    for end in range(2, n):
+        span = max(times[end] - times[anchor], 1e-9)
+        for k in range(anchor + 1, end):
+            share = (times[k] - times[anchor]) / span
+            error = 0.0
+            for d in range(points.shape[1]):
+                guess = points[anchor, d] + share * (points[end, d] - points[anchor, d])
+                error += (points[k, d] - guess) ** 2
+            if error > tolerance * tolerance:
+                anchor = end - 1
+                keep[anchor] = True
+                break
+    return keep
 
 
 def encode_path(seconds: np.ndarray, position: np.ndarray, shown: np.ndarray) -> list[list[int]]:
