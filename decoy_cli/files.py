@@ -13,15 +13,21 @@ import math
 import os
 import shutil
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.text import csv_inert
+
+JsonValue: TypeAlias = "str | int | float | bool | list[JsonValue] | dict[str, JsonValue] | None"
+"""What a JSON file holds, as `json.loads` returns it."""
+
+JsonObject: TypeAlias = "dict[str, JsonValue]"
+"""A JSON object: what the outputs' JSON files are."""
 
 
 def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> Path:
@@ -86,7 +92,7 @@ def staged(folder: str | Path) -> Iterator[Path]:
         ) from None
 
 
-def json_ready(value: Any) -> Any:
+def json_ready(value: object) -> JsonValue:
     """`value` as strict JSON data: NaN and infinities as null (strict JSON has neither), numpy
     scalars and arrays as Python numbers and lists, paths as strings, tuples as lists."""
     if isinstance(value, np.ndarray):
@@ -101,20 +107,33 @@ def json_ready(value: Any) -> Any:
         return [json_ready(v) for v in value]
     if isinstance(value, Path):
         return str(value)
-    return value
+    if value is None or isinstance(value, str | int | float):
+        return value
+    raise TypeError(f"not JSON data: {type(value).__name__}")
 
 
-def json_text(data: Any, *, sort_keys: bool = True) -> str:
+def json_object(value: Mapping[str, object]) -> JsonObject:
+    """`json_ready` of a mapping: a JSON object."""
+    return {str(k): json_ready(v) for k, v in value.items()}
+
+
+def object_at(data: JsonObject, key: str) -> JsonObject:
+    """The JSON object under `key` of `data`; an empty one when there is none."""
+    value = data.get(key)
+    return value if isinstance(value, dict) else {}
+
+
+def json_text(data: object, *, sort_keys: bool = True) -> str:
     """Pretty strict JSON of `data` (see `json_ready`), ending in a newline."""
     return json.dumps(json_ready(data), indent=2, sort_keys=sort_keys, allow_nan=False) + "\n"
 
 
-def write_json(path: str | Path, data: Any, *, sort_keys: bool = True) -> Path:
+def write_json(path: str | Path, data: object, *, sort_keys: bool = True) -> Path:
     """Write `data` as pretty strict JSON, atomically: the one JSON writer of every output."""
     return write_atomic(path, json_text(data, sort_keys=sort_keys).encode())
 
 
-def read_json_object(path: Path, written_by: str) -> dict[str, Any]:
+def read_json_object(path: Path, written_by: str) -> JsonObject:
     """The JSON object a command wrote to `path` (`written_by`: "`decoy replay`", ...); a
     missing, unreadable or other file is one DecoyError line saying so."""
     try:

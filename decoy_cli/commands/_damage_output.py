@@ -5,9 +5,9 @@ paper's values."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Literal
 
 from rich.console import Console
 from rich.progress import (
@@ -21,8 +21,10 @@ from rich.progress import (
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG
+from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG, DogMetrics
+from decoy_cli.damage.hp_lost import HpLostScores
 from decoy_cli.damage.sample_set import SampleStats
+from decoy_cli.damage.scores import CellRecord
 
 if TYPE_CHECKING:
     from decoy_cli.damage.training import Progress as TrainingProgress
@@ -123,7 +125,7 @@ def print_samples(console: Console, samples: int, stats: SampleStats) -> None:
         )
 
 
-def _number(value: Any, digits: int = 3) -> str:
+def _number(value: float | None, digits: int = 3) -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
     if isinstance(value, int):
@@ -131,7 +133,7 @@ def _number(value: Any, digits: int = 3) -> str:
     return f"{value:.{digits}f}"
 
 
-def dip_table(metrics: dict[str, Any], title: str) -> Table:
+def dip_table(metrics: Mapping[str, float], title: str) -> Table:
     """DIP's metrics beside the paper's."""
     table = Table(title=title)
     for column in ("metric", "value", "paper"):
@@ -156,12 +158,22 @@ def dip_table(metrics: dict[str, Any], title: str) -> Table:
     return table
 
 
-def dog_table(metrics: dict[str, Any], title: str) -> Table:
+_DogFigure = Literal[
+    "damage_mae_hp",
+    "damage_r2",
+    "hit_group_accuracy",
+    "hit_group_accuracy_generated",
+    "mean_wasserstein_hp",
+    "wasserstein_all_hp",
+]
+
+
+def dog_table(metrics: DogMetrics, title: str) -> Table:
     """DOG's metrics beside the paper's."""
     table = Table(title=title)
     for column in ("metric", "value", "paper"):
         table.add_column(column, justify="left" if column == "metric" else "right")
-    rows = (
+    rows: tuple[tuple[str, _DogFigure | None, int], ...] = (
         ("damage MAE, reconstruction (HP)", "damage_mae_hp", 2),
         ("damage R², reconstruction", "damage_r2", 3),
         ("hit-group accuracy, reconstruction", "hit_group_accuracy", 3),
@@ -184,12 +196,12 @@ def dog_table(metrics: dict[str, Any], title: str) -> Table:
         "–",
     )
     table.add_row("damaging samples", f"{metrics['samples']:,}", "–")
-    for weapon, tv in metrics.get("hit_group_tv", {}).items():
+    for weapon, tv in metrics["hit_group_tv"].items():
         table.add_row(f"hit-group total variation, {weapon}", _number(tv, 3), "–")
     return table
 
 
-def cells_table(cells: list[dict[str, Any]]) -> Table:
+def cells_table(cells: Sequence[CellRecord]) -> Table:
     """The (weapon, hit group) cells of the Wasserstein mean."""
     table = Table(title="generated vs real damage per cell")
     for column in ("weapon", "hit group", "real", "generated", "Wasserstein (HP)"):
@@ -205,7 +217,7 @@ def cells_table(cells: list[dict[str, Any]]) -> Table:
     return table
 
 
-def hp_lost_table(scores: dict[str, dict[str, Any]], title: str) -> Table:
+def hp_lost_table(scores: dict[str, dict[str, HpLostScores]], title: str) -> Table:
     """HP lost drawn against real, per unit (step, hit) and map (`damage.hp_lost`)."""
     table = Table(title=title)
     columns = ("unit", "map", "n", "real", "drawn", "bias", "W", "max W", "floor", "cells")

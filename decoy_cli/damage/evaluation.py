@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
 
@@ -40,6 +40,7 @@ from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
 from decoy_cli.damage.scores import (
     MIN_CELL,
     Cell,
+    CellRecord,
     classification_metrics,
     hit_group_tv,
     regression_metrics,
@@ -109,11 +110,30 @@ def evaluate_dip(dip: LoadedDip, samples: Samples, threshold: float | None = Non
     return DipEvaluation(metrics, samples.hit.copy(), probabilities)
 
 
+class DogMetrics(TypedDict):
+    """DOG's metrics (module docstring), as `evaluate_dog` reports them."""
+
+    samples: int
+    damage_mae_hp: float
+    damage_r2: float
+    hit_group_accuracy: float
+    hit_group_accuracy_generated: float
+    generated_mean_damage_hp: float
+    real_mean_damage_hp: float
+    wasserstein_all_hp: float
+    mean_wasserstein_hp: float
+    wasserstein_cells: int
+    hit_group_tv: dict[str, float]
+    min_cell: int
+    draws: int
+    cells: list[CellRecord]
+
+
 @dataclass(frozen=True)
 class DogEvaluation:
     """DOG's metrics on positive samples and the values behind them (damage in HP)."""
 
-    metrics: dict[str, Any]
+    metrics: DogMetrics
     real_damage: np.ndarray
     real_group: np.ndarray
     weapon: np.ndarray
@@ -205,7 +225,7 @@ def evaluate_dog(
         min_cell,
     )
     regression = regression_metrics(real, reconstructed)
-    metrics: dict[str, Any] = {
+    metrics: DogMetrics = {
         "samples": len(positives),
         "damage_mae_hp": regression["mae"],
         "damage_r2": regression["r2"],
@@ -223,7 +243,7 @@ def evaluate_dog(
         ),
         "min_cell": min_cell,
         "draws": draws,
-        "cells": [c.__dict__ for c in cells],
+        "cells": [c.record() for c in cells],
     }
     return DogEvaluation(
         metrics,

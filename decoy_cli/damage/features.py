@@ -54,12 +54,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import ModelError
+from decoy_cli.files import JsonObject
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch
 
 MAPS: tuple[str, ...] = (
@@ -175,7 +175,7 @@ class FeatureSpec:
         object.__setattr__(self, "half_extent_m", half)
         object.__setattr__(self, "distance_scale_m", scale)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> JsonObject:
         """The spec as a JSON-ready dict (the constants only for normalised units)."""
         if self.units == "hammer":
             return {"units": "hammer"}
@@ -187,7 +187,7 @@ class FeatureSpec:
         }
 
     @classmethod
-    def from_json(cls, data: Any) -> FeatureSpec:
+    def from_json(cls, data: object) -> FeatureSpec:
         """The spec of a `to_json` dict; anything else is a ModelError."""
         if not isinstance(data, dict) or "units" not in data:
             raise ModelError("feature spec must be an object with 'units'")

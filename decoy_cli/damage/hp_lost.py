@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.hit_groups import DISTANCE_BANDS_U
 from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.scores import MIN_CELL, keyed_cells, sampling_floor
+from decoy_cli.damage.scores import MIN_CELL, CellRecord, keyed_cells, sampling_floor
 
 if TYPE_CHECKING:
     from decoy_cli.damage.model_folder import LoadedDog
@@ -80,6 +80,12 @@ def drawn_hp_lost(damage: np.ndarray, victim_hp: np.ndarray) -> np.ndarray:
     return np.minimum(damage, np.maximum(np.asarray(victim_hp, np.float64), 1.0)[None, :])
 
 
+class HpCellRecord(CellRecord):
+    """A cell of `HpLostScores`, with its sampling floor."""
+
+    floor_hp: float
+
+
 @dataclass(frozen=True)
 class HpLostScores:
     """HP lost per step, drawn against real, by (weapon, distance band) cell (module doc)."""
@@ -91,10 +97,10 @@ class HpLostScores:
     max_wasserstein_hp: float
     mean_floor_hp: float
     steps_in_cells: int
-    cells: list[dict[str, Any]] = field(default_factory=list)
+    cells: list[HpCellRecord] = field(default_factory=list)
     """weapon, part (the band), real, generated, wasserstein_hp, floor_hp."""
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, object]:
         return dict(self.__dict__)
 
 
@@ -123,7 +129,7 @@ def score_hp_lost(
         max_wasserstein_hp=float(np.max(values)) if values else math.nan,
         mean_floor_hp=float(np.nanmean(floors)) if floors else math.nan,
         steps_in_cells=sum(c.real for c in cells),
-        cells=[c.__dict__ | {"floor_hp": f} for c, f in zip(cells, floors, strict=True)],
+        cells=[{**c.record(), "floor_hp": f} for c, f in zip(cells, floors, strict=True)],
     )
 
 

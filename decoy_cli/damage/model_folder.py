@@ -22,7 +22,6 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import torch
 from torch import nn
@@ -31,7 +30,7 @@ from decoy_cli.damage.calibration import Calibration
 from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
-from decoy_cli.files import json_text, write_atomic
+from decoy_cli.files import JsonObject, JsonValue, json_text, object_at, write_atomic
 
 FORMAT = "decoy-damage-model"
 FORMAT_VERSION = 1
@@ -45,7 +44,7 @@ class LoadedDip:
     net: DipNet
     spec: FeatureSpec
     threshold: float
-    metadata: dict[str, Any] = field(default_factory=dict)
+    metadata: JsonObject = field(default_factory=dict)
     calibration: Calibration | None = None
     """The folder's `dip_calibration.json` (`decoy models calibrate`), when it has one."""
 
@@ -56,10 +55,10 @@ class LoadedDog:
 
     net: DogNet
     spec: FeatureSpec
-    metadata: dict[str, Any] = field(default_factory=dict)
+    metadata: JsonObject = field(default_factory=dict)
 
 
-def vocabulary() -> dict[str, list[str]]:
+def vocabulary() -> JsonObject:
     """The one-hot orders the networks are built for."""
     return {"maps": list(MAPS), "weapons": list(WEAPONS), "hit_groups": list(HIT_GROUPS)}
 
@@ -69,7 +68,7 @@ def save_dip(
     net: DipNet,
     spec: FeatureSpec,
     threshold: float,
-    metadata: dict[str, Any] | None = None,
+    metadata: JsonObject | None = None,
 ) -> Path:
     """Write `dip.pt` and `dip.json` into `folder` (created if needed); returns the folder."""
     threshold = float(threshold)
@@ -79,7 +78,7 @@ def save_dip(
 
 
 def save_dog(
-    folder: str | Path, net: DogNet, spec: FeatureSpec, metadata: dict[str, Any] | None = None
+    folder: str | Path, net: DogNet, spec: FeatureSpec, metadata: JsonObject | None = None
 ) -> Path:
     """Write `dog.pt` and `dog.json` into `folder` (created if needed); returns the folder."""
     return _save(Path(folder), "dog", net, spec, {}, metadata or {})
@@ -90,10 +89,10 @@ def _save(
     kind: str,
     net: nn.Module,
     spec: FeatureSpec,
-    extra: dict[str, Any],
-    metadata: dict[str, Any],
+    extra: JsonObject,
+    metadata: JsonObject,
 ) -> Path:
-    description = {
+    description: JsonObject = {
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
         "kind": kind,
@@ -128,7 +127,7 @@ def load_dip(folder: str | Path) -> LoadedDip:
         net,
         FeatureSpec.from_json(description["features"]),
         float(threshold),
-        description["metadata"],
+        object_at(description, "metadata"),
         load_calibration(Path(folder)),
     )
 
@@ -159,10 +158,11 @@ def load_dog(folder: str | Path) -> LoadedDog:
     description, state = _load(Path(folder), "dog")
     net = DogNet()
     load_state(net, state, Path(folder) / "dog.pt")
-    return LoadedDog(net, FeatureSpec.from_json(description["features"]), description["metadata"])
+    metadata = object_at(description, "metadata")
+    return LoadedDog(net, FeatureSpec.from_json(description["features"]), metadata)
 
 
-def _load(folder: Path, kind: str) -> tuple[dict[str, Any], dict[str, torch.Tensor]]:
+def _load(folder: Path, kind: str) -> tuple[JsonObject, dict[str, torch.Tensor]]:
     """The checked JSON description and the state dict of one model of a folder."""
     if not folder.is_dir():
         raise ModelError(f"{folder}: no such model folder")
@@ -172,7 +172,7 @@ def _load(folder: Path, kind: str) -> tuple[dict[str, Any], dict[str, torch.Tens
             f"{folder}: no {kind}.json (a model folder holds {kind}.pt and {kind}.json)"
         )
     try:
-        description = json.loads(path.read_text(encoding="utf-8"))
+        description: JsonValue = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as error:
         raise ModelError(f"{path}: cannot read: {error}") from None
     except json.JSONDecodeError as error:
@@ -198,7 +198,7 @@ def _load(folder: Path, kind: str) -> tuple[dict[str, Any], dict[str, torch.Tens
     return description, state_dict_of(read_torch_file(weights), weights)
 
 
-def read_torch_file(path: Path) -> Any:
+def read_torch_file(path: Path) -> object:
     """What a torch.save file holds, loaded on the CPU with `weights_only=True` (no code runs);
     a missing, foreign or damaged file is one ModelError line."""
     if not path.is_file():
@@ -211,7 +211,7 @@ def read_torch_file(path: Path) -> Any:
         raise ModelError(f"{path}: not a torch weights file ({first[:160]})") from None
 
 
-def state_dict_of(data: Any, path: Path) -> dict[str, torch.Tensor]:
+def state_dict_of(data: object, path: Path) -> dict[str, torch.Tensor]:
     """The state dict in what `read_torch_file` returned: a dict of named tensors, or a
     checkpoint dict holding one under "model_state_dict" (as the paper's files do)."""
     if isinstance(data, dict) and isinstance(data.get("model_state_dict"), dict):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
@@ -144,6 +145,16 @@ def confusion_matrix(real: np.ndarray, predicted: np.ndarray, classes: int) -> n
     return matrix
 
 
+class CellRecord(TypedDict):
+    """A `Cell` as its reports write it."""
+
+    weapon: str
+    part: str
+    real: int
+    generated: int
+    wasserstein_hp: float
+
+
 @dataclass(frozen=True)
 class Cell:
     """One (weapon, part) cell, the part a hit group or a distance band: sample counts and the
@@ -154,6 +165,15 @@ class Cell:
     real: int
     generated: int
     wasserstein_hp: float
+
+    def record(self) -> CellRecord:
+        return {
+            "weapon": self.weapon,
+            "part": self.part,
+            "real": self.real,
+            "generated": self.generated,
+            "wasserstein_hp": self.wasserstein_hp,
+        }
 
 
 def group_names(codes: np.ndarray) -> np.ndarray:

@@ -32,7 +32,7 @@ from decoy_cli.damage.train_options import (
     TrainOptions,
 )
 from decoy_cli.errors import DecoyError
-from decoy_cli.files import json_ready, write_atomic
+from decoy_cli.files import json_object, write_atomic
 
 if TYPE_CHECKING:
     from decoy_cli.damage.training import DipRun, DogRun, EpochRecord, Progress, Run
@@ -57,7 +57,7 @@ class TrainingResult(Generic[RunT]):
     stats: SampleStats
     split: Split
     run: RunT
-    metadata: dict[str, Any]
+    metadata: dict[str, object]
     model_folder: Path
     report_folder: Path
 
@@ -87,7 +87,7 @@ def train_dip_model(
     from decoy_cli.damage.training import fit_dip
 
     run = fit_dip(samples, split, options, FeatureSpec(units=units), balanced, progress)
-    metadata = {
+    metadata: dict[str, object] = {
         **provenance(
             command="dip",
             choice=choice,
@@ -100,7 +100,7 @@ def train_dip_model(
         "threshold_rule": DIP_THRESHOLD_RULE,
         **run.summary(),
     }
-    save_dip(out, run.model.net, run.model.spec, run.model.threshold, json_ready(metadata))
+    save_dip(out, run.model.net, run.model.spec, run.model.threshold, json_object(metadata))
     folder = report or out / "report"
     write_json(folder / "dip_metrics.json", metadata)
     write_atomic(folder / "dip_history.csv", history_csv(run.trained.history))
@@ -135,7 +135,7 @@ def train_dog_model(
     from decoy_cli.damage.training import fit_dog
 
     run = fit_dog(samples, split, options, FeatureSpec(), weights, draws, min_cell, progress)
-    metadata = {
+    metadata: dict[str, object] = {
         **provenance(
             command="dog",
             choice=choice,
@@ -148,7 +148,7 @@ def train_dog_model(
         "damage_target": DOG_DAMAGE_TARGET,
         **run.summary(),
     }
-    save_dog(out, run.model.net, run.model.spec, json_ready(metadata))
+    save_dog(out, run.model.net, run.model.spec, json_object(metadata))
     folder = report or out / "report"
     write_json(folder / "dog_metrics.json", {**metadata, "cells": run.test.metrics["cells"]})
     write_atomic(folder / "dog_history.csv", history_csv(run.trained.history))

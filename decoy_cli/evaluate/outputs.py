@@ -29,7 +29,6 @@ from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -49,7 +48,16 @@ from decoy_cli.evaluate.report import (
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
 from decoy_cli.evaluate.view_page import run_page
-from decoy_cli.files import json_ready, staged, write_atomic, write_csv, write_json
+from decoy_cli.files import (
+    JsonObject,
+    JsonValue,
+    json_object,
+    json_ready,
+    staged,
+    write_atomic,
+    write_csv,
+    write_json,
+)
 from decoy_cli.text import visible
 from decoy_cli.view.page import write_page
 
@@ -216,15 +224,15 @@ def _csv(path: Path, frame: pd.DataFrame) -> Path:
     return write_csv(path, frame)
 
 
-def _records(frame: pd.DataFrame) -> list[dict[str, Any]]:
+def _records(frame: pd.DataFrame) -> JsonValue:
     return json_ready(frame.astype(object).where(frame.notna(), None).to_dict("records"))
 
 
-def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> dict[str, Any]:
+def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> JsonObject:
     """What was run and every aggregate, as one JSON-able dict."""
     settings = evaluation.settings
     outcome = tables.outcome
-    return json_ready(
+    return json_object(
         {
             "data": data_kind(evaluation),
             "command": info.command,

@@ -8,7 +8,6 @@ is a DecoyError with one line.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -16,10 +15,18 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.compare import read_run
 from decoy_cli.evaluate.runner import round_id
-from decoy_cli.files import read_json_object
+from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
+from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import visible
-from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
+from decoy_cli.view.page import (
+    PageData,
+    TableSpec,
+    map_floor,
+    player_table,
+    round_entry,
+    table_spec,
+)
 
 TABLES = (
     ("trajectory", "Trajectory fidelity (metres): both protocols, by side"),
@@ -54,7 +61,9 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     if len(run.rounds) and not pd.api.types.is_integer_dtype(run.rounds["round"]):
         raise DecoyError(f"{folder / 'rounds.csv'}: a row without a round number")
     cache = RunCache(cache_root or folder)
-    rounds: list[dict[str, Any]] = []
+    rounds: list[JsonObject] = []
+    labels: list[str] = []
+    traces: list[RoundTrace] = []
     for row in run.rounds.itertuples():
         label = f"{visible(str(row.match))}:{row.round}"
         key = keys.get(round_id(str(row.file_sha), int(row.round)))
@@ -71,25 +80,25 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
             f"{said['winner_replay']} ({said['reason_replay']}) · {row.frames} frames, "
             f"{float(row.seconds):.0f} s"
         )
-        rounds.append(round_entry(f"{record.match_id}:{record.round_num}", info, record.trace))
+        labels.append(f"{record.match_id}:{record.round_num}")
+        traces.append(record.trace)
+        rounds.append(round_entry(labels[-1], info, record.trace))
     metrics = [m for m in ALL_METRIC_NAMES if m in run.players.columns]
     columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
     missing = [c for c in columns if c not in run.players.columns]
     if missing:
         raise DecoyError(f"{folder / 'players.csv'}: lacks the columns {', '.join(missing)}")
-    players = table_spec("", run.players[columns])
-    players["round"], players["player"] = _player_rows(folder, run.players, rounds)
+    players = player_table(run.players[columns], *_player_rows(folder, run.players, labels, traces))
     for row, r, p in zip(players["rows"], players["round"], players["player"], strict=True):
         # match and player (PLAYER_COLUMNS) as recorded, not as the CSV made them inert
-        row[0] = rounds[r]["label"].rsplit(":", 1)[0]
-        row[2] = rounds[r]["players"][p]["name"]
-    options = summary.get("options")
-    options = options if isinstance(options, dict) else {}
+        row[0] = visible(labels[r]).rsplit(":", 1)[0]
+        row[2] = visible(traces[r].players[p].name)
+    options = object_at(summary, "options")
     return {
         "title": visible(f"decoy evaluate: {(cache_root or folder).resolve().name}"),
         "subtitle": f"{summary.get('data', '?')} data · {summary.get('mechanics', '')} · "
         f"{len(rounds)} rounds · map {options.get('map', '?')}",
-        "map": map_floor(str(options.get("map") or _map_of(rounds))),
+        "map": map_floor(str(options.get("map") or _map_of(traces))),
         "tables": _tables(folder),
         "players": players,
         "rounds": rounds,
@@ -102,21 +111,22 @@ def _said(value: object) -> str:
     return "–" if pd.isna(value) else str(value)
 
 
-def _map_of(rounds: list[dict[str, Any]]) -> str:
-    return str(rounds[0]["map_name"]) if rounds else "de_dust2"
+def _map_of(traces: list[RoundTrace]) -> str:
+    return str(traces[0].map_name) if traces else "de_dust2"
 
 
 def _player_rows(
-    folder: Path, players: pd.DataFrame, rounds: list[dict[str, Any]]
+    folder: Path, players: pd.DataFrame, labels: list[str], traces: list[RoundTrace]
 ) -> tuple[list[int], list[int]]:
     """The round and player index of each players.csv row: its rows follow the rounds of
-    rounds.csv, each round's players in their order (decoy_cli/evaluate/tables.py)."""
+    rounds.csv (`labels`, `traces`), each round's players in their order
+    (decoy_cli/evaluate/tables.py)."""
     round_of, player_of = [], []
-    for index, round_ in enumerate(rounds):
-        for p in range(len(round_["players"])):
+    for index, trace in enumerate(traces):
+        for p in range(len(trace.players)):
             round_of.append(index)
             player_of.append(p)
-    numbers = [int(rounds[r]["label"].rsplit(":", 1)[1]) for r in round_of]
+    numbers = [int(labels[r].rsplit(":", 1)[1]) for r in round_of]
     if pd.to_numeric(players["round"], errors="coerce").tolist() != numbers:
         raise DecoyError(
             f"{folder / 'players.csv'}: its rows are not the players of the cached rounds "
@@ -125,7 +135,7 @@ def _player_rows(
     return round_of, player_of
 
 
-def _tables(folder: Path) -> list[dict[str, Any]]:
+def _tables(folder: Path) -> list[TableSpec]:
     tables = []
     for name, title in TABLES:
         path = folder / "tables" / f"{name}.csv"

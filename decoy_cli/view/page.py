@@ -5,10 +5,10 @@ The JSON is written so that no text from the data can end its script element or 
 (`<`, `>`, `&` and the line separators as `\\u` escapes), and the script shows every text
 through `textContent` or the canvas, never as markup.
 
-The data (`PageData`) is a dict: `title`, `subtitle`, `map` (`map_floor`), `tables` (each
-`title`, `columns`, `rows`), `players` (the player-round list: `columns`, `rows`, and per row
-the index of its `round` and of its `player` in that round), `rounds` (each `label`, `info`
-and a `RoundTrace` as a dict) and `initial` (the round shown first).
+The data (`PageData`): `title`, `subtitle`, `map` (`map_floor`), `tables` (each `title`,
+`columns`, `rows`), `players` (the player-round list: `columns`, `rows`, and per row the index
+of its `round` and of its `player` in that round), `rounds` (each `label`, `info` and a
+`RoundTrace` as a dict) and `initial` (the round shown first).
 """
 
 from __future__ import annotations
@@ -17,18 +17,54 @@ import json
 import math
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import TypedDict
 
 import msgspec
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.files import json_ready, write_atomic
+from decoy_cli.files import JsonObject, json_ready, write_atomic
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import visible
 
-PageData = dict[str, Any]
+Cell = str | int | float | bool | None
+"""A cell of a page's table."""
+
+
+class TableSpec(TypedDict):
+    """A table of the page."""
+
+    title: str
+    columns: list[str]
+    rows: list[list[Cell]]
+
+
+class PlayerTable(TableSpec):
+    """The player-round list: a table, and per row the index of its round and of its player."""
+
+    round: list[int]
+    player: list[int]
+
+
+class MapFloor(TypedDict):
+    """A map's nav areas as the page draws them (`map_floor`)."""
+
+    name: str
+    areas: list[int]
+
+
+class PageData(TypedDict):
+    """What the page shows (module docstring)."""
+
+    title: str
+    subtitle: str
+    map: MapFloor
+    tables: list[TableSpec]
+    players: PlayerTable
+    rounds: list[JsonObject]
+    initial: int
+
 
 _HERE = Path(__file__).resolve().parent
 _ESCAPES = {
@@ -40,7 +76,7 @@ _ESCAPES = {
 }
 
 
-def embedded_json(data: Any) -> str:
+def embedded_json(data: object) -> str:
     """`data` as strict JSON that is inert inside an HTML script element."""
     text = json.dumps(json_ready(data), separators=(",", ":"), allow_nan=False)
     for char, escape in _ESCAPES.items():
@@ -68,7 +104,7 @@ def write_page(path: str | Path, data: PageData) -> Path:
 
 
 @cache
-def map_floor(map_name: str) -> dict[str, Any]:
+def map_floor(map_name: str) -> MapFloor:
     """The map's floor for the page: its nav areas as one flat list of (x_min, y_min, x_max,
     y_max, mean height) in decimetres, lowest first (an upper floor is drawn over a lower)."""
     from decoy_cli.csgo import HAMMER_TO_M
@@ -81,24 +117,28 @@ def map_floor(map_name: str) -> dict[str, Any]:
     return {"name": map_name, "areas": np.rint(rows).astype(np.int64).reshape(-1).tolist()}
 
 
-def round_entry(label: str, info: str, trace: RoundTrace) -> dict[str, Any]:
+def round_entry(label: str, info: str, trace: RoundTrace) -> JsonObject:
     """One round of the page: its label, a line about it and its trace, the players' names
     with their control characters written as escapes (`decoy_cli.text.visible`)."""
-    entry: dict[str, Any] = {"label": visible(label), "info": visible(info)}
-    entry.update(msgspec.to_builtins(trace))
-    for player in entry["players"]:
+    recorded = msgspec.to_builtins(trace)
+    for player in recorded["players"]:
         player["name"] = visible(player["name"])
-    return entry
+    return {"label": visible(label), "info": visible(info), **recorded}
 
 
-def table_spec(title: str, frame: pd.DataFrame, digits: int = 4) -> dict[str, Any]:
+def table_spec(title: str, frame: pd.DataFrame, digits: int = 4) -> TableSpec:
     """A table of the page: its columns and rows, numbers rounded to `digits` significant
     digits, missing values as null."""
     rows = [[_cell(v, digits) for v in row] for row in frame.itertuples(index=False)]
     return {"title": title, "columns": [str(c) for c in frame.columns], "rows": rows}
 
 
-def _cell(value: Any, digits: int) -> Any:
+def player_table(frame: pd.DataFrame, rounds: list[int], players: list[int]) -> PlayerTable:
+    """The player-round list of `frame`, row k the player `players[k]` of round `rounds[k]`."""
+    return {**table_spec("", frame), "round": rounds, "player": players}
+
+
+def _cell(value: object, digits: int) -> Cell:
     if isinstance(value, np.generic):
         value = value.item()
     if value is None or value is pd.NA:
@@ -117,7 +157,7 @@ def _cell(value: Any, digits: int) -> Any:
 def round_index(data: PageData, label: str) -> int:
     """The index of the round labelled `label` ("MATCH:ROUND"); a DecoyError naming a few of
     the labels when there is none."""
-    labels = [r["label"] for r in data["rounds"]]
+    labels = [str(r["label"]) for r in data["rounds"]]
     if label in labels:
         return labels.index(label)
     shown = ", ".join(labels[:3]) + (", ..." if len(labels) > 3 else "")

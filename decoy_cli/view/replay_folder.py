@@ -8,18 +8,17 @@ A folder that is not a replay, lacks a file, or was written by a decoy that wrot
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import msgspec
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.files import read_json_object
+from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import visible
-from decoy_cli.view.page import PageData, map_floor, round_entry, table_spec
+from decoy_cli.view.page import PageData, map_floor, player_table, round_entry, table_spec
 
 REPLAY_MARKER = "replay.csv"
 """The file that tells a replay's folder from an evaluate run's."""
@@ -56,16 +55,14 @@ def replay_page(folder: Path) -> PageData:
     if missing or len(players) != len(trace.players):
         raise DecoyError(f"{folder / 'players.csv'}: not the players of {trace_path.name}")
     label = visible(f"{summary.get('match_id', '?')}:{summary.get('round_num', '?')}")
-    original, replay = summary.get("outcome_original") or {}, summary.get("outcome_replay") or {}
+    original, replay = object_at(summary, "outcome_original"), object_at(summary, "outcome_replay")
     info = (
         f"winner: data {original.get('winner')} ({original.get('reason')}), replay "
         f"{replay.get('winner')} ({replay.get('reason')}) · {summary.get('frames', '?')} frames"
     )
-    table = table_spec("", players[columns])
+    table = player_table(players[columns], [0] * len(players), list(range(len(players))))
     for row, player in zip(table["rows"], trace.players, strict=True):
         row[0] = visible(player.name)  # as recorded, not as the CSV made it inert
-    table["round"] = [0] * len(players)
-    table["player"] = list(range(len(players)))
     return {
         "title": f"decoy replay: {label}",
         "subtitle": visible(f"{folder.resolve().name} · map {trace.map_name}"),
@@ -77,7 +74,7 @@ def replay_page(folder: Path) -> PageData:
     }
 
 
-def _summary_rows(summary: dict[str, Any]) -> pd.DataFrame:
+def _summary_rows(summary: JsonObject) -> pd.DataFrame:
     """The summary's values, one row each (a dict's values as `name.key`)."""
     rows = []
     for name, value in summary.items():
