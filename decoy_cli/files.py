@@ -123,6 +123,11 @@ def object_at(data: JsonObject, key: str) -> JsonObject:
     return value if isinstance(value, dict) else {}
 
 
+def objects_in(value: JsonValue) -> list[JsonObject]:
+    """The JSON objects in `value` when it is a list (none otherwise)."""
+    return [item for item in value if isinstance(item, dict)] if isinstance(value, list) else []
+
+
 def json_text(data: object, *, sort_keys: bool = True) -> str:
     """Pretty strict JSON of `data` (see `json_ready`), ending in a newline."""
     return json.dumps(json_ready(data), indent=2, sort_keys=sort_keys, allow_nan=False) + "\n"

@@ -31,12 +31,13 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import decoy_cli
 from decoy_cli.bench import portable
 from decoy_cli.bench.portable import PORTABLE_SECTIONS
+from decoy_cli.bench.records import BenchSwitches, RatioRecord, SideBySide
 from decoy_cli.errors import DecoyError
+from decoy_cli.files import JsonObject, JsonValue, object_at, objects_in
 
 DRIVER = """
 import json, os, sys
@@ -164,7 +165,9 @@ def _git(where: Path, *args: str) -> str:
     return done.stdout
 
 
-def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | None, work: Path):
+def run_in(
+    tree: CodeTree, section: str, config: BenchSwitches, data: Path | None, work: Path
+) -> JsonObject:
     """One section in a fresh process of `tree`, in an empty folder of `work` removed after;
     its result, or {"error": one line}."""
     env = dict(os.environ)
@@ -192,21 +195,23 @@ def run_in(tree: CodeTree, section: str, config: dict[str, Any], data: Path | No
         if not result.is_file():
             last = (done.stderr.strip().splitlines() or ["no output"])[-1]
             return {"error": f"{tree.label}: the section process failed: {last}"}
-        loaded: dict[str, Any] = json.loads(result.read_text())
+        loaded: JsonValue = json.loads(result.read_text())
     except (OSError, ValueError, subprocess.TimeoutExpired) as error:
         return {"error": f"{tree.label}: {error}"}
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
+    if not isinstance(loaded, dict):
+        return {"error": f"{tree.label}: the section process wrote no JSON object"}
     if tree.path is not None and not str(loaded.get("code", "")).startswith(str(tree.path)):
         return {"error": f"{tree.label}: ran {loaded.get('code')}, not the code in {tree.path}"}
     return loaded
 
 
-def headlines(section: str, result: dict[str, Any]) -> dict[str, float]:
+def headlines(section: str, result: JsonObject) -> dict[str, float]:
     """The figures a speed-up is the ratio of, higher is better (a time becomes a rate)."""
     if "error" in result or "skipped" in result:
         return {}
-    figures: dict[str, Any] = {}
+    figures: dict[str, JsonValue] = {}
     if section == "metrics":
         figures = {"pairs/s": result.get("pairs_per_s")}
     elif section == "reader" and result.get("files"):
@@ -220,12 +225,13 @@ def headlines(section: str, result: dict[str, Any]) -> dict[str, float]:
         arrays = result.get("array_decisions_per_s", result.get("decisions_per_s"))
         figures["agent decisions/s, arrays (PettingZoo where absent)"] = arrays
     elif section == "table1":
-        rows = result.get("rows", [])
+        rows = objects_in(result.get("rows"))
         figures = {f"ticks/s, {row.get('agents')} agents": row.get("ticks_per_s") for row in rows}
     elif section == "combat_step":
-        for row in result.get("rows", []):
-            median = row.get("parts", {}).get("step", {}).get("median_ms")
-            figures[f"steps/s, {row.get('layout')}"] = 1e3 / median if median else None
+        for row in objects_in(result.get("rows")):
+            median = object_at(object_at(row, "parts"), "step").get("median_ms")
+            rate = 1e3 / median if isinstance(median, int | float) and median else None
+            figures[f"steps/s, {row.get('layout')}"] = rate
     return {k: float(v) for k, v in figures.items() if isinstance(v, int | float) and v > 0}
 
 
@@ -242,7 +248,7 @@ class Ratio:
     def ratios(self) -> list[float]:
         return [c / b for c, b in zip(self.current, self.baseline, strict=True) if b > 0]
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> RatioRecord:
         ratios = self.ratios
         return {
             "section": self.section,
@@ -258,21 +264,21 @@ class Ratio:
 
 def side_by_side(
     sections: list[str],
-    config: dict[str, Any],
+    config: BenchSwitches,
     data: Path | None,
     current: CodeTree,
     baseline: CodeTree,
     repeats: int,
     work: Path,
     on_run: Callable[[str, str, int], None] = lambda section, side, repeat: None,
-) -> dict[str, Any]:
+) -> SideBySide:
     """Each section `repeats` times on each side, alternating; raw results and the ratios."""
-    runs: dict[str, dict[str, list[dict[str, Any]]]] = {}
+    runs: dict[str, dict[str, list[JsonObject]]] = {}
     ratios: list[Ratio] = []
     for section in sections:
         runs[section] = {"current": [], "baseline": []}
         for repeat in range(repeats):
-            pair = {}
+            pair: dict[str, JsonObject] = {}
             for side, tree in (("current", current), ("baseline", baseline)):
                 on_run(section, side, repeat)
                 pair[side] = run_in(tree, section, config, data, work)

@@ -15,6 +15,7 @@ import time
 
 import numpy as np
 
+from decoy_cli.bench.records import CombatRow, StepTimes
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.sim.combat import DamageModel, LineOfSight, apply_damage, make_batch
 from decoy_cli.sim.state import Agents
@@ -78,7 +79,7 @@ def time_steps(
     return times, visible
 
 
-def summarize_ms(times: list[float]) -> dict[str, float]:
+def summarize_ms(times: list[float]) -> StepTimes:
     """Median, mean, min and max of wall times in seconds, as milliseconds."""
     ms = [t * 1e3 for t in times]
     return {
@@ -95,12 +96,12 @@ def step_costs(
     repeats: int = 300,
     seed: int = 0,
     map_name: str = BUILTIN_MAP,
-) -> list[dict]:
+) -> list[CombatRow]:
     """One row per layout: the step's parts (milliseconds) and the visible pairs per step, on a
     built-in map."""
     rng = np.random.default_rng(seed)
     graph = builtin_graph(map_name)
-    rows = []
+    rows: list[CombatRow] = []
     with PhysicsWorld(nav_world(map_name)) as physics:
         los = LineOfSight(physics, 2 * per_side)
         try:

@@ -12,10 +12,10 @@ import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from decoy_cli.bench.records import DataRecord, ReaderResult, ReplayResult
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import (
     Round,
@@ -51,7 +51,7 @@ class BenchData:
     folder: Path
     files: list[Path]
 
-    def describe(self) -> dict[str, Any]:
+    def describe(self) -> DataRecord:
         return {"kind": self.kind, "folder": str(self.folder), "files": len(self.files)}
 
 
@@ -71,7 +71,7 @@ def find_data(
     return None
 
 
-def reader_throughput(files: list[Path], repeats: int = 1) -> dict[str, Any]:
+def reader_throughput(files: list[Path], repeats: int = 1) -> ReaderResult:
     """`read_match` per file (median of `repeats`): seconds per file and MB per second.
 
     MB are 10^6 bytes of the file on disk (compressed) and of the JSON it holds (decompressed).
@@ -95,7 +95,7 @@ def reader_throughput(files: list[Path], repeats: int = 1) -> dict[str, Any]:
         decompressed += size
         rounds += len(match.rounds)
     total = sum(seconds)
-    result: dict[str, Any] = {
+    result: ReaderResult = {
         "files": len(seconds),
         "failed": len(failures),
         "failures": failures[:MAX_FAILURES_KEPT],
@@ -125,7 +125,7 @@ def replay_throughput(
     combat: bool = True,
     bomb: bool = True,
     seed: int = 0,
-) -> dict[str, Any]:
+) -> ReplayResult:
     """Rounds per second of snap + plan + replay + metrics in one process, on one world.
 
     The replay runs as `decoy replay` does by default (kinematic mover, bomb on, combat on
@@ -171,7 +171,7 @@ def replay_throughput(
             game_s += float(np.ptp(round_.frame_seconds))
             if max_rounds is not None and len(per_round) >= max_rounds:
                 break  # before the next round is replayed
-    result: dict[str, Any] = {
+    result: ReplayResult = {
         "rounds": len(per_round),
         "failed": len(failures),
         "failures": [f"{f.where}: {f.message}" for f in failures[:MAX_FAILURES_KEPT]],

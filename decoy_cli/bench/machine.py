@@ -11,7 +11,8 @@ import platform
 import resource
 import sys
 from pathlib import Path
-from typing import Any
+
+from decoy_cli.bench.records import MachineInfo
 
 PACKAGES = ("decoy", "numpy", "torch", "pybullet", "numba", "scipy", "pandas", "msgspec")
 
@@ -89,7 +90,7 @@ def machine_line() -> str:
     )
 
 
-def machine_info() -> dict[str, Any]:
+def machine_info() -> MachineInfo:
     """Cores, CPU, memory, load, OS and the versions of Python and the packages that matter."""
     return {
         "cores": os.cpu_count(),

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from decoy_cli.bench.records import MetricsResult
 from decoy_cli.metrics import trajectory_metrics
 
 RUN_SPEED_M_PER_FRAME = 2.4
@@ -47,7 +48,7 @@ def player_rounds(rng: np.random.Generator, count: int) -> list[PlayerRoundArray
     return rounds
 
 
-def metric_throughput(pairs: int = 2000, seed: int = 0) -> dict:
+def metric_throughput(pairs: int = 2000, seed: int = 0) -> MetricsResult:
     """Player-round pairs per second of `trajectory_metrics`, one thread, after a warm-up."""
     if pairs < 1:
         raise ValueError(f"need at least one player-round, not {pairs}")

@@ -24,9 +24,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
+
+if TYPE_CHECKING:  # types only: this file also runs on versions without these modules
+    from decoy_cli.bench.records import ArrayFigures, EnvResult, KinematicResult, PortableConfig
+    from decoy_cli.env import DecoyArrayEnv, DecoyParallelEnv
+    from decoy_cli.sim.combat import DamageModel
 
 KINEMATIC_AGENTS = 10
 """The agent count of the kinematic row (the issue's and the paper's middle row)."""
@@ -35,12 +40,25 @@ ENV_ROUNDS = 5
 """Timed environment rounds (one more, untimed, warms up the compiled code)."""
 
 
-def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
+class _TableMap(TypedDict, total=False):
+    """`speed_table`'s map, passed only off the built-in map (earlier versions know none)."""
+
+    map_name: str
+
+
+class _EnvMap(TypedDict, total=False):
+    """The environment's map, passed only off the built-in map (as `_TableMap`)."""
+
+    map: str
+
+
+def kinematic_section(config: PortableConfig) -> KinematicResult:
     """Table 1's protocol at `KINEMATIC_AGENTS` agents with the kinematic mover."""
     from decoy_cli.bench.simspeed import speed_table
 
     decisions = 1_000 if config.get("quick") else 10_000
     model, label = _model(config)
+    on_map: _TableMap = {"map_name": config["map"]} if "map" in config else {}
     rows = speed_table(
         (KINEMATIC_AGENTS,),
         decisions,
@@ -49,7 +67,7 @@ def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
         combat=bool(config.get("combat", True)),
         bomb=bool(config.get("bomb", True)),
         seed=int(config.get("seed", 0)),
-        **({"map_name": config["map"]} if "map" in config else {}),
+        **on_map,
     )
     row = rows[0].to_dict()
     return {
@@ -63,7 +81,7 @@ def kinematic_section(config: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def env_section(config: dict[str, Any]) -> dict[str, Any]:
+def env_section(config: PortableConfig) -> EnvResult:
     """Random masked 5v5 rounds through `DecoyParallelEnv` (module docstring)."""
     from decoy_cli.bench.machine import peak_rss_mb
 
@@ -76,7 +94,7 @@ def env_section(config: dict[str, Any]) -> dict[str, Any]:
     rng = np.random.default_rng(int(config.get("seed", 0)))
     model, label = _model(config)
     before = peak_rss_mb()
-    on_map = {"map": config["map"]} if "map" in config else {}
+    on_map: _EnvMap = {"map": config["map"]} if "map" in config else {}
     env = DecoyParallelEnv(mover="kinematic", damage_model=model, n_t=5, n_ct=5, **on_map)
     try:
         _play(env, rng, seed=0)  # warm-up: compilation and caches
@@ -106,7 +124,16 @@ def env_section(config: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def _play(env: Any, rng: np.random.Generator, seed: int) -> dict[str, Any]:
+class _Played(TypedDict):
+    """One round of `_play`."""
+
+    decisions: int
+    steps: int
+    game_s: float
+    outcome: str
+
+
+def _play(env: DecoyParallelEnv, rng: np.random.Generator, seed: int) -> _Played:
     """One round of random masked actions; its decisions, steps, game time and outcome."""
     obs, infos = env.reset(seed=seed)
     decisions = steps = 0
@@ -127,7 +154,7 @@ def _play(env: Any, rng: np.random.Generator, seed: int) -> dict[str, Any]:
     return {"decisions": decisions, "steps": steps, "game_s": tick / 60.0, "outcome": outcome}
 
 
-def _array_rounds(config: dict[str, Any], model: Callable | None, rounds: int) -> dict[str, Any]:
+def _array_rounds(config: PortableConfig, model: DamageModel | None, rounds: int) -> ArrayFigures:
     """The environment section's rounds through `DecoyArrayEnv`, if this code has it."""
     try:
         from decoy_cli.env.array_env import DecoyArrayEnv
@@ -155,7 +182,7 @@ def _array_rounds(config: dict[str, Any], model: Callable | None, rounds: int) -
     }
 
 
-def _play_arrays(env: Any, rng: np.random.Generator, seed: int) -> int:
+def _play_arrays(env: DecoyArrayEnv, rng: np.random.Generator, seed: int) -> int:
     """One round of random masked actions through the array environment; its decisions."""
     state = env.reset(seed)
     decisions = 0
@@ -166,7 +193,7 @@ def _play_arrays(env: Any, rng: np.random.Generator, seed: int) -> int:
     return decisions
 
 
-def _model(config: dict[str, Any]) -> tuple[Callable | None, str]:
+def _model(config: PortableConfig) -> tuple[DamageModel | None, str]:
     """The damage model the config names and how the report names it (None: "none", or a
     model that did not load, said so; the section then runs without shooting)."""
     from decoy_cli.damage import load_damage_model
@@ -180,7 +207,7 @@ def _model(config: dict[str, Any]) -> tuple[Callable | None, str]:
         return None, f"none ({models} did not load: {error})"
 
 
-PORTABLE_SECTIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
+PORTABLE_SECTIONS: dict[str, Callable[[PortableConfig], KinematicResult | EnvResult]] = {
     "kinematic": kinematic_section,
     "env": env_section,
 }

@@ -18,12 +18,18 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
-from typing import Any
 
 from decoy_cli import __version__
 from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
 from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
 from decoy_cli.bench.portable import PORTABLE_SECTIONS
+from decoy_cli.bench.records import (
+    BenchReport,
+    MachineInfo,
+    Measurement,
+    PortableConfig,
+    SectionResult,
+)
 from decoy_cli.bench.simspeed import (
     AGENT_COUNTS,
     PAPER_DECISIONS,
@@ -138,7 +144,9 @@ def check_damage_model(choice: str) -> ModelStatus:
     return ModelStatus(choice, True, f"learned DIP + {outcome} ({choice})")
 
 
-def run_section(name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None):
+def run_section(
+    name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None
+) -> Measurement:
     """Run one section in this process; its result with wall time and peak memory."""
     from decoy_cli.bench.combat import step_costs
     from decoy_cli.bench.metrics import metric_throughput
@@ -149,7 +157,7 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
 
         model = load_damage_model(status.choice)
     started = time.perf_counter()
-    result: dict[str, Any]
+    result: Measurement
     if name == "table1":
         rows = speed_table(
             config.agent_counts,
@@ -180,7 +188,7 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
         result = {"map": config.map_name, "damage_model": status.label, "rows": costs}
     elif name == "replay":
         data = _needed(data, name)
-        result = replay_throughput(
+        replayed = replay_throughput(
             data.files,
             config.replay_rounds,
             model,
@@ -188,26 +196,34 @@ def run_section(name: str, config: BenchConfig, status: ModelStatus, data: Bench
             bomb=config.bomb,
             seed=config.seed,
         )
-        result |= {"data": data.describe(), "damage_model": status.label if model else None}
+        replayed["data"] = data.describe()
+        replayed["damage_model"] = status.label if model else None
+        result = replayed
     elif name == "metrics":
         result = metric_throughput(config.metric_pairs, config.seed)
     elif name == "reader":
         data = _needed(data, name)
         files = data.files[: config.reader_files] if config.reader_files else data.files
-        result = reader_throughput(files) | {"data": data.describe()}
+        read = reader_throughput(files)
+        read["data"] = data.describe()
+        result = read
     else:
         raise ValueError(f"no bench section {name!r}; the sections are {', '.join(SECTIONS)}")
-    return result | {
-        "section_wall_s": time.perf_counter() - started,
-        "peak_rss_mb": peak_rss_mb(),
-        "ru_maxrss_mb": ru_maxrss_mb(),
-    }
+    result["section_wall_s"] = time.perf_counter() - started
+    result["peak_rss_mb"] = peak_rss_mb()
+    result["ru_maxrss_mb"] = ru_maxrss_mb()
+    return result
 
 
-def portable_config(config: BenchConfig) -> dict[str, Any]:
+def portable_config(config: BenchConfig) -> PortableConfig:
     """What a portable section (`decoy_cli.bench.portable`) reads of the config."""
-    keys = ("quick", "models", "combat", "bomb", "seed")
-    settings = {key: getattr(config, key) for key in keys}
+    settings: PortableConfig = {
+        "quick": config.quick,
+        "models": config.models,
+        "combat": config.combat,
+        "bomb": config.bomb,
+        "seed": config.seed,
+    }
     if config.map_name != BUILTIN_MAP:  # only then: earlier versions' sections know no map
         settings["map"] = config.map_name
     return settings
@@ -232,7 +248,7 @@ def _quiet_process() -> None:
 
 def run_isolated(
     name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None
-) -> dict[str, Any]:
+) -> SectionResult:
     """`run_section` in a fresh spawned process; a failure becomes {"error": one line}."""
     if name in DATA_SECTIONS and data is None:
         return {
@@ -256,9 +272,9 @@ def report(
     config: BenchConfig,
     status: ModelStatus,
     data: BenchData | None,
-    sections: dict[str, dict[str, Any]],
-    machine: dict[str, Any],
-) -> dict[str, Any]:
+    sections: dict[str, SectionResult],
+    machine: MachineInfo,
+) -> BenchReport:
     """The whole benchmark as one JSON-ready document; `machine` as `machine_info()` said at
     the start (the load average at the end is added)."""
     return {
@@ -277,6 +293,6 @@ def report(
     }
 
 
-def failed_sections(sections: dict[str, dict[str, Any]]) -> list[str]:
+def failed_sections(sections: dict[str, SectionResult]) -> list[str]:
     """Names of the sections that ended in an error."""
     return [name for name, result in sections.items() if "error" in result]

@@ -14,11 +14,12 @@ a model that never hits: its rows leave out the cost of inference and must say s
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import TypedDict
 
 import numpy as np
 
+from decoy_cli.bench.records import SpeedRowRecord
 from decoy_cli.csgo import BUILTIN_MAP, TICK_RATE
 from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
 from decoy_cli.sim.random_play import RandomPolicy
@@ -73,8 +74,21 @@ class SpeedRow:
     time_scale: float
     paper_ticks_per_s: float | None  # the paper's table, from its machine (not comparable)
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def to_dict(self) -> SpeedRowRecord:
+        return {
+            "agents": self.agents,
+            "mover": self.mover,
+            "rounds": self.rounds,
+            "ticks": self.ticks,
+            "decisions": self.decisions,
+            "kills": self.kills,
+            "wall_s": self.wall_s,
+            "cpu_s": self.cpu_s,
+            "game_s": self.game_s,
+            "ticks_per_s": self.ticks_per_s,
+            "time_scale": self.time_scale,
+            "paper_ticks_per_s": self.paper_ticks_per_s,
+        }
 
 
 def _spawn_agents(graph: WaypointGraph, count: int, rng: np.random.Generator) -> Agents:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 import typer
 from rich.console import Console
@@ -23,6 +23,20 @@ from decoy_cli.bench import (
     run_isolated,
 )
 from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
+from decoy_cli.bench.records import (
+    BenchSwitches,
+    CombatResult,
+    EnvResult,
+    KinematicResult,
+    MachineInfo,
+    MetricsResult,
+    ReaderResult,
+    ReplayResult,
+    SectionResult,
+    SideBySide,
+    Table1Result,
+    not_measured,
+)
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._options import MAPS_HELP, MOVER_HELP
 from decoy_cli.csgo import BUILTIN_MAP
@@ -123,8 +137,14 @@ def bench(
     machine = machine_info()
     console.print(_machine_line(machine), highlight=False)
     if baseline is not None:
-        switches = {"quick": quick, "models": models, "mover": mover, "combat": combat}
-        switches |= {"bomb": bomb, "seed": seed}
+        switches: BenchSwitches = {
+            "quick": quick,
+            "models": models,
+            "mover": mover,
+            "combat": combat,
+            "bomb": bomb,
+            "seed": seed,
+        }
         if config.map_name != BUILTIN_MAP:  # only then: earlier versions know no --map
             switches["map_name"] = config.map_name
         _side_by_side(console, chosen, switches, bench_data, baseline, repeats, out)
@@ -146,7 +166,7 @@ def bench(
         ),
         highlight=False,
     )
-    results: dict[str, dict[str, Any]] = {}
+    results: dict[str, SectionResult] = {}
     with Progress(
         TextColumn("{task.description}", markup=False),
         BarColumn(),
@@ -191,7 +211,7 @@ def _chosen_sections(text: str) -> list[str]:
 def _side_by_side(
     console: Console,
     chosen: list[str],
-    config: dict[str, Any],
+    config: BenchSwitches,
     bench_data: BenchData | None,
     ref: str,
     repeats: int,
@@ -201,8 +221,9 @@ def _side_by_side(
     Paths are made absolute: the runs start in folders of their own."""
     work = out.resolve().parent
     work.mkdir(parents=True, exist_ok=True)
-    if config["models"] not in (*SHIPPED_CHOICES, "none"):  # a folder, as the loader reads it
-        config = config | {"models": str(Path(config["models"]).resolve())}
+    models = config["models"]
+    if models not in (*SHIPPED_CHOICES, "none"):  # a folder, as the loader reads it
+        config = {**config, "models": str(Path(models).resolve())}
     data = bench_data.folder.resolve() if bench_data else None
     with baseline_tree(ref, work) as baseline:
         console.print(
@@ -238,7 +259,7 @@ def _side_by_side(
         raise typer.Exit(1)
 
 
-def _ratio_table(result: dict[str, Any]) -> Table:
+def _ratio_table(result: SideBySide) -> Table:
     table = _table(
         f"speed-up of the current code over {result['baseline']}, measured side by side",
         ["section", "figure", "current (min-max)", "baseline (min-max)", "ratio", "min", "max"],
@@ -258,7 +279,7 @@ def _ratio_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _machine_line(machine: dict[str, Any]) -> str:
+def _machine_line(machine: MachineInfo) -> str:
     packages = machine["packages"]
     versions = ", ".join(
         f"{name} {packages[name]}" for name in ("numpy", "torch", "pybullet") if packages[name]
@@ -275,22 +296,29 @@ def _load(load: list[float] | None) -> str:
     return f"{load[0]:.2f} (1 min)" if load else "unknown"
 
 
-def _render(name: str, result: dict[str, Any]) -> Table | Text:
-    """The section's table, or one line when it was skipped or failed."""
+def _render(name: str, result: SectionResult) -> Table | Text:
+    """The section's table, or one line when it was skipped or failed (the section's name
+    says which result it is)."""
     title = TITLES[name]
-    if "skipped" in result:
-        return Text(f"{title}: skipped ({result['skipped']})", style="yellow")
-    if "error" in result:
-        return Text(f"{title}: failed: {result['error']}", style="red")
-    return {
-        "table1": _table1,
-        "kinematic": _kinematic_table,
-        "env": _env_table,
-        "combat_step": _combat_table,
-        "replay": _replay_table,
-        "metrics": _metrics_table,
-        "reader": _reader_table,
-    }[name](result)
+    if not_measured(result):
+        if "skipped" in result:
+            return Text(f"{title}: skipped ({result['skipped']})", style="yellow")
+        return Text(f"{title}: failed: {result.get('error')}", style="red")
+    if name == "table1":
+        return _table1(cast(Table1Result, result))
+    if name == "kinematic":
+        return _kinematic_table(cast(KinematicResult, result))
+    if name == "env":
+        return _env_table(cast(EnvResult, result))
+    if name == "combat_step":
+        return _combat_table(cast(CombatResult, result))
+    if name == "replay":
+        return _replay_table(cast(ReplayResult, result))
+    if name == "metrics":
+        return _metrics_table(cast(MetricsResult, result))
+    if name == "reader":
+        return _reader_table(cast(ReaderResult, result))
+    raise KeyError(name)
 
 
 def _table(title: str, columns: list[str], caption: str | None = None) -> Table:
@@ -300,7 +328,7 @@ def _table(title: str, columns: list[str], caption: str | None = None) -> Table:
     return table
 
 
-def _table1(result: dict[str, Any]) -> Table:
+def _table1(result: Table1Result) -> Table:
     table = _table(
         f"Table 1: simulator speed, {result['decisions_per_row']:,} agent decisions per row",
         [
@@ -346,7 +374,7 @@ def _table1(result: dict[str, Any]) -> Table:
     return table
 
 
-def _kinematic_table(result: dict[str, Any]) -> Table:
+def _kinematic_table(result: KinematicResult) -> Table:
     table = _table(
         f"kinematic core: Table 1's protocol at {result['agents']} agents, event by event",
         ["decisions", "ticks", "wall s", "ticks/s", "time scale"],
@@ -363,7 +391,7 @@ def _kinematic_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _env_table(result: dict[str, Any]) -> Table:
+def _env_table(result: EnvResult) -> Table:
     table = _table(
         "environment: random masked actions, 5v5, combat and bomb on",
         [
@@ -403,7 +431,7 @@ def _env_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _combat_table(result: dict[str, Any]) -> Table:
+def _combat_table(result: CombatResult) -> Table:
     table = _table(
         "one 5v5 combat step, median ms",
         ["layout", "steps", "line of sight", "batch", "model", "damage", "step", "visible pairs"],
@@ -424,14 +452,14 @@ def _combat_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _replay_table(result: dict[str, Any]) -> Table:
+def _replay_table(result: ReplayResult) -> Table:
     options = result["options"]
+    combat = f"on ({result.get('damage_model')})" if options["combat"] else "off"
     table = _table(
         f"replay throughput ({result['data']['kind']} data), one process",
         ["rounds", "failed", "frames", "wall s", "rounds/s", "rounds per CPU s", "s per round"],
         caption=f"snap + plan + replay + metrics; {options['mover']} mover, bomb "
-        f"{'on' if options['bomb'] else 'off'}, combat "
-        f"{'on (' + result['damage_model'] + ')' if options['combat'] else 'off'}; "
+        f"{'on' if options['bomb'] else 'off'}, combat {combat}; "
         f"peak memory {result['peak_rss_mb']:.0f} MB",
     )
     if not result["rounds"]:
@@ -450,7 +478,7 @@ def _replay_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _metrics_table(result: dict[str, Any]) -> Table:
+def _metrics_table(result: MetricsResult) -> Table:
     table = _table(
         "metric throughput (ten metrics, both protocols, one thread)",
         ["player-round pairs", "mean frames", "wall s", "pairs/s", "ms per pair"],
@@ -466,7 +494,7 @@ def _metrics_table(result: dict[str, Any]) -> Table:
     return table
 
 
-def _reader_table(result: dict[str, Any]) -> Table:
+def _reader_table(result: ReaderResult) -> Table:
     table = _table(
         f"reader throughput ({result['data']['kind']} data, read_match)",
         ["files", "failed", "rounds", "MB xz", "MB JSON", "s per file", "MB/s JSON", "MB/s xz"],
