@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, cast
+from typing import cast
 
 import numpy as np
 import pandas as pd
@@ -48,6 +48,7 @@ from decoy_cli.esta.schema import (
     RoundState,
 )
 from decoy_cli.esta.source import decode_round, parse, read_bytes, round_number_hint
+from decoy_cli.files import JsonObject, JsonValue
 
 MAX_MATCH_PLAYER_FRAMES = 4_000_000
 """Most player-frames (players × frames, summed over rounds) a match file may hold: about 140
@@ -144,7 +145,7 @@ class Match:
     path: Path
     map_name: str
     tick_rate: int
-    meta: dict[str, Any]
+    meta: JsonObject
     rounds: list[Round]
     round_errors: dict[int, EstaError] = field(default_factory=dict)
 
@@ -386,7 +387,7 @@ def _claim(path: Path, position_of: dict[int, int], num: int, position: int) -> 
     position_of[num] = position
 
 
-def _tick_rate(path: Path, value: Any) -> int:
+def _tick_rate(path: Path, value: JsonValue) -> int:
     """`tickRate` as a positive int (128 or 64 in ESTA)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise EstaError(f"{path}: not an ESTA match file (tickRate {value!r} is not a number)")
@@ -395,7 +396,7 @@ def _tick_rate(path: Path, value: Any) -> int:
     return int(value)
 
 
-def _match_id(path: Path, value: Any) -> str:
+def _match_id(path: Path, value: JsonValue) -> str:
     """`matchID` as a string; the file name without its suffixes when null or empty."""
     if value is None or value == "":
         name = path.name

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 from decoy_cli.esta.frames import Side
+from decoy_cli.files import JsonObject
 from decoy_cli.weapons import is_known
 
 AWPY_HIT_GROUPS = (
@@ -163,7 +163,7 @@ class MatchRecord:
     tick_rate: int
     rounds: list[EstaRoundRecord]
     team_names: dict[str, str]
-    provenance: dict[str, Any]
+    provenance: JsonObject
     client_name: str = ""
     parse_rate: int = 64
 

@@ -14,12 +14,13 @@ import lzma
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TypeAlias
 
 import msgspec
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.schema import Invalid, RoundHead, RoundState
+from decoy_cli.files import JsonObject, JsonValue
 
 XZ_MAGIC = b"\xfd7zXZ\x00"
 
@@ -30,7 +31,7 @@ _HEAD_DECODER = msgspec.json.Decoder(RoundHead)
 _DECODE_ERRORS = (msgspec.MsgspecError, UnicodeDecodeError, RecursionError)
 """What decoding a raw value can raise: the first pass skips values without checking UTF-8."""
 
-RoundSource = Any
+RoundSource: TypeAlias = "msgspec.Raw | JsonValue"
 """A `gameRounds` entry: msgspec.Raw (the fast path) or an already parsed object (NaN path)."""
 
 
@@ -38,7 +39,7 @@ RoundSource = Any
 class Document:
     """A match file split into metadata (decoded) and rounds (not yet decoded)."""
 
-    top: dict[str, Any]
+    top: JsonObject
     rounds: list[RoundSource]
 
 

@@ -23,7 +23,6 @@ from __future__ import annotations
 import lzma
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import msgspec
 import numpy as np
@@ -52,7 +51,7 @@ from decoy_cli.esta.written_frames import (
     to_hammer,
     weapon_class,
 )
-from decoy_cli.files import write_atomic
+from decoy_cli.files import JsonObject, JsonValue, write_atomic
 
 XZ_PRESET = 6
 """xz preset: the default. Measured on an 8-round sample (14.3 MB of JSON): preset 6 gives 165 KB
@@ -77,7 +76,7 @@ def encode_match(match: MatchRecord) -> bytes:
     return _ENCODER.encode(match_document(match))
 
 
-def match_document(match: MatchRecord) -> dict[str, Any]:
+def match_document(match: MatchRecord) -> JsonObject:
     """The awpy 1.x JSON document of a match (plain dicts, lists and numbers)."""
     for side in ("T", "CT"):
         if side not in match.team_names:
@@ -88,7 +87,7 @@ def match_document(match: MatchRecord) -> dict[str, Any]:
     scores = {"T": 0, "CT": 0}
     spent_total: dict[str, int] = {}
     global_frame = 0
-    rounds = []
+    rounds: list[JsonValue] = []
     for record in match.rounds:
         check_round(record)
         document = _round_document(match, record, dict(scores), spent_total, global_frame)
@@ -140,7 +139,7 @@ def _round_document(
     scores: dict[str, int],
     spent_total: dict[str, int],
     global_frame: int,
-) -> dict[str, Any]:
+) -> JsonObject:
     rate = match.tick_rate
     teams = match.team_names
     loser = "CT" if r.winning_side == "T" else "T"
@@ -193,7 +192,7 @@ def _round_document(
     }
 
 
-def _side_roster(team: str, players: list[PlayerRecord]) -> dict[str, Any]:
+def _side_roster(team: str, players: list[PlayerRecord]) -> JsonObject:
     return {
         "teamName": team,
         "players": [{"playerName": p.name, "steamID": p.steam_id} for p in players],
@@ -209,11 +208,11 @@ class _EventContext:
         self.r = r
         self.plant_s = plant_s
 
-    def _time(self, tick: int) -> dict[str, Any]:
+    def _time(self, tick: int) -> JsonObject:
         seconds = (tick - self.r.freeze_end_tick) / self.rate
         return {"tick": tick, "seconds": seconds, "clockTime": clock_time(seconds, self.plant_s)}
 
-    def _who(self, role: str, index: int) -> dict[str, Any]:
+    def _who(self, role: str, index: int) -> JsonObject:
         if index < 0:
             return {f"{role}{k}": None for k in ("SteamID", "Name", "Team", "Side")}
         player = self.r.players[index]
@@ -225,7 +224,7 @@ class _EventContext:
         }
 
     @staticmethod
-    def _where(role: str, position: Sequence[float] | None, yaw: float | None) -> dict[str, Any]:
+    def _where(role: str, position: Sequence[float] | None, yaw: float | None) -> JsonObject:
         if position is None:
             x = y = z = view = None
         else:
@@ -246,7 +245,7 @@ class _EventContext:
         metres = float(np.linalg.norm(np.asarray(a, float) - np.asarray(b, float)))
         return floats(np.array([metres / HAMMER_TO_M]))[0]
 
-    def damage(self, d: DamageRecord) -> dict[str, Any]:
+    def damage(self, d: DamageRecord) -> JsonObject:
         attacker = self._who("attacker", d.attacker)
         victim = self._who("victim", d.victim)
         return {
@@ -269,7 +268,7 @@ class _EventContext:
             "zoomLevel": 0,
         }
 
-    def kill(self, k: KillRecord) -> dict[str, Any]:
+    def kill(self, k: KillRecord) -> JsonObject:
         players = self.r.players
         same_side = k.attacker >= 0 and players[k.attacker].side == players[k.victim].side
         traded = self._who("playerTraded", k.traded)
@@ -300,7 +299,7 @@ class _EventContext:
             "weaponClass": weapon_class(k.weapon),
         }
 
-    def bomb_event(self, b: BombEventRecord) -> dict[str, Any]:
+    def bomb_event(self, b: BombEventRecord) -> JsonObject:
         who = self._who("player", b.player)
         x, y, z = floats(to_hammer(np.asarray(b.position)))
         return {

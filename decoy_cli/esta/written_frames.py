@@ -7,8 +7,6 @@ equipment values, alive counts and buy types (decoy_cli/esta/writer.py writes th
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M
@@ -19,6 +17,7 @@ from decoy_cli.esta.records import (
     MatchRecord,
     player_key,
 )
+from decoy_cli.files import JsonObject, JsonValue
 from decoy_cli.weapons import WEAPONS
 
 _BUY_TYPES = ((5_000, "Full Eco"), (10_000, "Semi Eco"), (20_000, "Semi Buy"))
@@ -29,12 +28,11 @@ def to_hammer(values: np.ndarray) -> np.ndarray:
     return (np.asarray(values, dtype=np.float64) / HAMMER_TO_M).astype(np.float32)
 
 
-def floats(values: np.ndarray) -> list[Any]:
+def floats(values: np.ndarray) -> list[float | None]:
     """float32 values as Python floats printed in their shortest float32 form; NaN -> None."""
     flat = np.asarray(values, dtype=np.float32).ravel()
     text = flat.astype(str)
-    out: list[Any] = [None if s == "nan" else float(s) for s in text]
-    return out
+    return [None if s == "nan" else float(s) for s in text]
 
 
 def buy_type(value: int) -> str:
@@ -64,7 +62,7 @@ def frame_documents(
     plant_s: float | None,
     spent_total: dict[str, int],
     global_frame: int,
-) -> list[dict[str, Any]]:
+) -> list[JsonValue]:
     """Every frame of a round, both sides, with the full awpy player state."""
     rate = match.tick_rate
     ticks = np.asarray(r.frame_ticks, dtype=np.int64)
@@ -97,10 +95,12 @@ def frame_documents(
     }
     place = np.full((p, f), "", dtype=object) if r.place is None else np.asarray(r.place)
     bomb = floats(to_hammer(np.asarray(r.bomb_position)))
-    frames = []
+    frames: list[JsonValue] = []
     for j in range(f):
         seconds = (int(ticks[j]) - r.freeze_end_tick) / rate
-        teams: dict[str, list[dict[str, Any]]] = {"T": [], "CT": []}
+        teams: dict[str, list[JsonValue]] = {"T": [], "CT": []}
+        team_value = {"T": 0, "CT": 0}
+        team_alive = {"T": 0, "CT": 0}
         for i, player in enumerate(r.players):
             if not present[i, j]:
                 continue
@@ -109,6 +109,8 @@ def frame_documents(
             has_bomb = bool(r.has_bomb[i, j])
             inventory = [*player.inventory, *(["C4"] if has_bomb else [])] if alive else []
             value = player.equipment_value if alive else 0
+            team_value[player.side] += value
+            team_alive[player.side] += alive
             teams[player.side].append(
                 {
                     "steamID": player.steam_id,
@@ -181,8 +183,8 @@ def frame_documents(
                 "tick": int(ticks[j]),
                 "seconds": seconds,
                 "clockTime": clock_time(seconds, plant_s),
-                "t": _team_state(match, "T", teams["T"]),
-                "ct": _team_state(match, "CT", teams["CT"]),
+                "t": _team_state(match, "T", teams["T"], team_value["T"], team_alive["T"]),
+                "ct": _team_state(match, "CT", teams["CT"], team_value["CT"], team_alive["CT"]),
                 "bombPlanted": bool(r.bomb_planted[j]),
                 "bombsite": str(r.bombsite[j]),
                 "bomb": None if x is None else {"x": x, "y": y, "z": z},
@@ -194,12 +196,15 @@ def frame_documents(
     return frames
 
 
-def _team_state(match: MatchRecord, side: str, players: list[dict[str, Any]]) -> dict[str, Any]:
+def _team_state(
+    match: MatchRecord, side: str, players: list[JsonValue], value: int, alive: int
+) -> JsonObject:
+    """A side's state in a frame: its `players`, their equipment `value` and `alive` count."""
     return {
         "side": side,
         "teamName": match.team_names[side],
-        "teamEqVal": sum(p["equipmentValue"] for p in players),
-        "alivePlayers": sum(1 for p in players if p["isAlive"]),
+        "teamEqVal": value,
+        "alivePlayers": alive,
         "totalUtility": 0,
         "players": players,
     }

@@ -22,7 +22,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import msgspec
 
@@ -32,6 +32,7 @@ from decoy_cli.esta.batch import UNREADABLE_FILE
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import RoundRecord, build_record
 from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
+from decoy_cli.files import JsonValue
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import PlaceFinder
 from decoy_cli.world.occlusion import OcclusionScene, read_sight_scene
@@ -175,7 +176,7 @@ def worker_state(settings: EvalSettings) -> _WorkerState:
     return state
 
 
-def is_synthetic(match_id: str, provenance: Any) -> bool:
+def is_synthetic(match_id: str, provenance: JsonValue) -> bool:
     """Whether a match says it was generated, not recorded (matchID or provenance)."""
     text = f"{match_id} {json.dumps(provenance, default=str)}".lower()
     return "synthetic" in text
