@@ -39,6 +39,7 @@ from decoy_cli.bench.simspeed import (
     speed_table,
 )
 from decoy_cli.csgo import BUILTIN_MAP
+from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.setup import MoverName
 from decoy_cli.waypoints.build import canonical_map
@@ -66,7 +67,7 @@ class BenchConfig:
     Table 1 has every mechanic on)."""
 
     quick: bool
-    models: str
+    models: ModelChoice
     mover: MoverName = "physics"
     combat: bool = True
     bomb: bool = True
@@ -84,7 +85,7 @@ class BenchConfig:
         cls,
         *,
         quick: bool,
-        models: str,
+        models: ModelChoice,
         mover: MoverName = "physics",
         combat: bool = True,
         bomb: bool = True,
@@ -115,17 +116,17 @@ class BenchConfig:
 class ModelStatus:
     """The damage model the sections use, as the report states it."""
 
-    choice: str
+    choice: ModelChoice
     loaded: bool
     label: str
     error: str | None = None
 
 
-def check_damage_model(choice: str) -> ModelStatus:
+def check_damage_model(choice: ModelChoice) -> ModelStatus:
     """Try to load the chosen damage model; on failure say why (the sections fall back)."""
     from decoy_cli.damage import load_damage_model
 
-    if choice == "none":
+    if choice == ModelName.NONE:
         return ModelStatus(choice, False, "none (--models none): line of sight only, no inference")
     try:
         model = load_damage_model(choice)
@@ -219,7 +220,7 @@ def portable_config(config: BenchConfig) -> PortableConfig:
     """What a portable section (`decoy_cli.bench.portable`) reads of the config."""
     settings: PortableConfig = {
         "quick": config.quick,
-        "models": config.models,
+        "models": str(config.models),
         "combat": config.combat,
         "bomb": config.bomb,
         "seed": config.seed,
@@ -285,7 +286,7 @@ def report(
         "config": {k: v for k, v in asdict(config).items() if k != "models"},
         "machine": machine,
         "load_average_end": load_average(),
-        "damage_model": asdict(status),
+        "damage_model": {**asdict(status), "choice": str(status.choice)},
         "data": data.describe() if data is not None else None,
         "sections": sections,
         "peak_rss_mb_main": peak_rss_mb(),

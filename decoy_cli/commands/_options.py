@@ -1,9 +1,15 @@
-"""Help of options shared by several commands: the maps, who decides deaths, and what to do
-with the fields the data lacks (the last two are `Literal` types, which Typer lists)."""
+"""Options shared by several commands: the mover and the damage models (one definition each),
+and the help of the maps, who decides deaths and what to do with the fields the data lacks
+(the mover, deaths and missing fields are `Literal` types, which Typer lists)."""
 
 from __future__ import annotations
 
+import typer
+
 from decoy_cli.csgo import MAP_NAMES
+from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.damage.choice import MODELS_METAVAR, ModelName
+from decoy_cli.sim.setup import MoverName
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
 """The built-in maps, for the help of every `--map`."""
@@ -29,3 +35,17 @@ MOVER_HELP = (
     "measured the more faithful in replays) or physics (pybullet capsules that block each "
     "other, as the paper's engine)"
 )
+
+
+def mover_option(default: MoverName) -> MoverName:
+    """The `--mover` option (Typer's parameter default), `default` unless told."""
+    return typer.Option(default, "--mover", help=f"The mover: {MOVER_HELP}.")
+
+
+MODELS_HELP = f"The damage models when shooting: {CHOICES_HELP}."
+
+
+def models_option(default: ModelName) -> str:
+    """The `--models` option (Typer's parameter default), `default` unless told: its text, which
+    the command parses once (`decoy_cli.damage.parse_models`)."""
+    return typer.Option(default.value, "--models", metavar=MODELS_METAVAR, help=MODELS_HELP)

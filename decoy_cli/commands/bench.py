@@ -38,9 +38,9 @@ from decoy_cli.bench.records import (
     not_measured,
 )
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import MAPS_HELP, MOVER_HELP
+from decoy_cli.commands._options import MAPS_HELP, models_option, mover_option
 from decoy_cli.csgo import BUILTIN_MAP
-from decoy_cli.damage import CHOICES_HELP, SHIPPED_CHOICES
+from decoy_cli.damage import SHIPPED_CHOICES, ModelName, parse_models
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
 from decoy_cli.sim.setup import MoverName
@@ -65,23 +65,14 @@ def bench(
         help="A smoke run of a few seconds per section: 1,000 decisions at 2 and 10 agents, "
         "3 rounds, 100 metric pairs, 2 files.",
     ),
-    models: str = typer.Option(
-        "shipped",
-        "--models",
-        help=f"Damage models of the combat step: {CHOICES_HELP}. If they cannot be loaded, the "
-        "benchmark says so and runs line of sight without inference. The default is the DOG, "
-        "not the rules that `replay` and `evaluate` default to: every earlier version has it, "
-        "so `--baseline` compares like with like.",
-    ),
+    models: str = models_option(ModelName.SHIPPED),
     data: Path | None = typer.Option(
         None,
         "--data",
         help="Folder of ESTA match files for the replay and reader sections (default: "
         "../shared/data/esta_dust2_tside when present, else the sample in examples/sample/).",
     ),
-    mover: MoverName = typer.Option(
-        "physics", "--mover", help=f"Mover of Table 1 (physics, as the paper): {MOVER_HELP}."
-    ),
+    mover: MoverName = mover_option("physics"),
     combat: bool = typer.Option(
         True,
         "--combat/--no-combat",
@@ -118,15 +109,21 @@ def bench(
 
     Sections: Table 1, a 5v5 combat step, replay, metrics and reader throughput, each in its
     own process; prints tables and writes a JSON report with the machine. Exits non-zero when a
-    section failed."""
+    section failed.
+
+    --mover is Table 1's (physics by default, as the paper's). --models is the combat step's:
+    if the models cannot be loaded, the benchmark says so and runs line of sight without
+    inference. Its default is the DOG (shipped), not the rules that `replay` and `evaluate`
+    default to: every earlier version has it, so `--baseline` compares like with like."""
     console = make_console()
     if out.is_dir():
         raise OutputError(f"--out {out}: is a folder; give the JSON file to write")
     check_writable(out)  # before minutes of measuring
     chosen = _chosen_sections(sections)
+    choice = parse_models(models)
     config = BenchConfig.create(
         quick=quick,
-        models=models,
+        models=choice,
         mover=mover,
         combat=combat,
         bomb=bomb,
@@ -139,7 +136,7 @@ def bench(
     if baseline is not None:
         switches: BenchSwitches = {
             "quick": quick,
-            "models": models,
+            "models": str(choice),
             "mover": mover,
             "combat": combat,
             "bomb": bomb,
@@ -149,7 +146,7 @@ def bench(
             switches["map_name"] = config.map_name
         _side_by_side(console, chosen, switches, bench_data, baseline, repeats, out)
         return
-    status = check_damage_model(models)
+    status = check_damage_model(choice)
     if status.error:
         console.print(
             f"damage model {models!r} could not be loaded: {status.error}"

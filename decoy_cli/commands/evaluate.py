@@ -27,10 +27,11 @@ from decoy_cli.commands._options import (
     DEATHS_HELP,
     MAPS_HELP,
     MISSING_HELP,
-    MOVER_HELP,
     SIGHT_MESH_HELP,
+    models_option,
+    mover_option,
 )
-from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
+from decoy_cli.damage import DEFAULT_MODELS, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
@@ -100,10 +101,8 @@ def evaluate(
     bomb: bool = typer.Option(
         True, "--bomb/--no-bomb", help="Bomb rules: carrier, plant, defuse, detonation."
     ),
-    models: str = typer.Option(
-        DEFAULT_MODELS, "--models", help=f"Damage model with --combat: {CHOICES_HELP}."
-    ),
-    mover: MoverName = typer.Option("kinematic", "--mover", help=f"The mover: {MOVER_HELP}."),
+    models: str = models_option(DEFAULT_MODELS),
+    mover: MoverName = mover_option("kinematic"),
     deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
     missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
     out: Path = typer.Option(
@@ -171,7 +170,7 @@ def evaluate(
         map_name=map_name,
         combat=combat,
         bomb=bomb,
-        models=models,
+        models=parse_models(models),
         mover=mover,
         seed=seed,
         implausible=check_policy(implausible),

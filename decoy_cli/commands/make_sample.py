@@ -11,8 +11,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import MAPS_HELP
-from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
+from decoy_cli.commands._options import MAPS_HELP, models_option
+from decoy_cli.damage import DEFAULT_MODELS, load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
@@ -27,9 +27,7 @@ def make_sample(
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="Folder to write the match file to."),
     rounds: int = typer.Option(8, "--rounds", help=f"Rounds to play (1-{MAX_ROUNDS})."),
     seed: int = typer.Option(0, "--seed", help="Seed of every random choice (>= 0)."),
-    models: str = typer.Option(
-        DEFAULT_MODELS, "--models", help=f"Damage models for combat: {CHOICES_HELP}."
-    ),
+    models: str = models_option(DEFAULT_MODELS),
     map_name: str = typer.Option("dust2", "--map", help=f"The map to play on: {MAPS_HELP}."),
 ) -> None:
     """Write a synthetic ESTA match: scripted 5v5 rounds played in the simulator.
@@ -46,12 +44,13 @@ def make_sample(
         raise DecoyError(f"--seed must be >= 0, not {seed}")
     map_id = canonical_map(map_name)
     console = make_console()
-    damage_model = load_damage_model(models)
+    choice = parse_models(models)
+    damage_model = load_damage_model(choice)
     if damage_model is None:
         console.print(
             "no damage models: combat is off (rounds end by bomb or time)", style="yellow"
         )
-    for line in map_warnings(models, [map_id]):
+    for line in map_warnings(choice, [map_id]):
         console.print(f"warning: {line}", style="yellow", markup=False)
     check_folder_writable(out)  # fail before playing, not after
     status = make_console(stderr=True)
@@ -72,13 +71,13 @@ def make_sample(
             rounds,
             seed,
             damage_model,
-            models,
+            str(choice),
             on_round=lambda _: progress.advance(task),
             map_name=map_id,
         )
     seconds = time.perf_counter() - started
 
-    table = Table(title=f"{sample.match.match_id} (synthetic, damage models: {models})")
+    table = Table(title=f"{sample.match.match_id} (synthetic, damage models: {choice})")
     table.add_column("round", justify="right")
     table.add_column("T plan")
     table.add_column("CT setup")

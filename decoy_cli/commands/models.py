@@ -27,7 +27,8 @@ from decoy_cli.commands._damage_output import (
     print_samples,
     progress_bars,
 )
-from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER
+from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
+from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
@@ -231,7 +232,9 @@ def calibrate(
 
 @app.command("evaluate")
 def evaluate(
-    models: str = typer.Argument(..., help=f"The models to score: {CHOICES_HELP}."),
+    models: str = typer.Argument(
+        ..., metavar=MODELS_METAVAR, help=f"The models to score: {CHOICES_HELP}."
+    ),
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
     out: Path = typer.Option(
         DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
@@ -276,7 +279,7 @@ def evaluate(
     bars, on_file, _ = progress_bars()
     with bars:
         result = evaluate_model_folder(
-            models=models,
+            models=parse_models(models),
             choice=choice,
             out=out,
             subset=subset,
@@ -292,9 +295,9 @@ def evaluate(
         console.print(f"warning: {line}", style="yellow", markup=False)
     if result.dip is not None:
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
-        for where, m in result.report["dip_by_map"].items():
+        for where, m in result.dip_by_map.items():
             console.print(
-                f"DIP on {where} ({result.report['dip_of_map'][where]}, threshold "
+                f"DIP on {where} ({result.dip_of_map[where]}, threshold "
                 f"{m['threshold']:.3f}): recall {m['recall']:.3f}, precision "
                 f"{m['precision']:.3f}, ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} "
                 f"damaging, {m['negatives']:,} not)",

@@ -15,10 +15,11 @@ from decoy_cli.commands._options import (
     DEATHS_HELP,
     MAPS_HELP,
     MISSING_HELP,
-    MOVER_HELP,
     SIGHT_MESH_HELP,
+    models_option,
+    mover_option,
 )
-from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS, load_damage_model
+from decoy_cli.damage import DEFAULT_MODELS, load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
@@ -35,7 +36,7 @@ def replay(
         True, "--combat/--no-combat", help="Shooting, with the damage models of --models."
     ),
     bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
-    mover: MoverName = typer.Option("kinematic", "--mover", help=f"The mover: {MOVER_HELP}."),
+    mover: MoverName = mover_option("kinematic"),
     map_name: str | None = typer.Option(
         None,
         "--map",
@@ -54,12 +55,7 @@ def replay(
     ),
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
-    models: str = typer.Option(
-        DEFAULT_MODELS,
-        "--models",
-        help=f"Damage models for shooting: {CHOICES_HELP} (with none, deaths in the data are "
-        "scripted).",
-    ),
+    models: str = models_option(DEFAULT_MODELS),
     implausible: str = typer.Option(
         "fail",
         "--implausible",
@@ -69,10 +65,12 @@ def replay(
     deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
     missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
 ) -> None:
-    """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data."""
+    """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data (with
+    --models none, deaths in the data are scripted)."""
     console = make_console()
     policy = check_policy(implausible)
-    damage_model = load_damage_model(models) if combat else None
+    choice = parse_models(models)
+    damage_model = load_damage_model(choice) if combat else None
     if combat and damage_model is None:
         console.print(
             "--models none: replaying without shooting (deaths in the data are scripted)",
@@ -91,7 +89,7 @@ def replay(
     run = replay_address(
         address,
         options,
-        models=models,
+        models=str(choice),
         map_name=map_name,
         graph_file=graph_file,
         out=out,
@@ -131,7 +129,7 @@ def replay(
         console.print(f"inferred: {note}", style="yellow", markup=False)
     if options.combat:
         console.print(f"deaths decided by: {options.deaths}")
-        for line in map_warnings(models, [round_.map_name]):
+        for line in map_warnings(choice, [round_.map_name]):
             console.print(f"warning: {line}", style="yellow", markup=False)
     _show_bomb(console, result.bomb_row())
     for title, names in (

@@ -1,5 +1,6 @@
 """Learned damage models, DIP and DOG (the paper's combat), with torch imported lazily.
 
+* choice.py: the `--models` choice (`ModelName`, `ModelFolder`, `parse_models`);
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
@@ -25,6 +26,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from decoy_cli.damage.choice import ModelChoice, ModelFolder, ModelName, parse_models
 from decoy_cli.errors import ModelError
 from decoy_cli.package_data import packaged_dir
 
@@ -34,12 +36,12 @@ if TYPE_CHECKING:
 SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
-DEFAULT_MODELS = "rules"
+DEFAULT_MODELS = ModelName.RULES
 """What `--models` is unless told: the shipped DIP (off its maps, the shipped map-independent
 one: `model_maps.dip_for_map`) with damage by the game's rules, the combination that measures
 best on the real damage events (README, "Damage models")."""
 
-SHIPPED_CHOICES = ("shipped", "rules")
+SHIPPED_CHOICES = (ModelName.SHIPPED, ModelName.RULES)
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
 
 CHOICES_HELP = (
@@ -60,7 +62,7 @@ PAPER_FOLDER = Path("decoy-out") / "models" / "paper"
 `--models paper` uses a folder `paper` when there is one, else this one."""
 
 
-def resolve_models(choice: str) -> Path:
+def resolve_models(choice: ModelChoice) -> Path:
     """The model folder a `--models` choice names (not "none"): the shipped one for "shipped"
     and "rules", a folder for "paper" (`PAPER_FOLDER`) or a path. A missing folder is one
     ModelError line."""
@@ -71,8 +73,8 @@ def resolve_models(choice: str) -> Path:
                 "(e.g. from `decoy models import-decoy`) or none"
             )
         return SHIPPED_MODELS
-    folder = Path(choice).expanduser()
-    if choice == "paper" and not folder.is_dir():
+    folder = Path(str(choice)).expanduser()
+    if choice == ModelName.PAPER and not folder.is_dir():
         folder = PAPER_FOLDER
         if not folder.is_dir():
             raise ModelError(
@@ -84,22 +86,22 @@ def resolve_models(choice: str) -> Path:
     return folder
 
 
-def damages_by_rules(choice: str, folder: Path) -> bool:
+def damages_by_rules(choice: ModelChoice, folder: Path) -> bool:
     """True when the choice's damage comes from the game's rules (`rules.json`), False when
     from the folder's DOG: "rules", or a folder with a rules.json and no DOG."""
     from decoy_cli.damage.rules_model import RULES_FILE
 
-    return choice == "rules" or (
+    return choice == ModelName.RULES or (
         (folder / RULES_FILE).is_file() and not (folder / "dog.json").is_file()
     )
 
 
-def model_roles(choice: str, map_name: str) -> dict[str, str]:
+def model_roles(choice: ModelChoice, map_name: str) -> dict[str, str]:
     """Which model decides who hits on `map_name` and which how much, in words, for a
     `--models` choice (a folder that cannot be read names itself only)."""
     from decoy_cli.damage.model_maps import dip_for_map
 
-    if choice == "none":
+    if choice == ModelName.NONE:
         return {"hits": "none (no shooting)", "damage": "none (no shooting)"}
     try:
         folder = resolve_models(choice)
@@ -113,16 +115,18 @@ def model_roles(choice: str, map_name: str) -> dict[str, str]:
     return {"hits": dip_for_map(choice, map_name).name, "damage": damage}
 
 
-def load_damage_model(choice: str) -> DamageModel | None:
+def load_damage_model(choice: ModelChoice | str) -> DamageModel | None:
     """The damage model a user chose: "shipped", "rules", "none" (None: no shooting), "paper"
     or the path of a model folder holding a DIP and a DOG (e.g. written by `decoy models
     import-decoy`) or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's
     rules). The shipped choices decide hits by the shipped map-independent DIP on the maps
     their own DIP was not trained on (`model_maps.dip_for_map`).
 
-    A missing or incompatible folder is one ModelError line.
+    The choice may be given as its text (`parse_models`). A missing or incompatible folder is
+    one ModelError line.
     """
-    if choice == "none":
+    choice = parse_models(choice)
+    if choice == ModelName.NONE:
         return None
     folder = resolve_models(choice)
     from decoy_cli.damage.combat import LearnedDamage, StandIn
@@ -139,12 +143,17 @@ def load_damage_model(choice: str) -> DamageModel | None:
 
 __all__ = [
     "CHOICES_HELP",
+    "DEFAULT_MODELS",
     "PAPER_FOLDER",
     "SHIPPED_CHOICES",
     "SHIPPED_MODELS",
+    "ModelChoice",
+    "ModelFolder",
+    "ModelName",
     "damages_by_rules",
     "load_damage_model",
     "model_roles",
+    "parse_models",
     "resolve_models",
     "shipped_models_installed",
 ]

@@ -10,13 +10,13 @@ are loaded, not when this module is imported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS, BulletCounts
+from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.damage.damage_rows import group_id
 from decoy_cli.damage.evaluation import DRAWS, DipEvaluation, DogEvaluation
 from decoy_cli.damage.hp_lost import HpLostScores
@@ -50,14 +50,19 @@ class FolderEvaluation:
     notes: list[str]
     warnings: list[str]
     """Model parts not trained on every map of the data (`model_maps.map_warnings`)."""
-    report: dict[str, Any]
+    report: dict[str, object]
+    """What metrics.json holds."""
     out: Path
     figures: list[Path]
+    dip_by_map: dict[str, dict[str, float]] = field(default_factory=dict)
+    """DIP's metrics on each map's samples (`evaluate_map_dips`)."""
+    dip_of_map: dict[str, str] = field(default_factory=dict)
+    """The DIP that decides hits on each map."""
 
 
 def evaluate_model_folder(
     *,
-    models: str,
+    models: ModelChoice,
     choice: SampleChoice,
     out: Path,
     subset: str = DEFAULT_SUBSET,
@@ -73,7 +78,7 @@ def evaluate_model_folder(
     ModelError line."""
     from decoy_cli.damage import damages_by_rules, resolve_models
 
-    if models == "none":
+    if models == ModelName.NONE:
         raise ModelError("none: no models to evaluate (none turns shooting off)")
     folder = resolve_models(models)
     by_rules = damages_by_rules(models, folder)
@@ -95,8 +100,8 @@ def evaluate_model_folder(
     from decoy_cli.damage.model_maps import map_warnings
     from decoy_cli.damage.rules_model import RulesFile
 
-    report: dict[str, Any] = {
-        "models": models,
+    report: dict[str, object] = {
+        "models": str(models),
         "model_folder": str(folder),
         "damage_by": "rules" if by_rules else "DOG",
         "data": [str(d) for d in choice.data],
@@ -108,8 +113,11 @@ def evaluate_model_folder(
     }
     figures: list[Path] = []
     notes: list[str] = []
-    name = models if models in ("rules", "shipped", "paper") else folder.name or str(folder)
+    named = models in (ModelName.RULES, ModelName.SHIPPED, ModelName.PAPER)
+    name = str(models) if named else folder.name or str(folder)
     dip_result = dog_result = None
+    by_map: dict[str, dict[str, float]] = {}
+    dip_of_map: dict[str, str] = {}
     if has_dip:
         chosen = balance(samples, index, choice.seed) if balanced else index
         if not samples.hit[chosen].any():
@@ -170,11 +178,13 @@ def evaluate_model_folder(
         report,
         out,
         figures,
+        by_map,
+        dip_of_map,
     )
 
 
 def evaluate_map_dips(
-    models: str, samples: Samples, chosen: np.ndarray, threshold: float | None
+    models: ModelChoice, samples: Samples, chosen: np.ndarray, threshold: float | None
 ) -> tuple[DipEvaluation, dict[str, dict[str, float]], dict[str, str]]:
     """The `chosen` samples scored map by map by the DIP each map gets
     (`model_maps.dip_for_map`), at its threshold (or `threshold`): the evaluation of them all,

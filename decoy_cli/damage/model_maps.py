@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.damage.rules_model import RULES_FILE
 
 ANY_MAP = "any_map"
@@ -40,7 +41,7 @@ def any_map_folder() -> Path | None:
     return folder if (folder / "dip.json").is_file() else None
 
 
-def stand_in_of(choice: str) -> tuple[Path, frozenset[str]] | None:
+def stand_in_of(choice: ModelChoice) -> tuple[Path, frozenset[str]] | None:
     """(the folder of the DIP that stands in off the choice's own DIP's maps, those maps) for
     the shipped choices when the map-independent DIP (`ANY_MAP`) is installed; None otherwise
     (a user's folder keeps its DIP everywhere). The one rule `dip_for_map` and the loaded
@@ -53,7 +54,7 @@ def stand_in_of(choice: str) -> tuple[Path, frozenset[str]] | None:
     return fallback, frozenset(trained_maps(resolve_models(choice), "dip") or [])
 
 
-def dip_for_map(choice: str, map_name: str) -> MapDip:
+def dip_for_map(choice: ModelChoice, map_name: str) -> MapDip:
     """The DIP that decides hits on `map_name` for a `--models` choice (not "none"): the
     choice's own, or off its maps the stand-in (`stand_in_of`)."""
     from decoy_cli.damage import SHIPPED_MODELS, resolve_models
@@ -87,14 +88,14 @@ def trained_maps(folder: Path, part: str) -> list[str] | None:
     return sorted(maps)
 
 
-def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
+def map_warnings(choice: ModelChoice, maps: Iterable[str]) -> list[str]:
     """One line per model part of the `--models` choice that was not trained on every one of
     `maps` where it is used, naming the maps it was trained on (or saying it does not say),
     and where the map-independent DIP stands in for the choice's own (`dip_for_map`); none for
     "none"."""
     from decoy_cli.damage import damages_by_rules, resolve_models
 
-    if choice == "none":
+    if choice == ModelName.NONE:
         return []
     folder = resolve_models(choice)
     used = sorted(set(maps))
@@ -127,7 +128,7 @@ def map_warnings(choice: str, maps: Iterable[str]) -> list[str]:
     return lines
 
 
-def _fallback_lines(choice: str, maps: list[str]) -> list[str]:
+def _fallback_lines(choice: ModelChoice, maps: list[str]) -> list[str]:
     """The lines of the maps where the map-independent DIP stands in for the choice's own
     (`dip_for_map`): which DIP decides hits there and the maps each was trained on, and the
     maps it never saw."""

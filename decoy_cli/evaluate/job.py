@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
+from decoy_cli.damage.choice import ModelChoice
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
 from decoy_cli.esta.batch import UNREADABLE_FILE
@@ -99,10 +100,10 @@ class _WorkerState:
         self.places = PlaceFinder(self.graph)
         self.physics = PhysicsWorld(graph_world(self.graph))
         self.sight = run_sight(settings, self.graph)
-        self.models: dict[str, DamageModel | None] = {}
+        self.models: dict[ModelChoice, DamageModel | None] = {}
         self.matches: OrderedDict[tuple[str, str, str], Match] = OrderedDict()
 
-    def damage_model(self, choice: str) -> DamageModel | None:
+    def damage_model(self, choice: ModelChoice) -> DamageModel | None:
         """The damage model of a `--models` choice, loaded once (torch on one thread)."""
         if choice not in self.models:
             from decoy_cli.damage import load_damage_model

@@ -244,7 +244,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> JsonObject
                 "graph": settings.graph or "shipped",
                 "combat": settings.combat,
                 "bomb": settings.bomb,
-                "models": settings.models,
+                "models": str(settings.models),
                 "mover": settings.mover,
                 "seed": settings.seed,
                 "implausible": settings.implausible,

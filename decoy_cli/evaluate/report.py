@@ -77,10 +77,10 @@ def mechanics(settings: EvalSettings) -> str:
 
 def model_lines(settings: EvalSettings) -> dict[str, str]:
     """ "hits decided by" and "damage decided by", in words (`damage.model_roles`)."""
-    from decoy_cli.damage import model_roles
+    from decoy_cli.damage import ModelName, model_roles
     from decoy_cli.damage.model_maps import map_warnings
 
-    models = settings.models if settings.combat else "none"
+    models = settings.models if settings.combat else ModelName.NONE
     roles = model_roles(models, settings.map_name)
     lines = {"hits decided by": roles["hits"], "damage decided by": roles["damage"]}
     warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
@@ -115,7 +115,7 @@ def command_line(
     words += ["--seed", str(settings.seed), "--combat" if settings.combat else "--no-combat"]
     words += ["--bomb" if settings.bomb else "--no-bomb"]
     if settings.combat:
-        words += ["--models", settings.models, "--deaths", settings.deaths]
+        words += ["--models", str(settings.models), "--deaths", settings.deaths]
     words += ["--mover", settings.mover, "--implausible", settings.implausible]
     words += ["--missing-fields", settings.missing]
     words += ["--fastdtw" if settings.fastdtw else "--no-fastdtw", "--out", str(out)]

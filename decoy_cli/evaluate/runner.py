@@ -27,6 +27,7 @@ from typing import Protocol
 
 import numpy as np
 
+from decoy_cli.damage.choice import ModelChoice, ModelFolder, ModelName
 from decoy_cli.errors import DecoyError, EstaError, GraphError
 from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
@@ -121,7 +122,7 @@ def make_settings(
     map_name: str,
     combat: bool,
     bomb: bool,
-    models: str,
+    models: ModelChoice,
     mover: MoverName,
     seed: int,
     implausible: Implausible = "fail",
@@ -150,8 +151,8 @@ def make_settings(
     if combat:
         from decoy_cli.damage import SHIPPED_CHOICES, load_damage_model, resolve_models
 
-        if models not in (*SHIPPED_CHOICES, "none"):  # a folder: absolute, for workers elsewhere
-            models = str(resolve_models(models).resolve())
+        if models not in (*SHIPPED_CHOICES, ModelName.NONE):  # absolute, for workers elsewhere
+            models = ModelFolder(str(resolve_models(models).resolve()))
         if load_damage_model(models) is not None:
             models_fingerprint = folder_fingerprint(resolve_models(models))
     sight_path, sight_sha = "", ""
@@ -165,7 +166,7 @@ def make_settings(
         map_name=name,
         combat=combat,
         bomb=bomb,
-        models=models if combat else "none",
+        models=models if combat else ModelName.NONE,
         mover=mover,
         seed=seed,
         grid=HeatGrid.for_map(name),

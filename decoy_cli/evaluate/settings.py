@@ -15,6 +15,7 @@ from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from decoy_cli.damage.choice import ModelChoice
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.heat import HeatGrid
@@ -65,7 +66,7 @@ class EvalSettings:
     map_name: str
     combat: bool
     bomb: bool
-    models: str
+    models: ModelChoice
     mover: MoverName
     seed: int
     grid: HeatGrid
@@ -93,7 +94,7 @@ class EvalSettings:
     """SHA-256 of that file."""
 
     def to_json(self) -> str:
-        return json.dumps(asdict(self), sort_keys=True)
+        return json.dumps({**asdict(self), "models": str(self.models)}, sort_keys=True)
 
 
 def round_key(settings: EvalSettings, file_sha: str, round_num: int) -> str:
