@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import typer
@@ -23,6 +22,7 @@ from decoy_cli.damage import DEFAULT_MODELS, load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.esta.plausibility import check_policy
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
+from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplayOptions
@@ -165,7 +165,7 @@ def replay(
     console.print(f"replay written to {run.folder}")
 
 
-def _show_bomb(console: Console, bomb: dict[str, Any] | None) -> None:
+def _show_bomb(console: Console, bomb: BombRow | None) -> None:
     """The bomb of the data against the replay's: plant, defuse and the data's anomalies."""
     if bomb is None or not bomb["bomb_recorded"]:
         console.print("bomb: off" if bomb is None else "bomb: not recorded in the data")

@@ -12,7 +12,7 @@ They are imported on first use, so importing one part does not load PettingZoo o
 from __future__ import annotations
 
 from importlib import import_module
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from decoy_cli.env.array_env import DecoyArrayEnv
@@ -26,7 +26,7 @@ _EXPORTS = {
 __all__ = ["DecoyArrayEnv", "DecoyParallelEnv"]
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     if name in _EXPORTS:
         return getattr(import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'decoy_cli.env' has no attribute {name!r}")

@@ -11,7 +11,7 @@ counts as missing.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TypeVar
 
 import msgspec
 import numpy as np
@@ -22,8 +22,11 @@ from decoy_cli.files import write_atomic
 
 CACHE_DIR = "cache"
 
+Stored = TypeVar("Stored", RoundRecord, FileIndex)
+"""What the cache stores."""
 
-def _native(value: Any) -> Any:
+
+def _native(value: object) -> object:
     """numpy scalars as Python values (msgpack knows only the Python types)."""
     if isinstance(value, np.generic):
         return value.item()
@@ -68,7 +71,7 @@ class RunCache:
         write_atomic(self.index_path(key), _ENCODER.encode(index))
 
 
-def _load(path: Path, decoder: msgspec.msgpack.Decoder) -> Any:
+def _load(path: Path, decoder: msgspec.msgpack.Decoder[Stored]) -> Stored | None:
     try:
         return decoder.decode(path.read_bytes())
     except (OSError, msgspec.DecodeError):

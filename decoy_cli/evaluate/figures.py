@@ -17,7 +17,8 @@ matplotlib is imported inside the functions (headless Agg backend).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,11 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.evaluate.tables import END_OF_DATA, NOT_RECORDED, UNDECIDED, Accumulator, Tables
 from decoy_cli.figures import draw_nav_areas, save_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from decoy_cli.world.navmesh import NavMesh
 
 FIGURES = {
     "heatmaps": "heatmaps.png",
@@ -42,7 +48,7 @@ _ORIGINAL = "#1f77b4"
 _REPLAY = "#d62728"
 
 
-def _pyplot() -> Any:
+def _pyplot() -> ModuleType:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -51,7 +57,7 @@ def _pyplot() -> Any:
     return plt
 
 
-def draw_figures(folder: Path, acc: Accumulator, tables: Tables, nav: Any) -> dict[str, Path]:
+def draw_figures(folder: Path, acc: Accumulator, tables: Tables, nav: NavMesh) -> dict[str, Path]:
     """Draw every figure into `folder`; returns name -> path."""
     paths = {name: folder / file for name, file in FIGURES.items()}
     draw_heatmaps(paths["heatmaps"], acc, nav)
@@ -91,7 +97,7 @@ def percentage_difference(original: np.ndarray, replay: np.ndarray, floor: float
     return np.where(mean >= floor, diff, np.nan)
 
 
-def draw_heatmaps(path: Path, acc: Accumulator, nav: Any) -> None:
+def draw_heatmaps(path: Path, acc: Accumulator, nav: NavMesh) -> None:
     """Original and replay heatmaps and their percentage difference (see the module doc)."""
     from matplotlib.colors import LogNorm
 
@@ -143,7 +149,7 @@ def draw_heatmaps(path: Path, acc: Accumulator, nav: Any) -> None:
     save_figure(fig, path)
 
 
-def draw_error_map(path: Path, acc: Accumulator, nav: Any) -> None:
+def draw_error_map(path: Path, acc: Accumulator, nav: NavMesh) -> None:
     """The replay's mean distance from the player, by where the player was."""
     plt = _pyplot()
     grid = acc.settings.grid
@@ -188,7 +194,7 @@ def draw_error_map(path: Path, acc: Accumulator, nav: Any) -> None:
     save_figure(fig, path)
 
 
-def _label_places(ax: Any, nav: Any) -> None:
+def _label_places(ax: Axes, nav: NavMesh) -> None:
     """Each nav place's name at the area-weighted centre of its areas."""
     area = (nav.x_max - nav.x_min) * (nav.y_max - nav.y_min)
     cx = (nav.x_min + nav.x_max) / 2 * HAMMER_TO_M

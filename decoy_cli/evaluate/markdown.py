@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Any
+from typing import SupportsFloat
 
 from decoy_cli.text import md_code, md_inline, visible
 
@@ -15,7 +15,7 @@ REPORT_ROWS_SHOWN = 20
 """Rows of a failure, warning or anomaly list shown in the report; the CSVs hold them all."""
 
 
-def num(value: Any, digits: int = 3) -> str:
+def num(value: SupportsFloat | None, digits: int = 3) -> str:
     """A number with fixed digits; "–" for NaN or None."""
     if value is None:
         return "–"

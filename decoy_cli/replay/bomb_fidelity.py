@@ -8,6 +8,7 @@ docs/metrics.md defines every column and `decoy_cli.metrics.bomb` aggregates the
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TypedDict
 
 import numpy as np
 
@@ -34,7 +35,24 @@ BOMB_COLUMNS = (
 """The bomb columns of a round row (rounds.csv, the replay's summary.json)."""
 
 
-def bomb_fidelity(data: DataBomb, events: Sequence[SimEvent]) -> dict[str, object]:
+class BombRow(TypedDict):
+    """A round's `BOMB_COLUMNS` (`bomb_fidelity`)."""
+
+    bomb_recorded: bool
+    plant_data: bool
+    plant_replay: bool
+    plant_time_error_s: float
+    plant_time_resolution_s: float
+    plant_site_data: str
+    plant_site_replay: str
+    plant_position_error_m: float
+    defuse_data: bool
+    defuse_replay: bool
+    defuse_time_error_s: float
+    bomb_anomalies: str
+
+
+def bomb_fidelity(data: DataBomb, events: Sequence[SimEvent]) -> BombRow:
     """The round's `BOMB_COLUMNS`: whether the data and the replay planted and defused, the
     plant's time, site and position errors and the defuse's time error (NaN unless both did),
     and the data's anomalies joined by `ANOMALY_SEPARATOR`."""

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
 
 import msgspec
 import numpy as np
@@ -35,7 +34,7 @@ def write_replay(
     round_: Round,
     result: ReplayResult,
     players: pd.DataFrame,
-    summary: dict[str, Any],
+    summary: dict[str, object],
 ) -> list[Path]:
     """Write the replay files into `folder` (each atomically); returns their paths."""
     folder = Path(folder)

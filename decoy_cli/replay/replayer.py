@@ -44,7 +44,7 @@ from decoy_cli.replay.bomb import (
     policy_plant,
     read_data_bomb,
 )
-from decoy_cli.replay.bomb_fidelity import bomb_fidelity
+from decoy_cli.replay.bomb_fidelity import BombRow, bomb_fidelity
 from decoy_cli.replay.deaths import DeathProtocol, RoundDeaths, data_deaths, replay_deaths
 from decoy_cli.replay.lateness import lateness_table
 from decoy_cli.replay.missing import Missing, contradictions, fill_missing
@@ -81,7 +81,7 @@ class ReplayResult:
     contradictions: tuple[str, ...] = ()  # what the data's frames and events say against each other
     bomb: DataBomb | None = None  # the data's bomb, when the replay followed it
 
-    def bomb_row(self) -> dict[str, object] | None:
+    def bomb_row(self) -> BombRow | None:
         """The bomb fidelity of this replay (`BOMB_COLUMNS`), None when the bomb was off."""
         return None if self.bomb is None else bomb_fidelity(self.bomb, self.events)
 

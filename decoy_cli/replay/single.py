@@ -13,7 +13,6 @@ import re
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -42,7 +41,7 @@ class SingleReplay:
     options: ReplayOptions
     result: ReplayResult
     players: pd.DataFrame
-    summary: dict[str, Any]
+    summary: dict[str, object]
     folder: Path
     seconds: float
 
@@ -138,7 +137,7 @@ def replay_summary(
     players: pd.DataFrame,
     seconds: float,
     sight: str = "the graph's world",
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """The contents of `summary.json`: the round, the options, both outcomes, counts, the
     fields inferred, the bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off) and the
     kill-level fidelity (`KILL_COLUMNS`)."""
