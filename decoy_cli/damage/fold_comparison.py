@@ -24,7 +24,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -36,6 +35,7 @@ from decoy_cli.damage.scores import hit_group_tv, sampling_floor, wasserstein_ce
 from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
+from decoy_cli.files import JsonObject, JsonValue, object_at
 
 MIN_CELL = 5
 """Fewest real samples of a cell in the Wasserstein mean (issue 13's protocol)."""
@@ -163,21 +163,25 @@ def rules_out_of_fold(
     return damage, group
 
 
-def training_overlap(metadata: dict[str, Any], samples: Samples) -> str:
+def training_overlap(metadata: JsonObject, samples: Samples) -> str:
     """What share of the samples' rounds a model saw while it was trained (its training or
     validation part, as its metadata's split records them), in words for a label."""
-    split = metadata.get("split") or {}
-    units = split.get("units") or {}
-    seen = set(units.get("train", [])) | set(units.get("val", []))
+    split = object_at(metadata, "split")
+    units = object_at(split, "units")
+    seen = set(_list(units.get("train"))) | set(_list(units.get("val")))
     key = samples.match if split.get("by") == "match" else samples.group
     rounds = {str(g): str(k) for g, k in zip(samples.group, key, strict=True)}
     overlap = sum(1 for unit in rounds.values() if unit in seen)
     if not split:
         return "its training data unrecorded"
     if overlap == 0:
-        maps = metadata.get("maps")
+        maps = [str(m) for m in _list(metadata.get("maps"))]
         return "trained on none of these rounds" + (f" ({', '.join(maps)})" if maps else "")
     return f"trained or validated on {overlap} of these {len(rounds)} rounds"
+
+
+def _list(value: JsonValue) -> list[JsonValue]:
+    return value if isinstance(value, list) else []
 
 
 def compare_on_folds(

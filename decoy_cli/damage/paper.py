@@ -28,7 +28,6 @@ import hashlib
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import torch
 
@@ -42,6 +41,7 @@ from decoy_cli.damage.model_folder import (
 )
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
+from decoy_cli.files import JsonObject, JsonValue
 
 PAPER_HIT_GROUPS = ("Head", "Neck", "Stomach", "Chest", "Arm", "Leg")
 """The hit-group order of the paper's DOG."""
@@ -135,13 +135,13 @@ def _read_checkpoint(path: Path, kind: str) -> tuple[ImportedModel, dict[str, to
     return info, state
 
 
-def read_args(path: Path, kind: str) -> dict[str, Any] | None:
+def read_args(path: Path, kind: str) -> JsonObject | None:
     """The training options of a checkpoint (None without the file); a ModelError when they
     name another architecture than the one imported."""
     if not path.is_file():
         return None
     try:
-        args = json.loads(path.read_text(encoding="utf-8"))
+        args: JsonValue = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
         raise ModelError(f"{path}: not a readable args JSON ({error})") from None
     if not isinstance(args, dict):
@@ -173,7 +173,7 @@ def import_paper(source: Path, out: Path) -> PaperImport:
     return PaperImport(Path(out), (dip_info, dog_info), PAPER_THRESHOLD)
 
 
-def _metadata(info: ImportedModel, args: dict[str, Any] | None) -> dict[str, Any]:
+def _metadata(info: ImportedModel, args: JsonObject | None) -> JsonObject:
     notes = {
         "dip": f"threshold {PAPER_THRESHOLD} as reported in the paper",
         "dog": "hit groups permuted from the paper's order "

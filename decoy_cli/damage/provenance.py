@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from decoy_cli import __version__, files
 from decoy_cli.damage.sample_set import Samples, SampleStats
@@ -61,7 +60,7 @@ def provenance(
     stats: SampleStats,
     options: TrainOptions,
     samples: Samples,
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """What a model was trained on and how (`command` is "dip" or "dog"; "maps", those of its
     training samples): kept in the model's JSON metadata, so a model folder says where it came
     from."""
@@ -83,6 +82,6 @@ def provenance(
     }
 
 
-def write_json(path: Path, data: dict[str, Any]) -> None:
+def write_json(path: Path, data: dict[str, object]) -> None:
     """Pretty strict JSON in the order given (`decoy_cli.files.write_json`)."""
     files.write_json(path, data, sort_keys=False)

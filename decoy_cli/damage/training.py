@@ -26,7 +26,7 @@ import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Generic, TypeVar, cast
+from typing import Generic, TypeVar, cast
 
 import numpy as np
 import torch
@@ -269,7 +269,7 @@ class Run(Generic[EvaluationT, ModelT]):
     test: EvaluationT
     model: ModelT
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """Sizes, best epoch and test metrics as a JSON-ready dict."""
         return {
             "samples": {name: len(index) for name, index in self.parts.items()},

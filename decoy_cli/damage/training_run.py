@@ -13,7 +13,7 @@ import io
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Generic, TypeVar
 
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import (
@@ -35,7 +35,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.files import json_object, write_atomic
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.training import DipRun, DogRun, EpochRecord, Progress, Run
+    from decoy_cli.damage.training import DipRun, DogRun, EpochRecord, Progress
 
 ProgressCallback = Callable[["Progress"], None]
 """Called after every batch and every epoch of training (`training.Progress`)."""
@@ -44,7 +44,7 @@ DIP_THRESHOLD_RULE = "the highest F1 on the validation part"
 DOG_DAMAGE_TARGET = "hpDamage summed per pair and step, capped at 100 HP"
 
 
-RunT = TypeVar("RunT", bound="Run[Any, Any]")
+RunT = TypeVar("RunT", bound="DipRun | DogRun")
 
 
 @dataclass(frozen=True)
