@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from numbers import Integral
-from typing import Any
+from typing import Any, TypedDict
 
 import gymnasium
 import numpy as np
@@ -31,6 +31,20 @@ from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
 __all__ = ["DEFAULT_WEAPONS", "DecoyParallelEnv"]
+
+
+class RoundEnd(TypedDict, total=False):
+    """How the round ended, in every agent's info once it has."""
+
+    winner: str
+    reason: str | None
+
+
+class AgentInfo(RoundEnd):
+    """An agent's info: whether it needs a decision, the tick, and the round's end once over."""
+
+    needs_decision: bool
+    tick: int
 
 
 class DecoyParallelEnv(ParallelEnv):
@@ -193,8 +207,8 @@ class DecoyParallelEnv(ParallelEnv):
         return self.game.physics
 
     def reset(
-        self, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, dict[str, Any]]]:
+        self, seed: int | None = None, options: dict[str, object] | None = None
+    ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, AgentInfo]]:
         """Start a new round; `options` is not used."""
         state = self.game.reset(seed)
         self.agents = list(self.possible_agents)
@@ -202,13 +216,13 @@ class DecoyParallelEnv(ParallelEnv):
         return self._observe(self.agents, state), self._infos(self.agents, state)
 
     def step(
-        self, actions: Mapping[str, Any]
+        self, actions: Mapping[str, object]
     ) -> tuple[
         dict[str, dict[str, np.ndarray]],
         dict[str, float],
         dict[str, bool],
         dict[str, bool],
-        dict[str, dict[str, Any]],
+        dict[str, AgentInfo],
     ]:
         """Apply the actions of the agents that need a decision, then run the simulator until
         an alive agent needs one or the round ends."""
@@ -255,7 +269,7 @@ class DecoyParallelEnv(ParallelEnv):
 
     # ---- internals ----------------------------------------------------------------------------
 
-    def _action(self, agent: int, action: Any) -> int:
+    def _action(self, agent: int, action: object) -> int:
         """An agent's action as the int 0..8 it must be (8: STOP)."""
         if isinstance(action, bool) or not isinstance(action, Integral):
             raise ValueError(
@@ -273,8 +287,8 @@ class DecoyParallelEnv(ParallelEnv):
             for k in (index[name],)
         }
 
-    def _infos(self, names: list[str], state: ArrayStep) -> dict[str, dict[str, Any]]:
-        end = {}
+    def _infos(self, names: list[str], state: ArrayStep) -> dict[str, AgentInfo]:
+        end: RoundEnd = {}
         if state.winner is not None:
             end = {"winner": state.winner, "reason": state.reason}
         due, index, tick = state.needs_decision.tolist(), self._index, state.tick

@@ -28,7 +28,7 @@ from decoy_cli.rl.factory import env_from_config
 class DecoyRLlibEnv(MultiAgentEnv):
     """One CS:GO round per episode for RLlib; `config` holds `factory.ENV_SETTINGS`."""
 
-    def __init__(self, config: dict[str, Any] | None = None) -> None:
+    def __init__(self, config: dict[str, object] | None = None) -> None:
         super().__init__()
         self.env = env_from_config(config)
         names: list[str] = list(self.env.possible_agents)
@@ -52,7 +52,7 @@ class DecoyRLlibEnv(MultiAgentEnv):
         acting = [name for name in self.env.agents if infos[name]["needs_decision"]]
         return self._observe(observations, acting), {name: infos[name] for name in acting}
 
-    def step(self, action_dict: dict[Any, Any]):
+    def step(self, action_dict: dict[Any, Any]):  # as MultiAgentEnv.step
         observations, rewards, ends, _, infos = self.env.step(action_dict)
         acting = [name for name in observations if infos[name]["needs_decision"] or ends[name]]
         self.agents = list(self.env.agents)
@@ -69,7 +69,9 @@ class DecoyRLlibEnv(MultiAgentEnv):
         self.env.close()
 
     @staticmethod
-    def _observe(observations: dict[str, Any], names: list[str]) -> dict[str, Any]:
+    def _observe(
+        observations: dict[str, dict[str, np.ndarray]], names: list[str]
+    ) -> dict[str, dict[str, np.ndarray]]:
         return {
             name: {
                 "observations": observations[name]["observation"],
