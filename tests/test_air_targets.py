@@ -86,23 +86,30 @@ def test_a_soft_target_a_long_way_round_is_dropped() -> None:
 
 
 def test_the_cap_measures_the_player_over_the_running_time_as_the_plan_does() -> None:
-    """A drop of 2 m down and 0.7 m across in 1 s with an AWP: the fall takes its air time, so
-    the run needs more than the AWP's speed, which the player showed it had; the replay is
-    allowed it and reaches the landing on time."""
+    """A drop of 2 m then a 0.7 m run in 0.68 s with an AWP: the fall takes its air time and no
+    run (the run goes on while the agent falls), so the 0.7 m left need more than the AWP's
+    speed; the cap is the larger of the AWP's speed and the player's own over the running time
+    (his displacement less the path's drop), times the path's zig-zag (at most 1.3): enough,
+    so the replay reaches the target on time."""
     graph = with_drop()
-    positions = graph.positions[[10, 7]].copy()
-    seconds = np.array([0.0, 1.0])
+    positions = graph.positions[[10, 4]].copy()
+    seconds = np.array([0.0, 0.68])
     weapons = np.array(["AWP", "AWP"])
     snap = snap_positions(graph, positions, np.ones(2, bool))
     plan = build_plan(graph, snap.node, seconds, np.ones(2, bool), weapons)
+    assert plan.path_node.tolist() == [10, 7, 4]
     fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
     assert plan.interval_air_s[0] == pytest.approx(fall_s)
-    length = math.hypot(SPACING, 2.0)
-    required = length / (1.0 - fall_s)
+    required = SPACING / (0.68 - fall_s)
     assert plan.interval_required_speed_m_s[0] == pytest.approx(required)
     assert required > max_speed_m_s("AWP") and plan.interval_infeasible[0]
+    drop = math.hypot(SPACING, 2.0)
+    straight = np.linalg.norm(positions[1] - positions[0]) - drop
+    zigzag = min(SPACING / straight, 1.3)
+    own = straight / (0.68 - fall_s)
     caps = interval_caps(plan, positions)
-    assert caps[0] == pytest.approx(required)  # the player's own speed, straight, no zig-zag
+    assert caps[0] == pytest.approx(max(max_speed_m_s("AWP"), own) * zigzag)
+    assert caps[0] > required
     assert expected_lateness(plan, caps).tolist() == pytest.approx([0.0, 0.0])
 
 

@@ -205,7 +205,7 @@ def test_compiled_steps_with_plants_and_defuses_give_what_stepping_gives(monkeyp
         site = env.graph.region_of("bombsite_a")
         rng = np.random.default_rng(7)
         states, events = [], []
-        for seed in range(4):
+        for seed in range(8):
             state = env.reset(seed)
             assert env.sim is not None
             for agent, node in enumerate(rng.choice(site, 10, replace=False)):

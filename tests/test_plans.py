@@ -275,24 +275,23 @@ def test_unreachable_target_is_recorded_and_relocated() -> None:
     assert plan.action_deadline_s.tolist() == [1.0, 2.0, 3.0]
     check_action_chain(graph, plan)
     assert plan.total_length_m == pytest.approx(graph.edge_length[plan.action_edge[0]] + 0.7)
-    # the drop: 2 m of fall take sqrt(2 h / g) without headway, so the 0.7 m run has the rest
-    fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
-    assert plan.worst_ratio == pytest.approx(math.hypot(0.7, 2.0) / (1.0 - fall_s) / KNIFE_M_S)
+    # the drop is crossed in its fall (no run), so the worst interval is the last: 0.7 m in 1 s
+    assert plan.interval_required_speed_m_s[0] == 0.0
+    assert plan.worst_ratio == pytest.approx(0.7 / 1.0 / KNIFE_M_S)
     assert plan.action_duration_s[0] == pytest.approx(1.0)
 
 
 def test_an_interval_is_shared_by_air_time_first_then_by_length() -> None:
+    """A drop (2 m, a safe fall) then a walk in one 2 s interval: the fall takes sqrt(2 h / g)
+    and no run (the run goes on while the agent falls), the walk's 0.7 m has the rest."""
     graph = with_drop()
-    plan = plan_for(graph, at(10, 7, 8, graph=graph), seconds=[0.0, 2.0, 3.0])
+    plan = plan_for(graph, at(10, 8, graph=graph), seconds=[0.0, 2.0])
+    assert plan.path_node.tolist() == [10, 7, 8]
+    drop = plan.action_edge[0]
     fall_s = math.sqrt(2 * 2.0 / GRAVITY_M_S2)
-    assert plan.action_duration_s[0] == pytest.approx(2.0)
-    assert plan.interval_required_speed_m_s[0] == pytest.approx(
-        graph.edge_length[plan.action_edge[0]] / (2.0 - fall_s)
-    )
-    assert graph.edge_air_s[plan.action_edge[0]] == pytest.approx(fall_s)
-    assert graph.edge_cost[plan.action_edge[0]] == pytest.approx(
-        graph.edge_length[plan.action_edge[0]] + RUN_SPEED_M_S * fall_s
-    )
+    assert graph.edge_air_s[drop] == pytest.approx(fall_s) and graph.edge_run_m[drop] == 0.0
+    assert plan.interval_required_speed_m_s[0] == pytest.approx(0.7 / (2.0 - fall_s))
+    assert graph.edge_cost[drop] == pytest.approx(RUN_SPEED_M_S * fall_s)  # no fall damage
 
 
 def test_standing_still_ten_seconds_is_ten_seconds_of_stop() -> None:

@@ -52,8 +52,9 @@ def asks_more(
 
 
 def less_climbed(distance: np.ndarray, length: np.ndarray, run: np.ndarray) -> np.ndarray:
-    """A straight `distance` less the ladders climbed on a path of `length` of which `run` is
-    run (at least 0; NaN lengths: nothing climbed): what the player's own speed must cover."""
+    """A straight `distance` less what a path of `length`, of which `run` is run, climbs or
+    falls (ladders, ledges; at least 0; NaN lengths: nothing): what the player's own speed must
+    cover."""
     return np.maximum(distance - np.nan_to_num(length - run, nan=0.0), 0.0)
 
 

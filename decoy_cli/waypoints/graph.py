@@ -137,19 +137,25 @@ class WaypointGraph:
 
     @cached_property
     def edge_air_s(self) -> np.ndarray:
-        """(E,) seconds of each edge spent rising or falling, when an agent makes no headway:
-        the movers rise straight up onto a jump edge's height (at least the jump's take-off
-        speed) and fall straight down at a drop's end, under sv_gravity."""
+        """(E,) seconds of each edge spent in the air, under sv_gravity: a jump up rises straight
+        onto the edge's height (at least the jump's take-off speed) before it moves on; off a
+        ledge (a drop, a jump down) the run goes on while the agent falls, so the edge takes
+        its fall and no run (`edge_run_m`)."""
         dz = self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
         up = (self.edge_kind == EdgeKind.JUMP) & (dz > 0)
-        down = np.isin(self.edge_kind, (EdgeKind.JUMP, EdgeKind.DROP)) & (dz < 0)
         rise = np.maximum(dz, 0.0)
         take_off = np.maximum(JUMP_SPEED_M_S, np.sqrt(2 * GRAVITY_M_S2 * rise))
         rise_s = (take_off - np.sqrt(np.maximum(take_off**2 - 2 * GRAVITY_M_S2 * rise, 0.0))) / (
             GRAVITY_M_S2
         )
         fall_s = np.sqrt(2 * np.maximum(-dz, 0.0) / GRAVITY_M_S2)
-        return np.where(up, rise_s, np.where(down, fall_s, 0.0))
+        return np.where(up, rise_s, np.where(self.off_a_ledge, fall_s, 0.0))
+
+    @cached_property
+    def off_a_ledge(self) -> np.ndarray:
+        """(E,) True for the edges an agent takes by running off a ledge: drops, jumps down."""
+        dz = self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
+        return np.isin(self.edge_kind, (EdgeKind.JUMP, EdgeKind.DROP)) & (dz < 0)
 
     @cached_property
     def edge_climb_s(self) -> np.ndarray:
@@ -159,9 +165,11 @@ class WaypointGraph:
 
     @cached_property
     def edge_run_m(self) -> np.ndarray:
-        """(E,) metres of each edge an agent runs at its own speed: its length, none of a
-        ladder (climbed at the climbing speed, `edge_climb_s`)."""
-        return np.where(self.edge_kind == EdgeKind.LADDER, 0.0, self.edge_length)
+        """(E,) metres of each edge an agent runs at its own speed: its length; none off a ledge
+        (crossed in its fall, `edge_air_s`) or of a ladder (climbed at the climbing speed,
+        `edge_climb_s`)."""
+        none = (self.edge_kind == EdgeKind.LADDER) | self.off_a_ledge
+        return np.where(none, 0.0, self.edge_length)
 
     @cached_property
     def edge_fixed_s(self) -> np.ndarray:
@@ -171,10 +179,13 @@ class WaypointGraph:
 
     @cached_property
     def edge_cost(self) -> np.ndarray:
-        """(E,) what an edge costs a running agent, in metres: what it runs of it plus the
-        distance it would have run (at knife speed) in the time it spends rising, falling or
-        climbing."""
-        return self.edge_run_m + RUN_SPEED_M_S * self.edge_fixed_s
+        """(E,) what an edge costs a route, in metres: what an agent runs of it plus the
+        distance it would have run (at knife speed) while it rises, falls or climbs; a drop
+        with fall damage costs its length on top, so a route takes such a fall only where it
+        saves at least that much running (a player keeps his HP where a ladder or stairs are
+        about as quick: a rule chosen, not measured)."""
+        damage = np.where(self.fall_m > 0, self.edge_length, 0.0)
+        return self.edge_run_m + RUN_SPEED_M_S * self.edge_fixed_s + damage
 
     @cached_property
     def adjacency(self) -> csr_matrix:

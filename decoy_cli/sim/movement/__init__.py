@@ -9,9 +9,13 @@ state (`MoverBase`) and one edge-motion computation (`kernels.advance`, compiled
   time to cross an edge is its 3-D length over the speed, the length the replay planner uses.
   A jump rises in place with CS:GO's jump speed and gravity to the upper floor's height (a
   crouch-jump, modelled as a stronger start, where the top is above a plain jump), then moves
-  horizontally. A drop moves horizontally at the upper height to above the target, then falls
-  with gravity. These are the paths the waypoint builder verified a capsule along
-  (`decoy_cli.waypoints.lattice`), so an agent on its edge never enters a wall. A ladder edge
+  horizontally. Off a ledge (a drop, a jump down) the agent runs at its full speed and falls
+  with gravity while it runs on to above the target, as a player keeps his speed in the air:
+  the edge takes its fall time (or its run, if longer). The waypoint builder verified a capsule
+  along these paths (for a drop: at the upper height to above the target, then down; at full
+  speed the fall starts low enough past the ledge to stay clear of it, which
+  `tests/test_sim_movement.py` checks on a sample of real drops), so an agent on its edge
+  does not enter a wall. A ladder edge
   is a straight 3-D line too, climbed up or down at no more than the climbing speed
   (`LADDER_SPEED_M_S`); it passes over the ladder's lip, the one path not verified.
 * `PhysicsMover`: the same motion for capsule bodies in pybullet that block each other, as

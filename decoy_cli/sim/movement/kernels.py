@@ -61,8 +61,9 @@ def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, looka
     """Move one agent for `t` seconds along its edge from node (sx, sy, sz) to (tx, ty, tz).
 
     Phases: RISE (jump: vertical, gravity, until the target height), LINE (walk/step/ladder:
-    along the 3-D line at `speed`), GLIDE (jump/drop: horizontal at constant height at
-    `speed`), FALL (gravity, until the target height). An agent off its line (pushed aside by
+    along the 3-D line at `speed`), GLIDE (horizontal at constant height at `speed`: a jump's
+    top, or the rest of the run after a fall landed short), FALL (gravity until the target
+    height, running on towards the target meanwhile). An agent off its line (pushed aside by
     another) steers back to it, `lookahead` ahead of its projection. Returns (x, y, z, phase,
     vz, seconds left, arrived); the seconds left are those after arriving.
     """
@@ -111,8 +112,20 @@ def advance(x, y, z, sx, sy, sz, tx, ty, tz, phase, vz, speed, t, gravity, looka
             return x, y, z, phase, vz, 0.0, False
         if phase == FALL:
             land_t = (vz + math.sqrt(vz * vz + 2.0 * gravity * max(0.0, z - tz))) / gravity
+            air_t = min(t, land_t)
+            ex, ey = tx - x, ty - y  # the run goes on while falling
+            dist = math.hypot(ex, ey)
+            over = dist <= speed * air_t + EPS
+            if over:
+                x, y = tx, ty
+            elif dist > 0.0:
+                x += ex * speed * air_t / dist
+                y += ey * speed * air_t / dist
             if land_t <= t:
-                return x, y, tz, IDLE, 0.0, t - land_t, True
+                if over:
+                    return x, y, tz, IDLE, 0.0, t - land_t, True
+                z, t, vz, phase = tz, t - land_t, 0.0, GLIDE  # landed short: run the rest
+                continue
             z += vz * t - 0.5 * gravity * t * t
             vz -= gravity * t
             return x, y, z, phase, vz, 0.0, False
@@ -199,6 +212,11 @@ def begin_edge(i, tx, ty, tz, kind, speed, cap, jump_speed, gravity, pos, target
     if kind == JUMP_EDGE and tz > z + EPS:
         iv[i, I_PHASE] = RISE
         fv[i, F_VZ] = max(jump_speed, math.sqrt(2.0 * gravity * (tz - z)))
+    elif kind in (JUMP_EDGE, DROP_EDGE) and tz < z - EPS:
+        # Off a ledge at full speed, the run going on while the agent falls (a player keeps
+        # his speed in the air): at that speed he clears the ledge before he sinks below it.
+        iv[i, I_PHASE] = FALL
+        fv[i, F_SPEED] = fv[i, F_MAX_SPEED]
     elif kind in (JUMP_EDGE, DROP_EDGE):
         iv[i, I_PHASE] = GLIDE
     else:

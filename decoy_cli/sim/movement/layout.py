@@ -16,8 +16,8 @@ from __future__ import annotations
 IDLE = 0  # no goal, or arrived: stands still
 RISE = 1  # jump: rising with gravity to the upper floor's height
 LINE = 2  # walk or step: along the straight 3-D line from node to node
-GLIDE = 3  # jump or drop: horizontal at constant height
-FALL = 4  # drop (or a jump past its top): falling with gravity to the target's height
+GLIDE = 3  # a jump's run at its top's height, or what is left to run after a landing
+FALL = 4  # off a ledge or past a jump's top: falling with gravity, running on meanwhile
 
 EPS = 1e-9
 """Lengths and times below this are zero (metres, seconds)."""
