@@ -17,6 +17,7 @@ from worlds import floor, graph_of, make_world, seeds_of, wall, walls_around
 
 from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, SAFE_DROP_M, TICK_RATE
 from decoy_cli.errors import WorldError
+from decoy_cli.replay import PathCache
 from decoy_cli.sim.movement import KinematicMover, PhysicsMover, kernels
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import RUN_SPEED_M_S, EdgeKind, WaypointGraph
@@ -490,3 +491,56 @@ def test_random_play_over_a_ladder_is_the_same_compiled_and_stepped() -> None:
         heights = stepped.recording.position[:, :, 2]
         climbed += int(((heights > 1.0) & (heights < PLATFORM_Z - 1.0)).any(axis=0).sum())
     assert climbed >= 3  # agents were seen on the ladder
+
+
+# ---- the replay follows a climb -------------------------------------------------------------
+
+
+def ladder_and_drop() -> WaypointGraph:
+    """A ledge (0, 1 at z = 3) over a floor (2, 3 at z = 0): a ladder from the foot 3 up to 0 and
+    down again, and a drop from 1 to 2 with a walk 2 -> 3, quicker down than the climb."""
+    positions = [(0.0, 0.0, 3.0), (0.7, 0.0, 3.0), (0.7, 0.7, 0.0), (0.0, 0.7, 0.0)]
+    edges = [
+        (0, 1, EdgeKind.WALK, 2),
+        (1, 0, EdgeKind.WALK, 6),
+        (1, 2, EdgeKind.DROP, 0),
+        (2, 3, EdgeKind.WALK, 6),
+        (3, 2, EdgeKind.WALK, 2),
+        (3, 0, EdgeKind.LADDER, 4),
+        (0, 3, EdgeKind.LADDER, 0),
+    ]
+    e = np.array(edges, dtype=np.int64)
+    return WaypointGraph(
+        positions=np.array(positions),
+        edge_source=e[:, 0].astype(np.int32),
+        edge_target=e[:, 1].astype(np.int32),
+        edge_kind=e[:, 2].astype(np.uint8),
+        edge_direction=e[:, 3].astype(np.uint8),
+        node_place=np.full(4, -1, dtype=np.int16),
+        place_names=[],
+        regions={},
+    )
+
+
+def test_a_point_on_a_ladder_heads_for_its_end_nearest_in_height() -> None:
+    graph = ladder_and_drop()
+    points = np.array(
+        [
+            [0.0, 0.35, 2.0],  # on the ladder, nearer the top (node 0)
+            [0.0, 0.35, 1.0],  # nearer the foot (node 3)
+            [0.5, 0.35, 1.0],  # 0.5 m across: still within reach
+            [1.0, 0.35, 1.0],  # 1 m across: beside it, not on it
+            [0.0, 0.35, 3.5],  # above the top
+        ]
+    )
+    assert graph.ladder_end(points).tolist() == [0, 3, 3, -1, -1]
+
+
+def test_between_a_ladders_ends_the_path_is_the_ladder() -> None:
+    graph = ladder_and_drop()
+    ladder_down = int(np.flatnonzero((graph.edge_source == 0) & (graph.edge_target == 3))[0])
+    by_drop = graph.edge_cost[[0, 2, 3]].sum()
+    assert by_drop < graph.edge_cost[ladder_down]  # the drop is the quicker way down
+    assert graph.shortest_path(0, 3) == [0, 1, 2, 3]
+    assert PathCache(graph).edges(0, 3).tolist() == [ladder_down]
+    assert PathCache(graph).edges(1, 3).tolist() == [2, 3]  # not from a ladder's end: shortest

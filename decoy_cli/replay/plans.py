@@ -36,7 +36,7 @@ import pandas as pd
 
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.replay.pace import asks_more, edge_durations, less_climbed, running_seconds
-from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
+from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, EdgeKind, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
 RELOCATE_ACTION = 9
@@ -50,7 +50,9 @@ _NO_EDGE = np.array([-1], dtype=np.int64)
 
 
 class PathCache:
-    """Shortest paths between waypoint pairs on one graph, each pair computed once.
+    """Shortest paths between waypoint pairs on one graph, each pair computed once; between the
+    two ends of a ladder, the ladder (a player at one end and then the other climbed it, even
+    where a drop beside it is quicker).
 
     Share one cache between the players of a round (or many rounds): players crossing the same
     spots ask for the same pairs.
@@ -76,6 +78,12 @@ class PathCache:
         return self._paths[key]
 
     def _compute(self, source: int, target: int) -> np.ndarray | None:
+        key = source * self.graph.num_nodes + target
+        at = int(np.searchsorted(self._keys, key))
+        if at < len(self._keys) and self._keys[at] == key:
+            edge = self._edge_ids[at]
+            if self.graph.edge_kind[edge] == EdgeKind.LADDER:  # from one end to the other: on it
+                return np.array([edge], dtype=np.int64)
         try:
             nodes = np.asarray(self.graph.shortest_path(source, target), dtype=np.int64)
         except GraphError:

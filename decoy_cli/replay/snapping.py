@@ -59,7 +59,8 @@ class SnapResult:
     """(F,) int8 `SnapStatus` per frame: why a frame was or was not snapped."""
     ground_node: np.ndarray
     """(F,) int64 for frames in the air: the waypoint nearest the spot on the world's floor
-    straight under the position (-1 elsewhere, or none within the snap distance)."""
+    straight under the position, or on a ladder the end of its edge nearest in height (-1
+    elsewhere, or none within the snap distance)."""
 
     def count(self, status: SnapStatus) -> int:
         """Number of frames with this status."""
@@ -140,7 +141,8 @@ def snap_positions(
             under = pos[in_air].copy()
             under[:, 2] = floor_z[in_air]
             index, _ = graph.nearest(under, max_distance=max_distance)
-            ground_node[in_air] = index
+            ladder = graph.ladder_end(pos[in_air])  # a climber heads for the ladder's ends
+            ground_node[in_air] = np.where(ladder >= 0, ladder, index)
     return SnapResult(node=node, error_m=error, status=status, ground_node=ground_node)
 
 

@@ -62,6 +62,20 @@ class EdgeKind(IntEnum):
     LADDER = 4  # up or down a ladder of the nav mesh, at the climbing speed
 
 
+LADDER_REACH_M = 0.75
+"""How far across the floor from the line between a ladder's two waypoints a climbing player may
+be (half a player's width plus about a lattice spacing: the builder puts a ladder's waypoints
+beside its foot and past its lip): chosen, not measured."""
+
+
+def _to_segment_2d(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(M,) distance of each 2-D point to the segment from a to b."""
+    ab = b - a
+    length2 = float(ab @ ab)
+    t = np.clip((points - a) @ ab / length2, 0.0, 1.0) if length2 > 0 else np.zeros(len(points))
+    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+
+
 # Vertical band for the floor-aware lookup: how far a waypoint may lie above or below the query.
 # Feet sit on the floor, so the band is tight above: a waypoint more than a step (plus a ramp's
 # rise between lattice points) above the feet is on a box or ledge the player is not on. It is
@@ -225,6 +239,23 @@ class WaypointGraph:
         return self.regions[name]
 
     # ---- nearest waypoint -------------------------------------------------------------------
+
+    def ladder_end(self, points: np.ndarray, reach: float = LADDER_REACH_M) -> np.ndarray:
+        """(M,) for points (M, 3) on a ladder, the end of its edge nearest in height (-1 for the
+        rest): a point on a ladder lies between the heights of its two ends and within `reach`
+        of the line between them across the floor."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        end = np.full(len(points), -1, dtype=np.int64)
+        for e in np.flatnonzero(self.edge_kind == EdgeKind.LADDER):
+            foot, top = int(self.edge_source[e]), int(self.edge_target[e])
+            if self.positions[foot, 2] > self.positions[top, 2]:
+                foot, top = top, foot
+            low, high = self.positions[foot], self.positions[top]
+            between = (points[:, 2] > low[2]) & (points[:, 2] < high[2])
+            across = _to_segment_2d(points[:, :2], low[:2], high[:2]) <= reach
+            nearer = np.where(points[:, 2] - low[2] > high[2] - points[:, 2], top, foot)
+            end = np.where((end < 0) & between & across, nearer, end)
+        return end
 
     @cached_property
     def _tree(self) -> cKDTree:
