@@ -1,6 +1,7 @@
 """Options shared by several commands: the mover and the damage models (one definition each),
 and the help of the maps, who decides deaths and what to do with the fields the data lacks
-(the mover, deaths and missing fields are `Literal` types, which Typer lists)."""
+(the mover, deaths, missing fields and implausible data are `Literal` types, which Typer
+lists)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import typer
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.damage import CHOICES_HELP
 from decoy_cli.damage.choice import MODELS_METAVAR, ModelName
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.sim.setup import MoverName
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
@@ -30,6 +32,10 @@ MISSING_HELP = (
     "defuser): infer (filled by the rules of decoy_cli/replay/missing.py and named per round "
     "in the outputs) or error (the round fails)."
 )
+IMPLAUSIBLE_HELP = (
+    "Rounds with implausible data (README: what the reader and the replay refuse): fail (a "
+    "recorded failure) or warn (replayed anyway, their warnings named in the outputs)."
+)
 MOVER_HELP = (
     "kinematic (compiled motion along the graph's edges, agents pass through each other; "
     "measured the more faithful in replays) or physics (pybullet capsules that block each "
@@ -40,6 +46,11 @@ MOVER_HELP = (
 def mover_option(default: MoverName) -> MoverName:
     """The `--mover` option (Typer's parameter default), `default` unless told."""
     return typer.Option(default, "--mover", help=f"The mover: {MOVER_HELP}.")
+
+
+def implausible_option() -> Implausible:
+    """The `--implausible` option (Typer's parameter default): fail unless told."""
+    return typer.Option("fail", "--implausible", help=IMPLAUSIBLE_HELP)
 
 
 MODELS_HELP = f"The damage models when shooting: {CHOICES_HELP}."

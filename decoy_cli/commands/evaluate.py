@@ -28,6 +28,7 @@ from decoy_cli.commands._options import (
     MAPS_HELP,
     MISSING_HELP,
     SIGHT_MESH_HELP,
+    implausible_option,
     models_option,
     mover_option,
 )
@@ -35,7 +36,7 @@ from decoy_cli.damage import DEFAULT_MODELS, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
-from decoy_cli.esta.plausibility import check_policy
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
 from decoy_cli.evaluate.markdown import interval, num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
@@ -127,13 +128,7 @@ def evaluate(
         "on for the paper's Table 2 setting (--no-combat --no-bomb), off otherwise. Part of "
         "the cache key: switching it replays the rounds again.",
     ),
-    implausible: str = typer.Option(
-        "fail",
-        "--implausible",
-        help="Rounds with implausible data (README: what the reader and the replay refuse): "
-        "fail (recorded failures), or warn (replayed, their warnings counted in the report and "
-        "listed in rounds.csv).",
-    ),
+    implausible: Implausible = implausible_option(),
     workers: int | None = typer.Option(
         None,
         "--workers",
@@ -173,7 +168,7 @@ def evaluate(
         models=parse_models(models),
         mover=mover,
         seed=seed,
-        implausible=check_policy(implausible),
+        implausible=implausible,
         deaths=deaths,
         missing=missing,
         fastdtw=fastdtw,

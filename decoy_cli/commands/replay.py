@@ -15,12 +15,13 @@ from decoy_cli.commands._options import (
     MAPS_HELP,
     MISSING_HELP,
     SIGHT_MESH_HELP,
+    implausible_option,
     models_option,
     mover_option,
 )
 from decoy_cli.damage import DEFAULT_MODELS, load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
-from decoy_cli.esta.plausibility import check_policy
+from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.deaths import DeathProtocol
@@ -56,19 +57,13 @@ def replay(
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
     models: str = models_option(DEFAULT_MODELS),
-    implausible: str = typer.Option(
-        "fail",
-        "--implausible",
-        help="Implausible data (README: what the reader and the replay refuse): fail, or warn "
-        "and replay it anyway.",
-    ),
+    implausible: Implausible = implausible_option(),
     deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
     missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data (with
     --models none, deaths in the data are scripted)."""
     console = make_console()
-    policy = check_policy(implausible)
     choice = parse_models(models)
     damage_model = load_damage_model(choice) if combat else None
     if combat and damage_model is None:
@@ -84,7 +79,7 @@ def replay(
         seed=seed,
         deaths=deaths,
         missing=missing,
-        implausible=policy,
+        implausible=implausible,
     )
     run = replay_address(
         address,

@@ -29,12 +29,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from itertools import pairwise
-from typing import Literal, cast, get_args
+from typing import Literal
 
 import numpy as np
 
 from decoy_cli.csgo import MAX_VELOCITY_M_S
-from decoy_cli.errors import EstaError
 from decoy_cli.esta.frames import FrameArrays
 from decoy_cli.esta.schema import Invalid
 
@@ -45,14 +44,6 @@ MAX_SPEED_M_S = MAX_VELOCITY_M_S
 
 Implausible = Literal["fail", "warn"]
 """What an implausible round does: fail (default) or replay with warnings (module doc)."""
-IMPLAUSIBLE_CHOICES: tuple[str, ...] = get_args(Implausible)
-
-
-def check_policy(value: str) -> Implausible:
-    """`value` as a policy if it is one of `IMPLAUSIBLE_CHOICES`, else an EstaError naming them."""
-    if value not in IMPLAUSIBLE_CHOICES:
-        raise EstaError(f"--implausible {value!r}: use {' or '.join(IMPLAUSIBLE_CHOICES)}")
-    return cast(Implausible, value)
 
 
 def check_frames(arrays: FrameArrays, policy: Implausible = "fail") -> tuple[str, ...]:
