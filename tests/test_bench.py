@@ -228,3 +228,13 @@ def test_never_hits_and_the_machine_helpers(tmp_path: Path) -> None:
     status.write_text("Name: python\nVmPeak: 9 kB\nVmHWM:\t  51200 kB\nVmRSS: 1 kB\n")
     assert peak_rss_mb(status) == pytest.approx(51200 * 1024 / 1e6)
     assert peak_rss_mb(tmp_path / "missing") >= ru_maxrss_mb() > 1
+
+
+def test_a_table_1_row_and_its_record_name_the_same_fields() -> None:
+    """`SpeedRow.to_dict` hands its fields over as they are: the record must name them all."""
+    from dataclasses import fields
+
+    from decoy_cli.bench.records import SpeedRowRecord
+    from decoy_cli.bench.simspeed import SpeedRow
+
+    assert list(SpeedRowRecord.__annotations__) == [f.name for f in fields(SpeedRow)]
