@@ -20,7 +20,7 @@ import numpy as np
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.esta import read_match
 from decoy_cli.esta.writer import write_match
-from decoy_cli.metrics.trajectory import trajectory_metrics
+from decoy_cli.metrics import player_metrics
 from decoy_cli.replay import ReplayOptions, replay_round
 from decoy_cli.synth.edge_rounds import KINDS, edge_match
 from decoy_cli.waypoints.build import builtin_graph, canonical_map
@@ -48,13 +48,8 @@ def main() -> None:
             rows = []
             for round_, kind in zip(read_match(path).rounds, kinds, strict=True):
                 replay = replay_round(round_, graph, ReplayOptions(combat=False, bomb=False))
-                values = trajectory_metrics(
-                    round_.position[0],
-                    round_.alive[0],
-                    replay.recording.position[:, 0],
-                    replay.recording.alive[:, 0],
-                ).values
-                rows.append((kind, values["mean_dist"], values["max_dist"]))
+                row = player_metrics(round_, replay.trace()).iloc[0]
+                rows.append((kind, row["mean_dist"], row["max_dist"]))
             for kind in KINDS:
                 mean = np.array([m for k, m, _ in rows if k == kind])
                 worst = np.array([x for k, _, x in rows if k == kind])

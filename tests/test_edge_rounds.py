@@ -12,7 +12,7 @@ import pytest
 from decoy_cli.csgo import GRAVITY_M_S2, JUMP_SPEED_M_S, LADDER_SPEED_M_S
 from decoy_cli.esta import read_match
 from decoy_cli.esta.writer import write_match
-from decoy_cli.metrics.trajectory import trajectory_metrics
+from decoy_cli.metrics import player_metrics
 from decoy_cli.replay import ReplayOptions, replay_round
 from decoy_cli.synth.edge_rounds import KINDS, edge_match, edge_motion
 from decoy_cli.waypoints.build import builtin_graph
@@ -65,10 +65,5 @@ def test_every_kind_of_edge_replays_within_half_a_metre(tmp_path: Path) -> None:
     rounds = read_match(write_match(record, tmp_path / "edges.json.xz")).rounds
     for round_, kind in zip(rounds, kinds, strict=True):
         replay = replay_round(round_, graph, ReplayOptions(combat=False, bomb=False))
-        values = trajectory_metrics(
-            round_.position[0],
-            round_.alive[0],
-            replay.recording.position[:, 0],
-            replay.recording.alive[:, 0],
-        ).values
-        assert values["mean_dist"] <= 0.5, (kind.name, values)
+        row = player_metrics(round_, replay.trace()).iloc[0]
+        assert row["mean_dist"] <= 0.5, (kind.name, row.to_dict())

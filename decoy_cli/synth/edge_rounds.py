@@ -20,7 +20,6 @@ reports every map; the tests replay a sample.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable
 
 import numpy as np
@@ -66,35 +65,35 @@ def edge_motion(start: np.ndarray, end: np.ndarray, kind: int, speed: float) -> 
 
 
 def edge_path(graph: WaypointGraph, edge: int, rng: np.random.Generator) -> list[int]:
-    """Waypoints of a round over `edge`: walk edges into its start, the edge, walk edges on."""
-    source, target = int(graph.edge_source[edge]), int(graph.edge_target[edge])
-    before = _walk(graph, source, rng, forward=False)
-    return [*before[::-1], source, target, *_walk(graph, target, rng, forward=True)]
+    """Edges of a round over `edge`: walk edges into its start, the edge, walk edges on."""
+    before = _walk(graph, int(graph.edge_source[edge]), rng, forward=False)
+    return [*before[::-1], edge, *_walk(graph, int(graph.edge_target[edge]), rng, forward=True)]
 
 
 def _walk(graph: WaypointGraph, node: int, rng: np.random.Generator, forward: bool) -> list[int]:
+    """Up to `WALK_AROUND` walk edges on from `node` (or into it), never back to a waypoint."""
     here, there = graph.edge_source, graph.edge_target
     if not forward:
         here, there = there, here
     walks = graph.edge_kind == EdgeKind.WALK
-    seen, nodes = {node}, []
+    seen, edges = {node}, []
     for _ in range(WALK_AROUND):
         choices = [e for e in np.flatnonzero(walks & (here == node)) if int(there[e]) not in seen]
         if not choices:
             break
-        node = int(there[int(rng.choice(choices))])
+        edges.append(int(rng.choice(choices)))
+        node = int(there[edges[-1]])
         seen.add(node)
-        nodes.append(node)
-    return nodes
+    return edges
 
 
 def path_positions(
-    graph: WaypointGraph, nodes: list[int], speed: float, rate: float
+    graph: WaypointGraph, edges: list[int], speed: float, rate: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(seconds, positions) of a player moving along `nodes`, sampled `rate` times a second,
+    """(seconds, positions) of a player moving along `edges`, sampled `rate` times a second,
     and once more half a second after he arrives."""
-    pairs = itertools.pairwise(nodes)
-    motions = [edge_motion(*_ends(graph, a, b), _kind(graph, a, b), speed) for a, b in pairs]
+    source, target = graph.positions[graph.edge_source], graph.positions[graph.edge_target]
+    motions = [edge_motion(source[e], target[e], int(graph.edge_kind[e]), speed) for e in edges]
     ends = np.cumsum([took for took, _ in motions])
     seconds = np.append(np.arange(0.0, ends[-1], 1.0 / rate), ends[-1] + 0.5)
     positions = []
@@ -102,14 +101,6 @@ def path_positions(
         k = min(int(np.searchsorted(ends, t, side="right")), len(motions) - 1)
         positions.append(motions[k][1](min(t, ends[k]) - (ends[k - 1] if k else 0.0)))
     return seconds, np.array(positions)
-
-
-def _ends(graph: WaypointGraph, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
-    return graph.positions[a], graph.positions[b]
-
-
-def _kind(graph: WaypointGraph, a: int, b: int) -> int:
-    return int(graph.edge_kind[(graph.edge_source == a) & (graph.edge_target == b)][0])
 
 
 def edge_round(
