@@ -142,10 +142,15 @@ class WaypointGraph:
         return np.linalg.norm(delta, axis=1)
 
     @cached_property
+    def edge_rise_m(self) -> np.ndarray:
+        """(E,) height of each edge's end above its start, metres (negative going down)."""
+        return self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
+
+    @cached_property
     def fall_m(self) -> np.ndarray:
         """(E,) depth of each drop edge deeper than the safe fall, metres; 0 for every other
         edge. An agent that takes such an edge lands with fall damage (the simulator's rule)."""
-        depth = self.positions[self.edge_source, 2] - self.positions[self.edge_target, 2]
+        depth = -self.edge_rise_m
         damaging = (self.edge_kind == EdgeKind.DROP) & (depth > SAFE_DROP_M)
         return np.where(damaging, depth, 0.0)
 
@@ -155,7 +160,7 @@ class WaypointGraph:
         onto the edge's height (at least the jump's take-off speed) before it moves on; off a
         ledge (a drop, a jump down) the run goes on while the agent falls, so the edge takes
         its fall and no run (`edge_run_m`)."""
-        dz = self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
+        dz = self.edge_rise_m
         up = (self.edge_kind == EdgeKind.JUMP) & (dz > 0)
         rise = np.maximum(dz, 0.0)
         take_off = np.maximum(JUMP_SPEED_M_S, np.sqrt(2 * GRAVITY_M_S2 * rise))
@@ -168,8 +173,7 @@ class WaypointGraph:
     @cached_property
     def off_a_ledge(self) -> np.ndarray:
         """(E,) True for the edges an agent takes by running off a ledge: drops, jumps down."""
-        dz = self.positions[self.edge_target, 2] - self.positions[self.edge_source, 2]
-        return np.isin(self.edge_kind, (EdgeKind.JUMP, EdgeKind.DROP)) & (dz < 0)
+        return np.isin(self.edge_kind, (EdgeKind.JUMP, EdgeKind.DROP)) & (self.edge_rise_m < 0)
 
     @cached_property
     def edge_climb_s(self) -> np.ndarray:
