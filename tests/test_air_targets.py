@@ -4,6 +4,7 @@ is expected to run into."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -144,7 +145,7 @@ def test_a_soft_target_on_the_way_stays_in_a_stretch_late_for_another_reason() -
     ground = snap.ground_node.copy()
     ground[2] = int(graph.nearest(aside)[0][0])
     assert ground[4] == on_line[4]
-    snap = type(snap)(snap.node, snap.error_m, snap.status, ground)
+    snap = dataclasses.replace(snap, ground_node=ground)
     seconds = np.arange(frames) * 0.5
     weapons = np.array(["Knife"] * frames)
     plan, caps = plan_player(graph, snap, positions, seconds, alive, weapons, PathCache(graph))
@@ -164,3 +165,30 @@ def test_after_a_gap_the_replay_is_placed_at_once_when_late() -> None:
     assert plan.interval_unreachable.tolist() == [False, True, False]
     late = expected_lateness(plan, np.array([0.7, 5.0, 5.0]))  # 1.4 m at 0.7 m/s: 2 s
     assert late.tolist() == pytest.approx([0.0, 1.5, 1.0, 0.5])
+
+
+@pytest.mark.parametrize("step_s", [0.5, 0.25])
+def test_a_fall_to_a_lower_floor_is_a_target_when_he_lands(step_s: float) -> None:
+    """Along the upper walkway and off its east end, 1.5 m above the lower one in the frame
+    after, on it the frame after that. He is over the landing spot (node 9) in the air, but
+    there only after his fall (from rest: an upper bound): the target's deadline is then, and
+    with frames closer than the fall it is left out (the next frame says where he is)."""
+    graph = over_a_lower_floor()
+    positions = np.vstack(
+        [graph.positions[:FRAMES], graph.positions[9] + [0.0, 0.0, 1.5], graph.positions[9]]
+    )
+    floor = np.array([3.0] * FRAMES + [0.0, 0.0])
+    alive = np.ones(FRAMES + 2, bool)
+    snap = snap_positions(graph, positions, alive, floor_z=floor)
+    fall = math.sqrt(2 * 1.5 / GRAVITY_M_S2)
+    assert snap.ground_node[FRAMES] == 9
+    assert snap.ground_delay_s[FRAMES] == pytest.approx(fall)
+    seconds = np.arange(FRAMES + 2) * step_s
+    weapons = np.array(["Knife"] * (FRAMES + 2))
+    plan, _ = plan_player(graph, snap, positions, seconds, alive, weapons, PathCache(graph))
+    kept = fall <= step_s
+    assert (FRAMES in plan.target_frame.tolist()) == kept
+    if kept:
+        assert plan.target_seconds[plan.target_frame == FRAMES][0] == pytest.approx(
+            seconds[FRAMES] + fall
+        )

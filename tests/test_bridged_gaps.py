@@ -44,7 +44,7 @@ def up_the_stairs(graph: WaypointGraph) -> tuple:
     snap = snap_positions(graph, positions, alive)
     node, error, status = snap.node.copy(), snap.error_m.copy(), snap.status.copy()
     node[2], error[2], status[2] = -1, np.nan, 3  # NO_WAYPOINT: on the stairs
-    snap = SnapResult(node, error, status, snap.ground_node)
+    snap = SnapResult(node, error, status, snap.ground_node, snap.ground_delay_s)
     seconds = np.arange(5, dtype=float)
     return snap, positions, seconds, alive, np.array(["Knife"] * 5)
 

@@ -17,7 +17,8 @@ from worlds import floor, graph_of, make_world, seeds_of, wall, walls_around
 
 from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, SAFE_DROP_M, TICK_RATE
 from decoy_cli.errors import WorldError
-from decoy_cli.replay import PathCache
+from decoy_cli.replay import PathCache, snap_positions
+from decoy_cli.replay.rounds import plan_player
 from decoy_cli.sim.movement import KinematicMover, PhysicsMover, kernels
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import RUN_SPEED_M_S, EdgeKind, WaypointGraph
@@ -522,18 +523,85 @@ def ladder_and_drop() -> WaypointGraph:
     )
 
 
-def test_a_point_on_a_ladder_heads_for_its_end_nearest_in_height() -> None:
+def test_a_point_is_on_a_ladder_between_its_ends_heights_and_within_reach() -> None:
     graph = ladder_and_drop()
     points = np.array(
         [
-            [0.0, 0.35, 2.0],  # on the ladder, nearer the top (node 0)
-            [0.0, 0.35, 1.0],  # nearer the foot (node 3)
+            [0.0, 0.35, 2.0],  # on the ladder
+            [0.0, 0.35, 1.0],
             [0.5, 0.35, 1.0],  # 0.5 m across: still within reach
             [1.0, 0.35, 1.0],  # 1 m across: beside it, not on it
             [0.0, 0.35, 3.5],  # above the top
         ]
     )
-    assert graph.ladder_end(points).tolist() == [0, 3, 3, -1, -1]
+    up = int(np.flatnonzero((graph.edge_source == 3) & (graph.edge_target == 0))[0])
+    assert graph.ladders.tolist() == [up]  # one edge per ladder: the one from its foot
+    assert graph.on_ladders(points)[:, 0].tolist() == [True, True, True, False, False]
+
+
+def test_a_ladder_passage_targets_the_end_left_and_the_end_reached_at_the_climbing_speed() -> None:
+    """Down the ladder of `ladder_and_drop`, frames 0.5 s apart: on the ledge (node 0), 0.1 m
+    below its floor on the ladder (snapped to node 0, but climbing), half way with no floor
+    found, 0.2 m above the foot (snapped to node 3, still climbing), at the foot. The passage
+    targets node 0 when he left it and node 3 when he reached it, by the climbing speed; the
+    path between is the ladder though the drop beside it is quicker."""
+    graph = ladder_and_drop()
+    positions = np.array(
+        [[0.0, 0.0, 3.0], [0.0, 0.05, 2.9], [0.0, 0.35, 1.5], [0.0, 0.6, 0.2], [0.0, 0.7, 0.0]]
+    )
+    floor = np.array([3.0, 3.0, np.nan, 0.0, 0.0])
+    alive = np.ones(5, bool)
+    snap = snap_positions(graph, positions, alive, floor_z=floor)
+    assert snap.status.tolist() == [0, 5, 5, 5, 0]  # SNAPPED, ON_LADDER ..., SNAPPED
+    assert snap.ground_node.tolist() == [-1, 0, -1, 3, -1]
+    down = int(np.flatnonzero((graph.edge_source == 0) & (graph.edge_target == 3))[0])
+    climb = math.dist(positions[0], positions[4]) / LADDER_SPEED_M_S
+    assert graph.edge_climb_s[down] == pytest.approx(climb)
+    np.testing.assert_allclose(snap.ground_delay_s, [0, -0.1 / 3 * climb, 0, 0.2 / 3 * climb, 0])
+    seconds = np.arange(5) * 0.5
+    plan, _ = plan_player(
+        graph, snap, positions, seconds, alive, np.array(["Knife"] * 5), PathCache(graph)
+    )
+    targets = [0, 1, 3, 4]
+    assert plan.target_frame.tolist() == targets
+    np.testing.assert_allclose(plan.target_seconds, (seconds + snap.ground_delay_s)[targets])
+    assert down in plan.action_edge.tolist() and 2 not in plan.action_edge.tolist()
+
+
+def two_ladders_from_one_foot() -> WaypointGraph:
+    """A foot (node 0, z = 0) with a short ladder up to a landing (1, z = 2) and a long one,
+    along nearly the same line, up to a roof (2, z = 4)."""
+    positions = [(0.0, 0.0, 0.0), (0.0, 0.7, 2.0), (0.0, 0.8, 4.0)]
+    edges = [
+        (0, 1, EdgeKind.LADDER, 0),
+        (1, 0, EdgeKind.LADDER, 4),
+        (0, 2, EdgeKind.LADDER, 0),
+        (2, 0, EdgeKind.LADDER, 4),
+    ]
+    e = np.array(edges, dtype=np.int64)
+    return WaypointGraph(
+        positions=np.array(positions),
+        edge_source=e[:, 0].astype(np.int32),
+        edge_target=e[:, 1].astype(np.int32),
+        edge_kind=e[:, 2].astype(np.uint8),
+        edge_direction=e[:, 3].astype(np.uint8),
+        node_place=np.full(3, -1, dtype=np.int16),
+        place_names=[],
+        regions={},
+    )
+
+
+@pytest.mark.parametrize(("top", "heights"), [(2, [1.0, 3.0]), (1, [0.6, 1.4])])
+def test_a_passage_climbs_the_ladder_whose_ends_it_joins(top: int, heights: list[float]) -> None:
+    """Low on the ladders both fit; a passage takes the one most of its frames are on, then
+    the one whose ends lie at the heights of the frames before and after it."""
+    graph = two_ladders_from_one_foot()
+    end = graph.positions[top]
+    climbing = [[0.0, 0.3 + 0.2 * k, h] for k, h in enumerate(heights)]
+    positions = np.array([[0.0, 0.0, 0.0], *climbing, end])
+    floor = np.array([0.0, 0.0, 0.0, end[2]])
+    snap = snap_positions(graph, positions, np.ones(4, bool), floor_z=floor)
+    assert snap.ground_node.tolist() == [-1, 0, top, -1]
 
 
 def test_between_a_ladders_ends_the_path_is_the_ladder() -> None:

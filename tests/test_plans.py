@@ -180,6 +180,7 @@ def test_snap_reasons_for_unsnapped_frames() -> None:
         "NO_POSITION": 1,
         "NO_WAYPOINT": 2,
         "AIRBORNE": 0,
+        "ON_LADDER": 0,
     }
     assert snap.num_unsnappable == 2
 

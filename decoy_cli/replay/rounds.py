@@ -164,7 +164,9 @@ def plan_player(
     (`interval_caps`; `positions` (F, 3) are the player's real ones, NaN where absent).
 
     A player in the air is over some spot of the floor, and heading for it keeps the replay
-    near the real path through a jump; but the spot under a jump across a gap or off a ledge
+    near the real path through a jump; its deadline is when he is there (the frame's time plus
+    `SnapResult.ground_delay_s`), and one outside the times of the frames before and after is
+    left out (they say where he is then). The spot under a jump across a gap or off a ledge
     may lie a long way round. Likewise a snapped frame closer in time to the last hard target
     than the lattice resolves (`hard_frames`) is a soft target: its waypoint says where the
     player went, but a waypoint a spacing off (snapping flips between neighbours, levels or
@@ -180,15 +182,19 @@ def plan_player(
     """
     present = np.isfinite(positions).all(axis=1)
     snapped = (snap.node >= 0) & alive
-    soft = ((snap.ground_node >= 0) & (snap.node < 0)) | (
-        snapped & ~hard_frames(seconds, snapped, target_seconds(graph))
-    )
-    nodes = np.where(snap.node >= 0, snap.node, snap.ground_node)
+    ground = (snap.ground_node >= 0) & (snap.node < 0)
+    climbing = ground & (snap.status == SnapStatus.ON_LADDER)
+    before, after = np.append(-np.inf, seconds[:-1]), np.append(seconds[1:], np.inf)
+    at = np.where(ground, seconds + snap.ground_delay_s, seconds)  # when he is at the target
+    ground &= climbing | ((at >= before) & (at <= after))
+    at = np.maximum.accumulate(np.where(ground, np.clip(at, before, after), seconds))
+    soft = (ground & ~climbing) | (snapped & ~hard_frames(seconds, snapped, target_seconds(graph)))
+    nodes = np.where(snap.node >= 0, snap.node, np.where(ground, snap.ground_node, -1))
     tried: set[tuple[int, int, int]] = set()  # (frame, target before, after) `resnap` tried
     bridged = np.zeros(len(seconds), dtype=bool)
     while True:
         plan = build_plan(
-            graph, nodes, seconds, alive, weapons, present=present, paths=paths,
+            graph, nodes, at, alive, weapons, present=present, paths=paths,
             bridged=bridged, positions=positions,
         )  # fmt: skip
         caps = interval_caps(plan, positions)

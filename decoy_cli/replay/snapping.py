@@ -13,15 +13,24 @@ nearest (a box beside the fall), a target the replay then has to detour to. Such
 instead the waypoint nearest the spot on the floor straight under it (`ground_node`), a target
 the plan uses only where it keeps the replay in time (`decoy_cli.replay.rounds.plan_player`);
 elsewhere the plan goes through those frames on the path between the frames before and after.
+
+A player is at that waypoint when he lands, not at the frame: `ground_delay_s` says how much
+later. Over the floor he jumped from that is no later (he is above his own path); falling to a
+lower floor it is his fall from rest (an upper bound: he may be falling already). A climber
+on a ladder is at no waypoint either: the first frame of a passage targets the end he left,
+the last the end he reaches, each at the time the climbing speed puts him there (the delay
+negative for the end he left); frames between have no target, and the plan's path between the
+two ends is the ladder (`decoy_cli.replay.plans.PathCache`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import IntEnum
 
 import numpy as np
 
+from decoy_cli.csgo import GRAVITY_M_S2, JUMP_HEIGHT_M
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.waypoints.graph import WaypointGraph, in_the_air
 
@@ -45,6 +54,7 @@ class SnapStatus(IntEnum):
     NO_POSITION = 2  # alive but without a finite position in the data
     NO_WAYPOINT = 3  # no waypoint on the position's floor within the snap distance
     AIRBORNE = 4  # in the air (`in_the_air`): jumping or falling
+    ON_LADDER = 5  # climbing a ladder (`WaypointGraph.on_ladders`), not at one of its ends
 
 
 @dataclass(frozen=True)
@@ -59,8 +69,11 @@ class SnapResult:
     """(F,) int8 `SnapStatus` per frame: why a frame was or was not snapped."""
     ground_node: np.ndarray
     """(F,) int64 for frames in the air: the waypoint nearest the spot on the world's floor
-    straight under the position, or on a ladder the end of its edge nearest in height (-1
-    elsewhere, or none within the snap distance)."""
+    straight under the position, or on a ladder the end of the passage's edge (-1 elsewhere,
+    between a passage's first and last frame, or none within the snap distance)."""
+    ground_delay_s: np.ndarray
+    """(F,) float64 seconds from the frame until the player is at `ground_node` (negative: since
+    he left it; 0 where there is none)."""
 
     def count(self, status: SnapStatus) -> int:
         """Number of frames with this status."""
@@ -119,13 +132,18 @@ def snap_positions(
     status[alive & ~finite] = SnapStatus.NO_POSITION
 
     candidates = alive & finite
+    ladders = np.zeros((frames, len(graph.ladders)), dtype=bool)
+    ladders[candidates] = graph.on_ladders(pos[candidates])
     if floor_z is not None:
         floor_z = np.asarray(floor_z, dtype=np.float64)
         if floor_z.shape != (len(pos),):
             raise EstaError(f"floor heights have shape {floor_z.shape}, expected ({len(pos)},)")
         airborne = candidates & in_the_air(pos[:, 2], floor_z, vertical_speed)
         status[airborne] = SnapStatus.AIRBORNE
-        candidates &= ~airborne
+        # on a ladder with no floor under him: climbing
+        climbing = candidates & ~airborne & ladders.any(axis=1) & np.isnan(floor_z)
+        status[climbing] = SnapStatus.ON_LADDER
+        candidates &= ~airborne & ~climbing
     query = np.flatnonzero(candidates)
     if len(query):
         index, distance = graph.nearest(pos[query], max_distance=max_distance)
@@ -135,15 +153,88 @@ def snap_positions(
         status[query[found]] = SnapStatus.SNAPPED
         status[query[~found]] = SnapStatus.NO_WAYPOINT
     ground_node = np.full(frames, -1, dtype=np.int64)
+    delay = np.zeros(frames)
     if floor_z is not None:
         in_air = np.flatnonzero((status == SnapStatus.AIRBORNE) & np.isfinite(floor_z))
         if len(in_air):
             under = pos[in_air].copy()
             under[:, 2] = floor_z[in_air]
-            index, _ = graph.nearest(under, max_distance=max_distance)
-            ladder = graph.ladder_end(pos[in_air])  # a climber heads for the ladder's ends
-            ground_node[in_air] = np.where(ladder >= 0, ladder, index)
-    return SnapResult(node=node, error_m=error, status=status, ground_node=ground_node)
+            ground_node[in_air] = graph.nearest(under, max_distance=max_distance)[0]
+            height = pos[in_air, 2] - floor_z[in_air]
+            lower = floor_z[in_air] < _level_left(graph, node)[in_air] - JUMP_HEIGHT_M
+            delay[in_air] = np.where(lower, np.sqrt(2 * np.maximum(height, 0) / GRAVITY_M_S2), 0)
+    _ladder_targets(graph, pos, ladders, node, error, status, ground_node, delay)
+    return SnapResult(node, error, status, ground_node, delay)
+
+
+def _level_left(graph: WaypointGraph, node: np.ndarray) -> np.ndarray:
+    """(F,) height of the waypoint of the last snapped frame up to each frame (NaN before the
+    first): the floor a player in the air jumped or fell from."""
+    last = np.maximum.accumulate(np.where(node >= 0, np.arange(len(node)), -1))
+    return np.where(last >= 0, graph.positions[node[np.maximum(last, 0)], 2], np.nan)
+
+
+def _ladder_targets(
+    graph: WaypointGraph, pos: np.ndarray, ladders: np.ndarray, node: np.ndarray,
+    error: np.ndarray, status: np.ndarray, ground: np.ndarray, delay: np.ndarray,
+) -> None:  # fmt: skip
+    """Set the targets of the frames on a ladder (in place; `ladders` (F, L): which of
+    `graph.ladders` each frame is on). Per passage (consecutive frames at no waypoint on a
+    ladder): the ladder whose ends lie nearest the heights just before and after it (ladders
+    may share an end), the end left at its first frame, the end reached at its last; one frame
+    alone targets the end nearer in height. A frame next to a passage snapped to one of its
+    ends but still on the ladder (between the ends' heights) is climbing, not there yet: it
+    joins the passage."""
+    unsnapped = np.isin(status, (SnapStatus.AIRBORNE, SnapStatus.NO_WAYPOINT, SnapStatus.ON_LADDER))
+    frames = np.flatnonzero(unsnapped & ladders.any(axis=1))
+    breaks = np.flatnonzero(np.diff(frames) != 1) + 1
+    for run in np.split(frames, breaks) if len(frames) else []:
+        first, last = int(run[0]), int(run[-1])
+        before = _height(pos, first - 1, pos[first, 2])
+        after = _height(pos, last + 1, pos[last, 2])
+        edge = _passage_ladder(graph, ladders[run], before, after)
+        foot, top = int(graph.edge_source[edge]), int(graph.edge_target[edge])
+        k = int(np.searchsorted(graph.ladders, edge))
+        while first > 0 and ladders[first - 1, k] and node[first - 1] in (foot, top):
+            first -= 1
+        while last + 1 < len(pos) and ladders[last + 1, k] and node[last + 1] in (foot, top):
+            last += 1
+        run = np.arange(first, last + 1)
+        node[run], error[run], status[run] = -1, np.nan, SnapStatus.ON_LADDER
+        ground[run], delay[run] = -1, 0.0
+        low, high = graph.positions[foot, 2], graph.positions[top, 2]
+        share_up = np.clip((pos[run, 2] - low) / (high - low), 0.0, 1.0)  # of the climb, done
+        climb_s = float(graph.edge_climb_s[edge])
+        up = _height(pos, last + 1, pos[last, 2]) >= _height(pos, first - 1, pos[first, 2])
+        if first == last:  # one frame: the end nearer in height
+            reach_top = share_up[0] >= 0.5
+            ground[first] = top if reach_top else foot
+            to_end = (1 - share_up[0] if reach_top else share_up[0]) * climb_s
+            delay[first] = to_end if reach_top == up else -to_end
+            continue
+        ground[first] = foot if up else top
+        delay[first] = -(share_up[0] if up else 1 - share_up[0]) * climb_s
+        ground[last] = top if up else foot
+        delay[last] = (1 - share_up[-1] if up else share_up[-1]) * climb_s
+
+
+def _passage_ladder(graph: WaypointGraph, on: np.ndarray, before: float, after: float) -> int:
+    """The ladder edge (from its foot) of a passage whose frames are on `on` (n, L): the one
+    most of them are on, then the one whose ends' heights lie nearest `before` and `after`
+    (climbing up or down)."""
+    low = graph.positions[graph.edge_source[graph.ladders], 2]
+    high = graph.positions[graph.edge_target[graph.ladders], 2]
+    mismatch = np.minimum(
+        abs(before - low) + abs(after - high), abs(before - high) + abs(after - low)
+    )
+    missed = len(on) - on.sum(axis=0)
+    return int(graph.ladders[np.lexsort((mismatch, missed))[0]])
+
+
+def _height(pos: np.ndarray, frame: int, otherwise: float) -> float:
+    """The height of `frame`, or `otherwise` where there is no such frame or no position."""
+    known = 0 <= frame < len(pos) and np.isfinite(pos[frame, 2])
+    return float(pos[frame, 2]) if known else otherwise
 
 
 def snap_into_sites(
@@ -173,4 +264,4 @@ def snap_into_sites(
         best = int(np.argmin(distance))
         if distance[best] <= max_distance:
             node[f], error[f] = inside[best], distance[best]
-    return SnapResult(node=node, error_m=error, status=snap.status, ground_node=snap.ground_node)
+    return replace(snap, node=node, error_m=error)

@@ -244,22 +244,28 @@ class WaypointGraph:
 
     # ---- nearest waypoint -------------------------------------------------------------------
 
-    def ladder_end(self, points: np.ndarray, reach: float = LADDER_REACH_M) -> np.ndarray:
-        """(M,) for points (M, 3) on a ladder, the end of its edge nearest in height (-1 for the
-        rest): a point on a ladder lies between the heights of its two ends and within `reach`
-        of the line between them across the floor."""
+    @cached_property
+    def ladders(self) -> np.ndarray:
+        """(L,) one edge of each ladder (the one from its lower end), in edge order."""
+        climb = self.edge_kind == EdgeKind.LADDER
+        up = self.positions[self.edge_target, 2] > self.positions[self.edge_source, 2]
+        return np.flatnonzero(climb & up)
+
+    def on_ladders(self, points: np.ndarray, reach: float = LADDER_REACH_M) -> np.ndarray:
+        """(M, L) which of the `ladders` each of the points (M, 3) is on: between the heights of
+        its two ends and within `reach` of the line between them across the floor (ladders
+        that share an end overlap)."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        end = np.full(len(points), -1, dtype=np.int64)
-        for e in np.flatnonzero(self.edge_kind == EdgeKind.LADDER):
-            foot, top = int(self.edge_source[e]), int(self.edge_target[e])
-            if self.positions[foot, 2] > self.positions[top, 2]:
-                foot, top = top, foot
-            low, high = self.positions[foot], self.positions[top]
-            between = (points[:, 2] > low[2]) & (points[:, 2] < high[2])
-            across = _to_segment_2d(points[:, :2], low[:2], high[:2]) <= reach
-            nearer = np.where(points[:, 2] - low[2] > high[2] - points[:, 2], top, foot)
-            end = np.where((end < 0) & between & across, nearer, end)
-        return end
+        low, high = (
+            self.positions[self.edge_source[self.ladders]],
+            self.positions[self.edge_target[self.ladders]],
+        )
+        on = np.zeros((len(points), len(self.ladders)), dtype=bool)
+        for k in range(len(self.ladders)):
+            between = (points[:, 2] > low[k, 2]) & (points[:, 2] < high[k, 2])
+            across = _to_segment_2d(points[:, :2], low[k, :2], high[k, :2]) <= reach
+            on[:, k] = between & across
+        return on
 
     @cached_property
     def _tree(self) -> cKDTree:
