@@ -57,7 +57,7 @@ def test_walks_and_ladders_are_straight_at_their_speed() -> None:
 
 
 @pytest.mark.parametrize(
-    ("map_name", "rate", "seed"), [("mirage", 2.0, 0), ("nuke", 8.0, 1)]
+    ("map_name", "rate", "seed"), [("mirage", 2.0, 0), ("mirage", 4.0, 0), ("nuke", 8.0, 1)]
 )
 def test_every_kind_of_edge_replays_within_half_a_metre(
     tmp_path: Path, map_name: str, rate: float, seed: int

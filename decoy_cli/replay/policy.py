@@ -206,6 +206,10 @@ class PlanPolicy:
             if self._plants_here(sim, agent, interval):
                 self.next_action[agent] = a - 1  # the move waits until the plant completes
                 return Decision(STOP_ACTION, hold_ticks=1, plant=True)
+            spare = self._spare_before_a_fall(sim.graph, agent, a - 1, deadline - now)
+            if spare > 0:  # nothing left to run but the fall: it lands on the deadline
+                self.next_action[agent] = a - 1
+                return Decision(STOP_ACTION, hold_ticks=spare, plant=plant, defuse=defuse)
             speed = self._speed(sim.graph, agent, a - 1, (deadline - now) / TICK_RATE)
             cap = None if self.interval_caps is None else float(self.interval_caps[agent][interval])
             return Decision(act, speed=speed, max_speed=cap, plant=plant, defuse=defuse)
@@ -226,6 +230,18 @@ class PlanPolicy:
             run, fixed = float(graph.edge_length[edge]), fixed - float(graph.edge_climb_s[edge])
         running_s = seconds_left - fixed
         return run / running_s if running_s > 0 else None
+
+    def _spare_before_a_fall(
+        self, graph: WaypointGraph, agent: int, action: int, ticks_left: int
+    ) -> int:
+        """Ticks to wait at a ledge before running off it, when the fall is all that is left of
+        the interval and lands before its deadline: a player with time to spare before a drop
+        does not land early and stand below (0 for every other move)."""
+        edge = int(self.plans[agent].action_edge[action])
+        if not graph.off_a_ledge[edge] or self._remaining[agent][action] > 0:
+            return 0
+        fall = int(np.ceil(self._remaining_air[agent][action] * TICK_RATE))
+        return max(ticks_left - fall, 0)
 
     def _arrive(self, agent: int, interval: int, now: int) -> None:
         """Log the arrival at the target that ends `interval` (first arrival only)."""
