@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_plans import make_graph
 from worlds import floor, graph_of, make_world, seeds_of, wall, walls_around
 
 from decoy_cli.csgo import HAMMER_TO_M, LADDER_SPEED_M_S, SAFE_DROP_M, TICK_RATE
@@ -510,17 +511,7 @@ def ladder_and_drop() -> WaypointGraph:
         (3, 0, EdgeKind.LADDER, 4),
         (0, 3, EdgeKind.LADDER, 0),
     ]
-    e = np.array(edges, dtype=np.int64)
-    return WaypointGraph(
-        positions=np.array(positions),
-        edge_source=e[:, 0].astype(np.int32),
-        edge_target=e[:, 1].astype(np.int32),
-        edge_kind=e[:, 2].astype(np.uint8),
-        edge_direction=e[:, 3].astype(np.uint8),
-        node_place=np.full(4, -1, dtype=np.int16),
-        place_names=[],
-        regions={},
-    )
+    return make_graph(positions, edges)
 
 
 def test_a_point_is_on_a_ladder_between_its_ends_heights_and_within_reach() -> None:
@@ -578,17 +569,7 @@ def two_ladders_from_one_foot() -> WaypointGraph:
         (0, 2, EdgeKind.LADDER, 0),
         (2, 0, EdgeKind.LADDER, 4),
     ]
-    e = np.array(edges, dtype=np.int64)
-    return WaypointGraph(
-        positions=np.array(positions),
-        edge_source=e[:, 0].astype(np.int32),
-        edge_target=e[:, 1].astype(np.int32),
-        edge_kind=e[:, 2].astype(np.uint8),
-        edge_direction=e[:, 3].astype(np.uint8),
-        node_place=np.full(3, -1, dtype=np.int16),
-        place_names=[],
-        regions={},
-    )
+    return make_graph(positions, edges)
 
 
 @pytest.mark.parametrize(("top", "heights"), [(2, [1.0, 3.0]), (1, [0.6, 1.4])])
