@@ -544,6 +544,7 @@ def test_a_ladder_passage_targets_the_end_left_and_the_end_reached_at_the_climbi
     alive = np.ones(5, bool)
     snap = snap_positions(graph, positions, alive, floor_z=floor)
     assert snap.status.tolist() == [0, 5, 5, 5, 0]  # SNAPPED, ON_LADDER ..., SNAPPED
+    assert snap.num_airborne == 3  # counted with the frames in the air, never lost
     assert snap.ground_node.tolist() == [-1, 0, -1, 3, -1]
     down = int(np.flatnonzero((graph.edge_source == 0) & (graph.edge_target == 3))[0])
     climb = math.dist(positions[0], positions[4]) / LADDER_SPEED_M_S

@@ -122,7 +122,7 @@ def totals_table(totals: SnapTotals, title: str) -> Table:
         ("snap error p95 (m)", _num(totals.snap_p95_m)),
         (f"snapped within {WITHIN_M:g} m", _share(totals.within)),
         ("unsnappable frames (no waypoint on their floor)", f"{totals.unsnappable:,}"),
-        ("frames in the air (not snapped, as in the replay)", f"{totals.airborne:,}"),
+        ("frames in the air or on a ladder (not snapped)", f"{totals.airborne:,}"),
         ("frame intervals", f"{totals.intervals:,}"),
         (
             "intervals needing more than max speed",

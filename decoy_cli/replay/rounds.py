@@ -71,8 +71,8 @@ class RoundPlan:
 
     `within_0.5m` is the share of alive frames with a position that snapped within 0.5 m;
     `unsnappable` counts alive frames with no waypoint on their floor, `airborne` those in the
-    air (found only with the world, not snapped and not in `within_0.5m`); `worst_ratio` is the
-    largest required / maximum speed ratio; `died_s` is NaN for a survivor.
+    air or on a ladder (found only with the world, not snapped and not in `within_0.5m`);
+    `worst_ratio` is the largest required / maximum speed ratio; `died_s` is NaN for a survivor.
     """
 
     @property

@@ -91,9 +91,9 @@ class SnapResult:
 
     @property
     def num_airborne(self) -> int:
-        """Alive frames in the air (`in_the_air`: jumping, falling): not snapped, a player in
-        the air stands at no waypoint."""
-        return self.count(SnapStatus.AIRBORNE)
+        """Alive frames in the air (`in_the_air`: jumping, falling) or climbing a ladder: not
+        snapped, a player there stands at no waypoint."""
+        return self.count(SnapStatus.AIRBORNE) + self.count(SnapStatus.ON_LADDER)
 
     def counts(self) -> dict[str, int]:
         """Frame count per status name (for example {'SNAPPED': 120, 'NOT_ALIVE': 13, ...})."""
