@@ -21,6 +21,7 @@ from decoy_cli.bench.machine import machine_line
 from decoy_cli.damage import load_damage_model
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.random_play import RandomPolicy
+from decoy_cli.sim.setup import RunSpec
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
@@ -42,13 +43,14 @@ def main() -> None:
     model = load_damage_model("shipped")
     print(machine_line())
     ratios = []
+    kinematic = RunSpec(mover="kinematic")
     with PhysicsWorld(nav_world()) as physics:
-        simspeed.run_agents(physics, graph, 2, 200, model, mover="kinematic")  # compilation
+        simspeed.run_agents(physics, graph, 2, 200, model, kinematic)  # compilation
         for _ in range(repeats):
             speed = {}
             for name, policy in (("compiled", RandomPolicy), ("one at a time", OneAtATime)):
                 simspeed.RandomPolicy = policy  # type: ignore[misc, assignment]
-                row = simspeed.run_agents(physics, graph, 10, 10_000, model, mover="kinematic")
+                row = simspeed.run_agents(physics, graph, 10, 10_000, model, kinematic)
                 speed[name] = row.ticks_per_s
             simspeed.RandomPolicy = RandomPolicy  # type: ignore[misc]
             ratios.append(speed["compiled"] / speed["one at a time"])

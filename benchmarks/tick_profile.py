@@ -20,6 +20,7 @@ from collections import defaultdict
 from decoy_cli.bench.machine import machine_line
 from decoy_cli.bench.simspeed import run_agents
 from decoy_cli.damage import load_damage_model
+from decoy_cli.sim.setup import RunSpec
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
@@ -46,9 +47,9 @@ def main() -> None:
     model = load_damage_model("shipped")
     profile = cProfile.Profile()
     with PhysicsWorld(nav_world()) as physics:
-        run_agents(physics, graph, 2, 200, model, mover=mover)  # warm-up: compilation
+        run_agents(physics, graph, 2, 200, model, RunSpec(mover=mover))  # warm-up: compilation
         profile.enable()
-        row = run_agents(physics, graph, agents, 10_000, model, mover=mover)
+        row = run_agents(physics, graph, agents, 10_000, model, RunSpec(mover=mover))
         profile.disable()
     stats = pstats.Stats(profile).stats  # type: ignore[attr-defined]
     own: dict[str, float] = defaultdict(float)

@@ -17,7 +17,7 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 from decoy_cli import __version__
 from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
@@ -35,13 +35,12 @@ from decoy_cli.bench.simspeed import (
     PAPER_DECISIONS,
     PAPER_TICKS_PER_S,
     NeverHits,
-    Switches,
     speed_table,
 )
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.errors import DecoyError
-from decoy_cli.sim.setup import MoverName
+from decoy_cli.sim.setup import MoverName, RunSpec
 from decoy_cli.waypoints.build import canonical_map
 
 REPORT_FORMAT = 1
@@ -60,18 +59,15 @@ PAPER = "DECOY paper (Wang, Ustun, McGroarty, WSC 2025), Table 1"
 
 
 @dataclass(frozen=True, kw_only=True)
-class BenchConfig:
+class BenchConfig(RunSpec):
     """What to run and how much of it: the full benchmark, or a quick smoke run.
 
-    `combat` and `bomb` switch the mechanics of Table 1 and of the replay section (the paper's
-    Table 1 has every mechanic on)."""
+    `combat` and `bomb` (`RunSpec`) switch the mechanics of Table 1 and of the replay section
+    (the paper's Table 1 has every mechanic on); Table 1 runs the paper's physics mover."""
 
     quick: bool
     models: ModelChoice
     mover: MoverName = "physics"
-    combat: bool = True
-    bomb: bool = True
-    seed: int = 0
     map_name: str = BUILTIN_MAP
     agent_counts: tuple[int, ...] = AGENT_COUNTS
     decisions: int = PAPER_DECISIONS
@@ -94,15 +90,19 @@ class BenchConfig:
     ) -> BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
         round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
-        switches = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
-        map_id = canonical_map(map_name)
-        if not quick:
-            return cls(quick=False, models=models, map_name=map_id, **switches)
-        return cls(
-            quick=True,
+        config = cls(
+            quick=quick,
             models=models,
-            map_name=map_id,
-            **switches,
+            mover=mover,
+            combat=combat,
+            bomb=bomb,
+            seed=seed,
+            map_name=canonical_map(map_name),
+        )
+        if not quick:
+            return config
+        return replace(
+            config,
             agent_counts=(2, 10),
             decisions=1_000,
             combat_repeats=20,

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass
-from typing import TypedDict, cast
+from typing import cast
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from decoy_cli.bench.records import SpeedRowRecord
 from decoy_cli.csgo import BUILTIN_MAP, TICK_RATE
 from decoy_cli.sim.combat import CombatBatch, DamageModel, DamageResult
 from decoy_cli.sim.random_play import RandomPolicy
-from decoy_cli.sim.setup import MoverName, RoundSetup, open_round
+from decoy_cli.sim.setup import MoverName, RoundSetup, RunSpec, open_round
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.waypoints.graph import WaypointGraph
@@ -36,6 +36,9 @@ AGENT_COUNTS = (2, 6, 10, 20, 100)
 PAPER_DECISIONS = 10_000
 """Agent decisions per row in the paper's Table 1."""
 
+PAPER_SPEC = RunSpec(mover="physics")
+"""The paper's Table 1 run: its physics mover, shooting and the bomb on."""
+
 PAPER_TICKS_PER_S: dict[int, float | None] = {2: 4322.0, 6: None, 10: 966.0, 20: 487.0, 100: 99.6}
 """The paper's physics ticks per second by agent count (None: no value recorded here)."""
 
@@ -46,15 +49,6 @@ class NeverHits:
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
         k = len(batch)
         return DamageResult(np.zeros(k, np.int64), np.full(k, -1, np.int8), np.zeros(k, bool))
-
-
-class Switches(TypedDict):
-    """The mechanics a Table 1 run switches (keyword arguments of `run_agents`)."""
-
-    mover: MoverName
-    combat: bool
-    bomb: bool
-    seed: int
 
 
 @dataclass
@@ -100,17 +94,15 @@ def run_agents(
     count: int,
     decisions: int,
     model: DamageModel,
-    *,
-    mover: MoverName = "physics",
-    combat: bool = True,
-    bomb: bool = True,
-    seed: int = 0,
+    spec: RunSpec = PAPER_SPEC,
 ) -> SpeedRow:
     """Play restarted rounds of `count` agents until `decisions` agent decisions (module doc)."""
     if count < 2:
         raise ValueError(f"a round needs at least 2 agents, not {count}")
-    setup = RoundSetup(graph=graph, mover=mover, combat=combat, bomb=bomb, damage_model=model)
-    rng = np.random.default_rng(seed)
+    setup = RoundSetup(
+        graph=graph, mover=spec.mover, combat=spec.combat, bomb=spec.bomb, damage_model=model
+    )
+    rng = np.random.default_rng(spec.seed)
     ticks = rounds = made = kills = 0
     started = time.perf_counter()
     cpu_started = time.process_time()
@@ -136,7 +128,7 @@ def run_agents(
     paper = PAPER_TICKS_PER_S.get(count)
     return SpeedRow(
         agents=count,
-        mover=mover,
+        mover=spec.mover,
         rounds=rounds,
         ticks=ticks,
         decisions=made,
@@ -169,8 +161,8 @@ def speed_table(
     """
     graph = builtin_graph(map_name)
     model = NeverHits() if model is None else model
-    options = Switches(mover=mover, combat=combat, bomb=bomb, seed=seed)
+    spec = RunSpec(mover=mover, combat=combat, bomb=bomb, seed=seed)
     with PhysicsWorld(nav_world(map_name)) as physics:
         if warmup_decisions:
-            run_agents(physics, graph, 2, warmup_decisions, model, **options)
-        return [run_agents(physics, graph, n, decisions, model, **options) for n in counts]
+            run_agents(physics, graph, 2, warmup_decisions, model, spec)
+        return [run_agents(physics, graph, n, decisions, model, spec) for n in counts]

@@ -13,18 +13,12 @@ import json
 from dataclasses import asdict, dataclass
 from functools import cache
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from decoy_cli.damage.choice import ModelChoice
 from decoy_cli.errors import EstaError
-from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.heat import HeatGrid
+from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.world.navmesh import asset_dir
-
-if TYPE_CHECKING:
-    from decoy_cli.replay.deaths import DeathProtocol
-    from decoy_cli.replay.missing import Missing
-    from decoy_cli.sim.setup import MoverName
 
 RECORD_VERSION = 7
 """Format of the cached per-round records and file indexes; bump when it changes."""
@@ -54,31 +48,21 @@ _CODE_PARTS = (
 
 
 @dataclass(frozen=True, kw_only=True)
-class EvalSettings:
+class EvalSettings(ReplaySpec):
     """Everything that decides one round's result; its JSON is hashed into the cache key.
 
-    `combat` switches shooting and `bomb` the bomb rules, independently (both off: movement
-    only, as in the paper's Table 2); `models` is the damage-model choice a worker loads (only
-    used with combat); `implausible` says whether a round with implausible data fails or is
-    replayed with warnings (decoy_cli/esta/plausibility.py).
+    The replay's spec (`ReplaySpec`: the mover, `combat`, `bomb`, the seed, the protocols) and
+    what an evaluation adds: the map, the damage-model choice a worker loads (only used with
+    combat), the code's and the models' fingerprints, the grids, the graph and sight files.
     """
 
     map_name: str
-    combat: bool
-    bomb: bool
     models: ModelChoice
-    mover: MoverName
-    seed: int
     grid: HeatGrid
     code: str
     """Fingerprint of the result-deciding code and the map's assets (`code_fingerprint`)."""
     models_fingerprint: str
     """Fingerprint of the damage model files ("" without combat or with no model)."""
-    implausible: Implausible = "fail"
-    deaths: DeathProtocol = "simulated"
-    """Who decides deaths with shooting on (`ReplayOptions.deaths`)."""
-    missing: Missing = "infer"
-    """Fill the fields the data lacks by rule, or fail the round (`ReplayOptions.missing`)."""
     fastdtw: bool = False
     """Also compute `paper_dtw_fastdtw` (the paper's FastDTW; slow, `metrics.fastdtw_metric`)."""
     hp_bin_s: float = HP_BIN_S

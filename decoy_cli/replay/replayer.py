@@ -53,7 +53,7 @@ from decoy_cli.replay.rounds import RoundPlan, snap_round
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.recording import Recording
 from decoy_cli.sim.rules import RulesConfig
-from decoy_cli.sim.setup import MoverName, OpenRound, RoundSetup, open_round
+from decoy_cli.sim.setup import OpenRound, RoundSetup, RunSpec, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import FIREARMS, NO_WEAPON, max_speed_m_s
@@ -135,18 +135,28 @@ class ReplayResult:
 
 
 @dataclass(frozen=True, kw_only=True)
-class ReplayOptions:
-    """How to replay: shooting, the bomb, the mover, the damage model, the seed.
+class ReplaySpec(RunSpec):
+    """A replay's switches, seed and protocols, as the command line gives them: what
+    `ReplayOptions` and the evaluation's settings (`EvalSettings`) share.
 
-    `combat` and `bomb` are independent switches (shooting needs `damage_model` too); both off
-    is the paper's movement-only replay. The default mover is the one measured more faithful
-    on real rounds (the README gives the numbers). `deaths` says who decides deaths when
-    shooting (module docstring); `missing` whether absent fields are filled or fail the round.
+    `combat` and `bomb` are independent switches; both off is the paper's movement-only
+    replay. The default mover is the one measured more faithful on real rounds (the README
+    gives the numbers). `deaths` says who decides deaths when shooting (module docstring);
+    `missing` whether absent fields are filled or fail the round.
     """
 
-    combat: bool = True
-    bomb: bool = True
-    mover: MoverName = "kinematic"
+    deaths: DeathProtocol = "simulated"
+    missing: Missing = "infer"
+    implausible: Implausible = "fail"
+    """Whether a player far off the map fails the round or is a warning (as the reader's
+    policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReplayOptions(ReplaySpec):
+    """How to replay: the spec (`ReplaySpec`), the damage model shooting needs, and where line
+    of sight is tested."""
+
     damage_model: DamageModel | None = None
     # With shooting, a round still undecided when the data ends (the replay's fights went
     # otherwise than the real ones) is played on, every agent holding its last waypoint and
@@ -155,12 +165,6 @@ class ReplayOptions:
     # combat round end "undecided" and outcome agreement measures nothing. The result says
     # which outcomes were decided after the data (`ReplayResult.played_out_s`).
     play_out: bool = True
-    seed: int = 0
-    deaths: DeathProtocol = "simulated"
-    missing: Missing = "infer"
-    implausible: Implausible = "fail"
-    """Whether a player far off the map fails the round or is a warning (as the reader's
-    policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
     sight: OcclusionScene | None = None
     """The map's geometry line of sight is tested in (`RoundSetup.sight`; None: the world)."""
 

@@ -52,7 +52,30 @@ class SetupError(DecoyError, ValueError):
 
 
 @dataclass(frozen=True, kw_only=True)
-class RoundSetup:
+class Switches:
+    """The switches of a simulated round, one meaning from the command line to the simulator:
+    the mover, shooting (`combat`), the bomb rules. `RoundSetup` and every run's options
+    (`RunSpec` and what extends it) are made of them; an unknown mover is refused here, once."""
+
+    mover: MoverName = "kinematic"
+    combat: bool = True
+    bomb: bool = True
+
+    def __post_init__(self) -> None:
+        if self.mover not in MOVERS:
+            raise SetupError(f"unknown mover {self.mover!r} (use {' or '.join(MOVERS)})")
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunSpec(Switches):
+    """A run's switches and its seed: what the replay (`ReplayOptions`), the evaluation
+    (`EvalSettings`) and the benchmark (`BenchConfig`) share."""
+
+    seed: int = 0
+
+
+@dataclass(frozen=True, kw_only=True)
+class RoundSetup(Switches):
     """How rounds are simulated (see the module docstring).
 
     `world` is the geometry for pybullet (None: the nav world the graph was built on); it is used
@@ -62,9 +85,6 @@ class RoundSetup:
     """
 
     graph: WaypointGraph
-    mover: MoverName = "kinematic"
-    combat: bool = True
-    bomb: bool = True
     damage_model: DamageModel | None = None
     combat_every_ticks: int = COMBAT_EVERY_TICKS
     combat_kills: bool = True
@@ -78,8 +98,7 @@ class RoundSetup:
     zones: SiteZones | None = None
 
     def __post_init__(self) -> None:
-        if self.mover not in MOVERS:
-            raise SetupError(f"unknown mover {self.mover!r} (use {' or '.join(MOVERS)})")
+        super().__post_init__()
         if self.combat_every_ticks < 1:
             raise SetupError(f"combat_every_ticks must be >= 1, got {self.combat_every_ticks}")
 
