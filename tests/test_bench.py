@@ -30,9 +30,11 @@ from decoy_cli.bench import (
 from decoy_cli.bench.machine import cpu_model, memory_gb, peak_rss_mb, ru_maxrss_mb
 from decoy_cli.bench.simspeed import PAPER_TICKS_PER_S, NeverHits
 from decoy_cli.cli import app
+from decoy_cli.damage.choice import ModelName
 from decoy_cli.errors import DecoyError, EstaError
+from decoy_cli.replay import ReplayOptions
 from decoy_cli.sim.combat import VisiblePairs, make_batch
-from decoy_cli.sim.setup import RoundSetup
+from decoy_cli.sim.setup import RoundSetup, RunSpec, SetupError
 from decoy_cli.waypoints.build import builtin_graph
 
 runner = CliRunner()
@@ -186,6 +188,21 @@ def test_bad_options_are_one_line(tmp_path: Path) -> None:
     assert data.exit_code == 1 and "no .json.xz or .json match files" in data.stderr
     with pytest.raises(DecoyError, match="unknown mover 'teleport'"):  # the library's one check
         RoundSetup(graph=builtin_graph(), mover="teleport")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: RunSpec(mover="teleport"),
+        lambda: ReplayOptions(mover="teleport", combat=False),
+        lambda: BenchConfig.create(quick=True, models=ModelName.NONE, mover="teleport"),
+    ],
+)
+def test_every_runs_options_refuse_an_unknown_mover_by_the_one_check(make: Any) -> None:
+    """The replay's, the benchmark's and the plain run spec share the switches (`Switches`),
+    and with them the one check of the mover."""
+    with pytest.raises(SetupError, match="unknown mover 'teleport' \\(use kinematic or physics\\)"):
+        make()
 
 
 def test_a_learned_model_runs_in_the_combat_step(tmp_path: Path) -> None:

@@ -140,9 +140,8 @@ class ReplaySpec(RunSpec):
     `ReplayOptions` and the evaluation's settings (`EvalSettings`) share.
 
     `combat` and `bomb` are independent switches; both off is the paper's movement-only
-    replay. The default mover is the one measured more faithful on real rounds (the README
-    gives the numbers). `deaths` says who decides deaths when shooting (module docstring);
-    `missing` whether absent fields are filled or fail the round.
+    replay. `deaths` says who decides deaths when shooting (module docstring); `missing`
+    whether absent fields are filled or fail the round.
     """
 
     deaths: DeathProtocol = "simulated"

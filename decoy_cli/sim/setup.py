@@ -55,7 +55,9 @@ class SetupError(DecoyError, ValueError):
 class Switches:
     """The switches of a simulated round, one meaning from the command line to the simulator:
     the mover, shooting (`combat`), the bomb rules. `RoundSetup` and every run's options
-    (`RunSpec` and what extends it) are made of them; an unknown mover is refused here, once."""
+    (`RunSpec` and what extends it) are made of them; an unknown mover is refused here, once.
+    The default mover is the one measured more faithful on real rounds (the README gives the
+    numbers)."""
 
     mover: MoverName = "kinematic"
     combat: bool = True
