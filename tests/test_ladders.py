@@ -560,6 +560,26 @@ def test_a_ladder_passage_targets_the_end_left_and_the_end_reached_at_the_climbi
     assert down in plan.action_edge.tolist() and 2 not in plan.action_edge.tolist()
 
 
+def test_a_jump_beside_a_ladders_foot_targets_the_foot_not_the_top() -> None:
+    """Standing at the foot (node 3), a jump on the ladder's line that lands at the foot again:
+    the frames in the air are on the ladder, but the passage leaves and reaches the foot; the
+    replay stays off the ladder."""
+    graph = ladder_and_drop()
+    foot = graph.positions[3]
+    up = np.array(
+        [[0.0, 0.0, 0.0], [0.0, -0.1, 0.6], [0.0, -0.1, 0.9], [0.0, -0.1, 0.5], [0, 0, 0]]
+    )
+    positions = foot + up
+    floor = np.zeros(5)
+    alive = np.ones(5, bool)
+    snap = snap_positions(graph, positions, alive, floor_z=floor)
+    assert snap.ground_node.tolist() == [-1, 3, -1, 3, -1]
+    seconds = np.arange(5) * 0.25
+    weapons = np.array(["Knife"] * 5)
+    plan, _ = plan_player(graph, snap, positions, seconds, alive, weapons, PathCache(graph))
+    assert not (graph.edge_kind[plan.action_edge[plan.action_edge >= 0]] == EdgeKind.LADDER).any()
+
+
 def two_ladders_from_one_foot() -> WaypointGraph:
     """A foot (node 0, z = 0) with a short ladder up to a landing (1, z = 2) and a long one,
     along nearly the same line, up to a roof (2, z = 4)."""

@@ -181,10 +181,11 @@ def _ladder_targets(
     """Set the targets of the frames on a ladder (in place; `ladders` (F, L): which of
     `graph.ladders` each frame is on). Per passage (consecutive frames at no waypoint on a
     ladder): the ladder whose ends lie nearest the heights just before and after it (ladders
-    may share an end), the end left at its first frame, the end reached at its last; one frame
-    alone targets the end nearer in height. A frame next to a passage snapped to one of its
-    ends but still on the ladder (between the ends' heights) is climbing, not there yet: it
-    joins the passage."""
+    may share an end); at its first frame the end he left, at its last the end he reached, each
+    the end nearer the height before or after the passage (one end twice for a jump beside a
+    ladder); one frame alone targets the end nearer in height. A frame next to a passage
+    snapped to one of its ends but still on the ladder (between the ends' heights) is climbing,
+    not there yet: it joins the passage."""
     unsnapped = np.isin(status, (SnapStatus.AIRBORNE, SnapStatus.NO_WAYPOINT, SnapStatus.ON_LADDER))
     frames = np.flatnonzero(unsnapped & ladders.any(axis=1))
     breaks = np.flatnonzero(np.diff(frames) != 1) + 1
@@ -204,18 +205,24 @@ def _ladder_targets(
         ground[run], delay[run] = -1, 0.0
         low, high = graph.positions[foot, 2], graph.positions[top, 2]
         share_up = np.clip((pos[run, 2] - low) / (high - low), 0.0, 1.0)  # of the climb, done
-        climb_s = float(graph.edge_climb_s[edge])
-        up = _height(pos, last + 1, pos[last, 2]) >= _height(pos, first - 1, pos[first, 2])
+        to_foot = share_up * graph.edge_climb_s[edge]  # seconds of climbing to either end
+        to_top = (1 - share_up) * graph.edge_climb_s[edge]
+        # the ends nearest the heights before and after: a climb leaves one and reaches the
+        # other, a jump beside the ladder's foot leaves and reaches the foot
+        before = _height(pos, first - 1, pos[first, 2])
+        after = _height(pos, last + 1, pos[last, 2])
+        left_top = abs(before - high) < abs(before - low)
+        reached_top = abs(after - high) < abs(after - low)
         if first == last:  # one frame: the end nearer in height
-            reach_top = share_up[0] >= 0.5
-            ground[first] = top if reach_top else foot
-            to_end = (1 - share_up[0] if reach_top else share_up[0]) * climb_s
-            delay[first] = to_end if reach_top == up else -to_end
+            at_top = share_up[0] >= 0.5
+            ground[first] = top if at_top else foot
+            seconds = float((to_top if at_top else to_foot)[0])
+            delay[first] = seconds if at_top == reached_top else -seconds
             continue
-        ground[first] = foot if up else top
-        delay[first] = -(share_up[0] if up else 1 - share_up[0]) * climb_s
-        ground[last] = top if up else foot
-        delay[last] = (1 - share_up[-1] if up else share_up[-1]) * climb_s
+        ground[first] = top if left_top else foot
+        delay[first] = -(to_top if left_top else to_foot)[0]
+        ground[last] = top if reached_top else foot
+        delay[last] = (to_top if reached_top else to_foot)[-1]
 
 
 def _passage_ladder(graph: WaypointGraph, on: np.ndarray, before: float, after: float) -> int:
