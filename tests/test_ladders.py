@@ -580,6 +580,21 @@ def test_a_jump_beside_a_ladders_foot_targets_the_foot_not_the_top() -> None:
     assert not (graph.edge_kind[plan.action_edge[plan.action_edge >= 0]] == EdgeKind.LADDER).any()
 
 
+def test_a_fall_beside_a_ladder_is_no_climb() -> None:
+    """Off the ledge (node 1, beside the ladder's top) down to the floor, the frames in the air
+    on the ladder's line: the height changes faster than a climb between them, so they are a
+    fall (in the air, over the floor), not a passage of the ladder."""
+    graph = ladder_and_drop()
+    positions = np.array([[0.0, 0.1, 3.0], [0.0, 0.3, 2.4], [0.0, 0.5, 0.8], [0.0, 0.7, 0.0]])
+    floor = np.array([3.0, 0.0, 0.0, 0.0])
+    alive = np.ones(4, bool)
+    seconds = np.array([0.0, 0.2, 0.4, 0.6])
+    fall = snap_positions(graph, positions, alive, floor_z=floor, seconds=seconds)
+    assert fall.status.tolist() == [0, 4, 4, 0]  # SNAPPED, AIRBORNE, AIRBORNE, SNAPPED
+    climb = snap_positions(graph, positions, alive, floor_z=floor, seconds=seconds * 4)
+    assert climb.status.tolist() == [0, 5, 5, 0]  # the same heights at a climb's pace
+
+
 def two_ladders_from_one_foot() -> WaypointGraph:
     """A foot (node 0, z = 0) with a short ladder up to a landing (1, z = 2) and a long one,
     along nearly the same line, up to a roof (2, z = 4)."""

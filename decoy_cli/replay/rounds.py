@@ -131,6 +131,7 @@ def snap_round(
             max_distance=max_distance,
             floor_z=floor_z[p],
             vertical_speed=None if physics is None else round_.vertical_speed[p],
+            seconds=seconds,
         )
         if sites is not None and node_site is not None and (sites[p] != "").any():
             snap = snap_into_sites(graph, snap, positions[p], sites[p], node_site, max_distance)

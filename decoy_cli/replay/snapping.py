@@ -30,7 +30,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from decoy_cli.csgo import GRAVITY_M_S2, JUMP_HEIGHT_M
+from decoy_cli.csgo import GRAVITY_M_S2, JUMP_HEIGHT_M, LADDER_SPEED_M_S
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.waypoints.graph import WaypointGraph, in_the_air
 
@@ -41,6 +41,10 @@ The lattice spacing is 0.7 m, so a position on the graph's floors lies within ab
 waypoint, and a jumping player about 1.2 m; a position farther than this from every waypoint on
 its floor is off the graph, and snapping it would invent a location.
 """
+
+CLIMB_MARGIN = 1.25
+"""How much faster than the climbing speed a player's height may change between two frames and
+his frames on a ladder still be a climb (chosen, not measured); faster, he fell beside it."""
 
 WITHIN_M = 0.5
 """Snap error the summary counts as good (the share of frames within it is reported)."""
@@ -107,6 +111,7 @@ def snap_positions(
     max_distance: float = DEFAULT_MAX_SNAP_M,
     floor_z: np.ndarray | None = None,
     vertical_speed: np.ndarray | None = None,
+    seconds: np.ndarray | None = None,
 ) -> SnapResult:
     """Snap each alive frame's position (metres, shape (F, 3)) to its floor-aware nearest waypoint.
 
@@ -114,6 +119,7 @@ def snap_positions(
     waypoint on their floor within `max_distance` get node -1 and error NaN, with their reason.
     `floor_z` (F,), the world's floor height under each position (NaN where none is known), marks
     the frames in the air, and so does a known non-zero `vertical_speed` (F,) (m/s) with it.
+    `seconds` (F,), the frame times, tell a climb from a fall beside a ladder.
     """
     pos = np.asarray(positions, dtype=np.float64)
     alive = np.asarray(alive, dtype=bool)
@@ -163,7 +169,7 @@ def snap_positions(
             height = pos[in_air, 2] - floor_z[in_air]
             lower = floor_z[in_air] < _level_left(graph, node)[in_air] - JUMP_HEIGHT_M
             delay[in_air] = np.where(lower, np.sqrt(2 * np.maximum(height, 0) / GRAVITY_M_S2), 0)
-    _ladder_targets(graph, pos, ladders, node, error, status, ground_node, delay)
+    _ladder_targets(graph, pos, seconds, ladders, node, error, status, ground_node, delay)
     return SnapResult(node, error, status, ground_node, delay)
 
 
@@ -175,8 +181,9 @@ def _level_left(graph: WaypointGraph, node: np.ndarray) -> np.ndarray:
 
 
 def _ladder_targets(
-    graph: WaypointGraph, pos: np.ndarray, ladders: np.ndarray, node: np.ndarray,
-    error: np.ndarray, status: np.ndarray, ground: np.ndarray, delay: np.ndarray,
+    graph: WaypointGraph, pos: np.ndarray, seconds: np.ndarray | None, ladders: np.ndarray,
+    node: np.ndarray, error: np.ndarray, status: np.ndarray, ground: np.ndarray,
+    delay: np.ndarray,
 ) -> None:  # fmt: skip
     """Set the targets of the frames on a ladder (in place; `ladders` (F, L): which of
     `graph.ladders` each frame is on). Per passage (consecutive frames at no waypoint on a
@@ -185,7 +192,8 @@ def _ladder_targets(
     the end nearer the height before or after the passage (one end twice for a jump beside a
     ladder); one frame alone targets the end nearer in height. A frame next to a passage
     snapped to one of its ends but still on the ladder (between the ends' heights) is climbing,
-    not there yet: it joins the passage."""
+    not there yet: it joins the passage. A passage whose height changes faster than a climb
+    between two of its frames (`seconds` known) is a fall beside the ladder: left as it is."""
     unsnapped = np.isin(status, (SnapStatus.AIRBORNE, SnapStatus.NO_WAYPOINT, SnapStatus.ON_LADDER))
     frames = np.flatnonzero(unsnapped & ladders.any(axis=1))
     breaks = np.flatnonzero(np.diff(frames) != 1) + 1
@@ -200,6 +208,8 @@ def _ladder_targets(
             first -= 1
         while last + 1 < len(pos) and ladders[last + 1, k] and node[last + 1] in (foot, top):
             last += 1
+        if seconds is not None and _faster_than_a_climb(pos, seconds, first, last):
+            continue  # a fall beside the ladder
         run = np.arange(first, last + 1)
         node[run], error[run], status[run] = -1, np.nan, SnapStatus.ON_LADDER
         ground[run], delay[run] = -1, 0.0
@@ -216,13 +226,22 @@ def _ladder_targets(
         if first == last:  # one frame: the end nearer in height
             at_top = share_up[0] >= 0.5
             ground[first] = top if at_top else foot
-            seconds = float((to_top if at_top else to_foot)[0])
-            delay[first] = seconds if at_top == reached_top else -seconds
+            to_end = float((to_top if at_top else to_foot)[0])
+            delay[first] = to_end if at_top == reached_top else -to_end
             continue
         ground[first] = top if left_top else foot
         delay[first] = -(to_top if left_top else to_foot)[0]
         ground[last] = top if reached_top else foot
         delay[last] = (to_top if reached_top else to_foot)[-1]
+
+
+def _faster_than_a_climb(pos: np.ndarray, seconds: np.ndarray, first: int, last: int) -> bool:
+    """Whether the height changes faster than `CLIMB_MARGIN` times the climbing speed between
+    two consecutive frames of `first`..`last` or the frames just around them."""
+    frames = np.arange(max(first - 1, 0), min(last + 2, len(pos)))
+    frames = frames[np.isfinite(pos[frames, 2])]
+    rise, took = np.abs(np.diff(pos[frames, 2])), np.diff(seconds[frames])
+    return bool((rise > CLIMB_MARGIN * LADDER_SPEED_M_S * took).any())
 
 
 def _passage_ladder(graph: WaypointGraph, on: np.ndarray, before: float, after: float) -> int:
