@@ -628,4 +628,9 @@ def test_between_a_ladders_ends_the_path_is_the_ladder() -> None:
     assert by_drop < graph.edge_cost[ladder_down]  # the drop is the quicker way down
     assert graph.shortest_path(0, 3) == [0, 1, 2, 3]
     assert PathCache(graph).edges(0, 3).tolist() == [ladder_down]
+    assert graph.edges_between(np.array([0, 0, 1]), np.array([3, 2, 2])).tolist() == [
+        ladder_down,
+        -1,  # no edge from 0 to 2
+        2,
+    ]
     assert PathCache(graph).edges(1, 3).tolist() == [2, 3]  # not from a ladder's end: shortest

@@ -60,7 +60,6 @@ class PathCache:
 
     def __init__(self, graph: WaypointGraph) -> None:
         self.graph = graph
-        self._keys, self._edge_ids = graph.edge_lookup
         self._paths: dict[tuple[int, int], np.ndarray | None] = {}
 
     def __len__(self) -> int:
@@ -78,18 +77,14 @@ class PathCache:
         return self._paths[key]
 
     def _compute(self, source: int, target: int) -> np.ndarray | None:
-        key = source * self.graph.num_nodes + target
-        at = int(np.searchsorted(self._keys, key))
-        if at < len(self._keys) and self._keys[at] == key:
-            edge = self._edge_ids[at]
-            if self.graph.edge_kind[edge] == EdgeKind.LADDER:  # from one end to the other: on it
-                return np.array([edge], dtype=np.int64)
+        ladder = self.graph.edges_between(np.array([source]), np.array([target]))
+        if ladder[0] >= 0 and self.graph.edge_kind[ladder[0]] == EdgeKind.LADDER:
+            return ladder  # from one end to the other: on it
         try:
             nodes = np.asarray(self.graph.shortest_path(source, target), dtype=np.int64)
         except GraphError:
             return None
-        keys = nodes[:-1] * self.graph.num_nodes + nodes[1:]
-        return self._edge_ids[np.searchsorted(self._keys, keys)]
+        return self.graph.edges_between(nodes[:-1], nodes[1:])
 
 
 @dataclass(frozen=True)

@@ -247,9 +247,7 @@ class WaypointGraph:
     @cached_property
     def ladders(self) -> np.ndarray:
         """(L,) one edge of each ladder (the one from its lower end), in edge order."""
-        climb = self.edge_kind == EdgeKind.LADDER
-        up = self.positions[self.edge_target, 2] > self.positions[self.edge_source, 2]
-        return np.flatnonzero(climb & up)
+        return np.flatnonzero((self.edge_kind == EdgeKind.LADDER) & (self.edge_rise_m > 0))
 
     def on_ladders(self, points: np.ndarray, reach: float = LADDER_REACH_M) -> np.ndarray:
         """(M, L) which of the `ladders` each of the points (M, 3) is on: between the heights of
@@ -335,6 +333,16 @@ class WaypointGraph:
         for shared in (sorted_keys, order):  # every path cache of the graph reads them
             shared.setflags(write=False)
         return sorted_keys, order
+
+    def edges_between(self, sources: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """(K,) the edge from each source node to its target (the cheapest where several are),
+        -1 where there is none (`edge_lookup`)."""
+        keys, edge_ids = self.edge_lookup
+        wanted = np.asarray(sources, dtype=np.int64) * self.num_nodes + np.asarray(targets)
+        if not len(keys):
+            return np.full(len(wanted), -1, dtype=np.int64)
+        at = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+        return np.where(keys[at] == wanted, edge_ids[at], -1).astype(np.int64)
 
     def path_lengths(self, source: int) -> tuple[np.ndarray, np.ndarray]:
         """Dijkstra from one node: (path cost, `edge_cost`, to every node; predecessor of every
