@@ -595,6 +595,18 @@ def test_a_fall_beside_a_ladder_is_no_climb() -> None:
     assert climb.status.tolist() == [0, 5, 5, 0]  # the same heights at a climb's pace
 
 
+def test_one_frame_on_a_ladder_targets_the_end_he_reaches() -> None:
+    """Up the ladder of `ladder_and_drop` at one frame a second: at the foot, a third of the
+    way up, on the ledge. The frame on the ladder targets the top when the climb puts him
+    there."""
+    graph = ladder_and_drop()
+    positions = np.array([[0.0, 0.7, 0.0], [0.0, 0.45, 1.0], [0.0, 0.0, 3.0]])
+    snap = snap_positions(graph, positions, np.ones(3, bool), floor_z=np.array([0.0, 0.0, 3.0]))
+    assert snap.ground_node.tolist() == [-1, 0, -1]
+    up = int(np.flatnonzero((graph.edge_source == 3) & (graph.edge_target == 0))[0])
+    assert snap.ground_delay_s[1] == pytest.approx(2 / 3 * graph.edge_climb_s[up])
+
+
 def two_ladders_from_one_foot() -> WaypointGraph:
     """A foot (node 0, z = 0) with a short ladder up to a landing (1, z = 2) and a long one,
     along nearly the same line, up to a roof (2, z = 4)."""

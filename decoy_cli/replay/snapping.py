@@ -190,7 +190,7 @@ def _ladder_targets(
     ladder): the ladder whose ends lie nearest the heights just before and after it (ladders
     may share an end); at its first frame the end he left, at its last the end he reached, each
     the end nearer the height before or after the passage (one end twice for a jump beside a
-    ladder); one frame alone targets the end nearer in height. A frame next to a passage
+    ladder); one frame alone targets the end he reached. A frame next to a passage
     snapped to one of its ends but still on the ladder (between the ends' heights) is climbing,
     not there yet: it joins the passage. A passage whose height changes faster than a climb
     between two of its frames (`seconds` known) is a fall beside the ladder: left as it is."""
@@ -201,9 +201,9 @@ def _ladder_targets(
         first, last = int(run[0]), int(run[-1])
         before = _height(pos, first - 1, pos[first, 2])
         after = _height(pos, last + 1, pos[last, 2])
-        edge = _passage_ladder(graph, ladders[run], before, after)
+        k = _passage_ladder(graph, ladders[run], before, after)
+        edge = int(graph.ladders[k])
         foot, top = int(graph.edge_source[edge]), int(graph.edge_target[edge])
-        k = int(np.searchsorted(graph.ladders, edge))
         while first > 0 and ladders[first - 1, k] and node[first - 1] in (foot, top):
             first -= 1
         while last + 1 < len(pos) and ladders[last + 1, k] and node[last + 1] in (foot, top):
@@ -214,25 +214,16 @@ def _ladder_targets(
         node[run], error[run], status[run] = -1, np.nan, SnapStatus.ON_LADDER
         ground[run], delay[run] = -1, 0.0
         low, high = graph.positions[foot, 2], graph.positions[top, 2]
-        share_up = np.clip((pos[run, 2] - low) / (high - low), 0.0, 1.0)  # of the climb, done
-        to_foot = share_up * graph.edge_climb_s[edge]  # seconds of climbing to either end
-        to_top = (1 - share_up) * graph.edge_climb_s[edge]
-        # the ends nearest the heights before and after: a climb leaves one and reaches the
+        done = np.clip((pos[run, 2] - low) / (high - low), 0.0, 1.0)  # share of the climb up
+        climb_s = float(graph.edge_climb_s[edge])
+        # the ends nearest the heights around the passage: a climb leaves one and reaches the
         # other, a jump beside the ladder's foot leaves and reaches the foot
-        before = _height(pos, first - 1, pos[first, 2])
-        after = _height(pos, last + 1, pos[last, 2])
         left_top = abs(before - high) < abs(before - low)
         reached_top = abs(after - high) < abs(after - low)
-        if first == last:  # one frame: the end nearer in height
-            at_top = share_up[0] >= 0.5
-            ground[first] = top if at_top else foot
-            to_end = float((to_top if at_top else to_foot)[0])
-            delay[first] = to_end if at_top == reached_top else -to_end
-            continue
         ground[first] = top if left_top else foot
-        delay[first] = -(to_top if left_top else to_foot)[0]
-        ground[last] = top if reached_top else foot
-        delay[last] = (to_top if reached_top else to_foot)[-1]
+        delay[first] = -climb_s * (1 - done[0] if left_top else done[0])
+        ground[last] = top if reached_top else foot  # one frame alone: the end reached
+        delay[last] = climb_s * (1 - done[-1] if reached_top else done[-1])
 
 
 def _faster_than_a_climb(pos: np.ndarray, seconds: np.ndarray, first: int, last: int) -> bool:
@@ -245,16 +236,16 @@ def _faster_than_a_climb(pos: np.ndarray, seconds: np.ndarray, first: int, last:
 
 
 def _passage_ladder(graph: WaypointGraph, on: np.ndarray, before: float, after: float) -> int:
-    """The ladder edge (from its foot) of a passage whose frames are on `on` (n, L): the one
-    most of them are on, then the one whose ends' heights lie nearest `before` and `after`
-    (climbing up or down)."""
+    """Which of `graph.ladders` a passage whose frames are on `on` (n, L) climbs: the one most
+    of them are on, then the one whose ends' heights lie nearest `before` and `after` (climbing
+    up or down)."""
     low = graph.positions[graph.edge_source[graph.ladders], 2]
     high = graph.positions[graph.edge_target[graph.ladders], 2]
     mismatch = np.minimum(
         abs(before - low) + abs(after - high), abs(before - high) + abs(after - low)
     )
     missed = len(on) - on.sum(axis=0)
-    return int(graph.ladders[np.lexsort((mismatch, missed))[0]])
+    return int(np.lexsort((mismatch, missed))[0])
 
 
 def _height(pos: np.ndarray, frame: int, otherwise: float) -> float:
