@@ -166,7 +166,6 @@ def test_evaluate_the_paper_models(data: Path, tmp_path: Path) -> None:
     [
         (["train", "dip", "{missing}"], "error: {missing}: no such file or folder"),
         (["train", "dip", "{data}"], "error: a split by match needs at least 3 matches"),
-        (["train", "dog", "{data}", "--mode", "movie"], "error: mode must be one of"),
         (["train", "dip", "{data}", "--split", "round", "--balance", "x"], "error: balance"),
         (["train", "dip", "{data}", "--epochs", "0"], "error: epochs must be at least 1"),
         (["train", "dog", "{data}", "--kl-weight", "-1"], "error: the KL weight must not"),
@@ -186,6 +185,30 @@ def test_bad_input_is_one_line(args: list[str], expected: str, data: Path, tmp_p
     assert result.exit_code == 1, result.output
     assert result.stderr.startswith(expected.format(**names))
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["train", "dip"],
+        ["train", "dog"],
+        ["models", "evaluate", "rules"],
+        ["models", "calibrate", "m"],
+    ],
+)
+@pytest.mark.parametrize(("option", "value"), [("--mode", "movie"), ("--split", "player")])
+def test_the_sample_options_are_one_group_with_choices(
+    command: list[str], option: str, value: str, data: Path
+) -> None:
+    """Every command that reads and splits samples takes the same group of options, with
+    their choices listed in its help and a bad choice refused in one usage line."""
+    argv = [*command, str(data), option, value]
+    result = runner.invoke(app, argv, env=WIDE)
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.output
+    assert f"Invalid value for '{option}'" in result.stderr
+    shown = runner.invoke(app, [*command[:2], "--help"], env=WIDE).output
+    for text in ("--mode", "auto|frames|events", "--split", "match|round", "--val-fraction"):
+        assert text in shown
 
 
 def test_a_corrupt_file_is_reported_and_training_goes_on(data: Path, tmp_path: Path) -> None:

@@ -1,16 +1,22 @@
-"""Options shared by several commands: the mover and the damage models (one definition each),
-and the help of the maps, who decides deaths and what to do with the fields the data lacks
-(the mover, deaths, missing fields and implausible data are `Literal` types, which Typer
-lists)."""
+"""Options shared by several commands, each defined once: how a round runs (`RunOptions`, the
+group `decoy replay` and `decoy evaluate` share), the mover and the damage models for the other
+commands, and the help of the maps (the mover, deaths, missing fields and implausible data are
+`Literal` types, which Typer lists)."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated
 
 import typer
 
 from decoy_cli.csgo import MAP_NAMES
-from decoy_cli.damage import CHOICES_HELP
+from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.damage.choice import MODELS_METAVAR, ModelName
 from decoy_cli.esta.plausibility import Implausible
+from decoy_cli.replay.deaths import DeathProtocol
+from decoy_cli.replay.missing import Missing
 from decoy_cli.sim.setup import MoverName
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
@@ -48,11 +54,6 @@ def mover_option(default: MoverName) -> MoverName:
     return typer.Option(default, "--mover", help=f"The mover: {MOVER_HELP}.")
 
 
-def implausible_option() -> Implausible:
-    """The `--implausible` option (Typer's parameter default): fail unless told."""
-    return typer.Option("fail", "--implausible", help=IMPLAUSIBLE_HELP)
-
-
 MODELS_HELP = f"The damage models when shooting: {CHOICES_HELP}."
 
 
@@ -60,3 +61,41 @@ def models_option(default: ModelName) -> str:
     """The `--models` option (Typer's parameter default), `default` unless told: its text, which
     the command parses once (`decoy_cli.damage.parse_models`)."""
     return typer.Option(default.value, "--models", metavar=MODELS_METAVAR, help=MODELS_HELP)
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How `decoy replay` and `decoy evaluate` run a round: shooting and its models, the bomb,
+    the mover, who decides deaths, what to do with missing fields and implausible data, the
+    geometry of sight, and the seed."""
+
+    combat: Annotated[
+        bool,
+        typer.Option(
+            "--combat/--no-combat",
+            help="Shooting, with the damage models of --models; without it deaths are scripted "
+            "from the data. The paper's movement-only Table 2 is --no-combat --no-bomb.",
+        ),
+    ] = True
+    bomb: Annotated[
+        bool,
+        typer.Option("--bomb/--no-bomb", help="Bomb rules: carrier, plant, defuse, detonation."),
+    ] = True
+    models: Annotated[str, typer.Option("--models", metavar=MODELS_METAVAR, help=MODELS_HELP)] = (
+        DEFAULT_MODELS.value
+    )
+    mover: Annotated[MoverName, typer.Option("--mover", help=f"The mover: {MOVER_HELP}.")] = (
+        "kinematic"
+    )
+    deaths: Annotated[DeathProtocol, typer.Option("--deaths", help=DEATHS_HELP)] = "simulated"
+    missing: Annotated[Missing, typer.Option("--missing-fields", help=MISSING_HELP)] = "infer"
+    implausible: Annotated[Implausible, typer.Option("--implausible", help=IMPLAUSIBLE_HELP)] = (
+        "fail"
+    )
+    sight_mesh: Annotated[Path | None, typer.Option("--sight-mesh", help=SIGHT_MESH_HELP)] = None
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed", help="Seed of the simulator's random numbers (and of evaluate's --sample)."
+        ),
+    ] = 0

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated, Literal
 
 import numpy as np
 import typer
@@ -12,6 +14,7 @@ from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedCo
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import MAPS_HELP
 from decoy_cli.errors import GraphError
 from decoy_cli.esta import collect_match_files
@@ -26,6 +29,7 @@ from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_al
 from decoy_cli.world import patch_learning
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
+from decoy_cli.world.world import World
 
 DEFAULT_OUT = Path("decoy-out") / "waypoints"
 
@@ -40,19 +44,45 @@ def _parse_point(text: str, option: str) -> list[float]:
     return values
 
 
+@dataclass(frozen=True)
+class UserMesh:
+    """A user's mesh to build on instead of the built-in nav world, and how to read it."""
+
+    mesh: Annotated[
+        Path | None,
+        typer.Option(
+            "--mesh", help="A user mesh (.obj or awpy .tri) instead of the built-in nav world."
+        ),
+    ] = None
+    units: Annotated[Literal["hammer", "m"], typer.Option("--units", help="Mesh units.")] = "hammer"
+    scale: Annotated[
+        float | None, typer.Option("--scale", help="Metres per mesh unit (overrides --units).")
+    ] = None
+    up_axis: Annotated[
+        str, typer.Option("--up-axis", help="Mesh axis that points up: z, y, -y, ...")
+    ] = "z"
+    offset: Annotated[
+        str, typer.Option("--offset", help="Added to the mesh after scaling (m).")
+    ] = "0,0,0"
+
+    def read(self) -> World:
+        """The mesh as a world in metres, refused when larger than a map."""
+        if self.mesh is None:
+            raise GraphError("no --mesh to read")
+        offset = _parse_point(self.offset, "--offset")
+        world = read_mesh(
+            self.mesh, units=self.units, scale=self.scale, up_axis=self.up_axis, offset=offset
+        )
+        check_extent(world)
+        return world
+
+
+@with_groups
 def build_waypoints(
     map_name: str = typer.Option(
         "dust2", "--map", help=f"Map whose places and spawns to use: {MAPS_HELP}."
     ),
-    mesh: Path | None = typer.Option(
-        None, "--mesh", help="A user mesh (.obj or awpy .tri) instead of the built-in nav world."
-    ),
-    units: str = typer.Option("hammer", "--units", help="Mesh units: hammer or m."),
-    scale: float | None = typer.Option(
-        None, "--scale", help="Metres per mesh unit (overrides --units)."
-    ),
-    up_axis: str = typer.Option("z", "--up-axis", help="Mesh axis that points up: z, y, -y, ..."),
-    offset: str = typer.Option("0,0,0", "--offset", help="Added to the mesh after scaling (m)."),
+    user_mesh: UserMesh = UserMesh(),
     spacing: float = typer.Option(0.7, "--spacing", help="Lattice spacing in metres.", min=0.2),
     wall_nodes: bool = typer.Option(
         True,
@@ -99,17 +129,14 @@ def build_waypoints(
     """Build a waypoint graph: BFS lattice, drop pass, verification, pruning, manual points."""
     console = make_console()
     map_id = canonical_map(map_name)
-    if learn_patches is not None and mesh is not None:
+    if learn_patches is not None and user_mesh.mesh is not None:
         raise GraphError("--learn-patches learns on the built-in nav world; leave out --mesh")
-    if mesh is None:
+    if user_mesh.mesh is None:
         world = nav_world(map_id)
         name = map_id
     else:
-        world = read_mesh(
-            mesh, units=units, scale=scale, up_axis=up_axis, offset=_parse_point(offset, "--offset")
-        )
-        check_extent(world)
-        name = mesh.name.split(".")[0]
+        world = user_mesh.read()
+        name = user_mesh.mesh.name.split(".")[0]
     seed_points = np.array([_parse_point(s, "--seed") for s in seeds]) if seeds else None
     manual_points = read_manual_waypoints(manual) if manual is not None else None
     out = out or DEFAULT_OUT / f"{name}.npz"
@@ -205,7 +232,7 @@ def build_waypoints(
     console.print(table)
     regions = ", ".join(f"{name} {len(nodes):,}" for name, nodes in graph.regions.items())
     console.print(f"region waypoints: {regions}", highlight=False)
-    if mesh is None:
+    if user_mesh.mesh is None:
         _show_coverage(console, nav_coverage(graph, load_navmesh(map_id)))
     console.print(f"graph written to {out}")
     if plot:

@@ -23,20 +23,15 @@ from rich.text import Text
 
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import (
-    DEATHS_HELP,
     MAPS_HELP,
-    MISSING_HELP,
-    SIGHT_MESH_HELP,
-    implausible_option,
-    models_option,
-    mover_option,
+    RunOptions,
 )
-from decoy_cli.damage import DEFAULT_MODELS, parse_models
+from decoy_cli.damage import parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
-from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
 from decoy_cli.evaluate.markdown import interval, num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
@@ -59,9 +54,6 @@ from decoy_cli.evaluate.runner import (
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
-from decoy_cli.replay.deaths import DeathProtocol
-from decoy_cli.replay.missing import Missing
-from decoy_cli.sim.setup import MoverName
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -69,6 +61,7 @@ if TYPE_CHECKING:
 DEFAULT_OUT = Path("decoy-out") / "evaluate"
 
 
+@with_groups
 def evaluate(
     inputs: list[Path] = typer.Argument(
         None,
@@ -88,24 +81,10 @@ def evaluate(
         help="Waypoint graph (.npz from build-waypoints, e.g. with --learn-patches) to replay "
         "on, with the world it was built on; its map must be --map. Default: the shipped one.",
     ),
-    sight_mesh: Path | None = typer.Option(None, "--sight-mesh", help=SIGHT_MESH_HELP),
     sample: int | None = typer.Option(
         None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
     ),
-    seed: int = typer.Option(0, "--seed", help="Seed of the sample and of the simulator."),
-    combat: bool = typer.Option(
-        True,
-        "--combat/--no-combat",
-        help="Shooting, with the damage model of --models; without it deaths are scripted "
-        "from the data. The paper's movement-only Table 2 is --no-combat --no-bomb.",
-    ),
-    bomb: bool = typer.Option(
-        True, "--bomb/--no-bomb", help="Bomb rules: carrier, plant, defuse, detonation."
-    ),
-    models: str = models_option(DEFAULT_MODELS),
-    mover: MoverName = mover_option("kinematic"),
-    deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
-    missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
+    run_options: RunOptions = RunOptions(),
     out: Path = typer.Option(
         DEFAULT_OUT,
         "--out",
@@ -128,7 +107,6 @@ def evaluate(
         "on for the paper's Table 2 setting (--no-combat --no-bomb), off otherwise. Part of "
         "the cache key: switching it replays the rounds again.",
     ),
-    implausible: Implausible = implausible_option(),
     workers: int | None = typer.Option(
         None,
         "--workers",
@@ -161,19 +139,20 @@ def evaluate(
     console = make_console()
     inputs = inputs or default_inputs()
     collect_match_files(inputs)  # bad paths fail here, before a damage model is loaded
+    given = run_options
     settings = make_settings(
         map_name=map_name,
-        combat=combat,
-        bomb=bomb,
-        models=parse_models(models),
-        mover=mover,
-        seed=seed,
-        implausible=implausible,
-        deaths=deaths,
-        missing=missing,
+        combat=given.combat,
+        bomb=given.bomb,
+        models=parse_models(given.models),
+        mover=given.mover,
+        seed=given.seed,
+        implausible=given.implausible,
+        deaths=given.deaths,
+        missing=given.missing,
         fastdtw=fastdtw,
         graph=graph,
-        sight_mesh=sight_mesh,
+        sight_mesh=given.sight_mesh,
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend

@@ -14,12 +14,7 @@ from decoy_cli.commands._damage_output import (
     DATA_HELP,
     DRAWS_HELP,
     MIN_CELL_HELP,
-    MODE_HELP,
-    SEED_HELP,
-    SPLIT_HELP,
-    TEST_HELP,
-    VAL_HELP,
-    WINDOW_HELP,
+    SampleOptions,
     cells_table,
     dip_table,
     dog_table,
@@ -27,20 +22,13 @@ from decoy_cli.commands._damage_output import (
     print_samples,
     progress_bars,
 )
+from decoy_cli.commands._groups import with_groups
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
 from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
-from decoy_cli.damage.provenance import SampleChoice
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S
 from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import (
-    DEFAULT_SEED,
-    DEFAULT_SPLIT,
-    DEFAULT_TEST_FRACTION,
-    DEFAULT_VAL_FRACTION,
-)
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 
@@ -157,6 +145,7 @@ def fit_rules_command(
 
 
 @app.command("calibrate")
+@with_groups
 def calibrate(
     model_folder: Path = typer.Argument(..., help="A model folder with dip.pt/json."),
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
@@ -169,12 +158,7 @@ def calibrate(
         help="How the combat step decides a hit from the calibrated probability: threshold "
         "(the paper's rule) or bernoulli (a hit with that probability).",
     ),
-    split: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
-    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
-    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
-    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
-    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+    samples: SampleOptions = SampleOptions(),
 ) -> None:
     """Calibrate a folder's DIP on the validation part of the split (Platt or temperature
     scaling) and write dip_calibration.json into the folder; prints the Brier score and the
@@ -190,15 +174,7 @@ def calibrate(
         )
     if (model_folder / "dip.json").is_file():
         check_folder_writable(model_folder)
-    choice = SampleChoice(
-        data=data,
-        mode=mode,
-        window_s=window,
-        split_by=split,
-        seed=seed,
-        val_fraction=val_fraction,
-        test_fraction=test_fraction,
-    )
+    choice = samples.choice(data)
     bars, on_file, _ = progress_bars()
     with bars:
         result = calibrate_dip_folder(
@@ -231,6 +207,7 @@ def calibrate(
 
 
 @app.command("evaluate")
+@with_groups
 def evaluate(
     models: str = typer.Argument(
         ..., metavar=MODELS_METAVAR, help=f"The models to score: {CHOICES_HELP}."
@@ -245,12 +222,7 @@ def evaluate(
         help="Samples to evaluate on: all, or the train, val or test part of the split below "
         "(the same options as training give the same parts).",
     ),
-    split: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
-    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
-    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
-    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
-    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+    samples: SampleOptions = SampleOptions(),
     balanced: bool = typer.Option(BALANCED, "--balance/--no-balance", help=BALANCE_HELP),
     threshold: float | None = typer.Option(
         None, "--threshold", help="DIP decision threshold (default: the model's own)."
@@ -266,15 +238,7 @@ def evaluate(
     figures: ROC and precision-recall curves, reconstructed vs real damage, the error
     histogram, the hit-group confusion matrix, generated vs real damage per weapon and hit
     group. Exits non-zero, after writing them, when a file or round failed."""
-    choice = SampleChoice(
-        data=data,
-        mode=mode,
-        window_s=window,
-        split_by=split,
-        seed=seed,
-        val_fraction=val_fraction,
-        test_fraction=test_fraction,
-    )
+    choice = samples.choice(data)
     check_folder_writable(out)  # before minutes of reading and sampling
     bars, on_file, _ = progress_bars()
     with bars:

@@ -10,34 +10,23 @@ from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import (
-    DEATHS_HELP,
     MAPS_HELP,
-    MISSING_HELP,
-    SIGHT_MESH_HELP,
-    implausible_option,
-    models_option,
-    mover_option,
+    RunOptions,
 )
-from decoy_cli.damage import DEFAULT_MODELS, load_damage_model, parse_models
+from decoy_cli.damage import load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
-from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.bomb_fidelity import BombRow
-from decoy_cli.replay.deaths import DeathProtocol
-from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
-from decoy_cli.sim.setup import MoverName
 
 
+@with_groups
 def replay(
     address: str = typer.Argument(..., metavar="FILE:ROUND", help="The round, e.g. m.json.xz:3."),
-    combat: bool = typer.Option(
-        True, "--combat/--no-combat", help="Shooting, with the damage models of --models."
-    ),
-    bomb: bool = typer.Option(True, "--bomb/--no-bomb", help="Bomb rules (plant, defuse, ...)."),
-    mover: MoverName = mover_option("kinematic"),
+    run_options: RunOptions = RunOptions(),
     map_name: str | None = typer.Option(
         None,
         "--map",
@@ -48,38 +37,33 @@ def replay(
         "--graph",
         help="Waypoint graph (.npz from build-waypoints; default: the built-in one of the map).",
     ),
-    sight_mesh: Path | None = typer.Option(None, "--sight-mesh", help=SIGHT_MESH_HELP),
     out: Path | None = typer.Option(
         None,
         "--out",
         help="Output folder (default decoy-out/replay/<file name>-<content hash>_r<round>).",
     ),
     gif: bool = typer.Option(False, "--gif", help="Also write an animated GIF of the round."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the simulator's random numbers."),
-    models: str = models_option(DEFAULT_MODELS),
-    implausible: Implausible = implausible_option(),
-    deaths: DeathProtocol = typer.Option("simulated", "--deaths", help=DEATHS_HELP),
-    missing: Missing = typer.Option("infer", "--missing-fields", help=MISSING_HELP),
 ) -> None:
     """Replay a real round: snap, plan, simulate at 60 Hz, and compare with the data (with
     --models none, deaths in the data are scripted)."""
     console = make_console()
-    choice = parse_models(models)
-    damage_model = load_damage_model(choice) if combat else None
-    if combat and damage_model is None:
+    given = run_options
+    choice = parse_models(given.models)
+    damage_model = load_damage_model(choice) if given.combat else None
+    if given.combat and damage_model is None:
         console.print(
             "--models none: replaying without shooting (deaths in the data are scripted)",
             style="yellow",
         )
     options = ReplayOptions(
         combat=damage_model is not None,
-        bomb=bomb,
-        mover=mover,
+        bomb=given.bomb,
+        mover=given.mover,
         damage_model=damage_model,
-        seed=seed,
-        deaths=deaths,
-        missing=missing,
-        implausible=implausible,
+        seed=given.seed,
+        deaths=given.deaths,
+        missing=given.missing,
+        implausible=given.implausible,
     )
     run = replay_address(
         address,
@@ -89,7 +73,7 @@ def replay(
         graph_file=graph_file,
         out=out,
         gif=gif,
-        sight_mesh=sight_mesh,
+        sight_mesh=given.sight_mesh,
     )
     round_, result, players = run.round_, run.result, run.players
     real = (round_.winning_side, round_.end_reason)
@@ -98,7 +82,7 @@ def replay(
         f"round {round_.round_num} of {round_.match_id}: {round_.num_frames} frames "
         f"({run.summary['frame_rate']}) replayed in "
         f"{run.seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
-        f"bomb {'on' if bomb else 'off'})"
+        f"bomb {'on' if options.bomb else 'off'})"
     )
     outcome = Table(title="outcome")
     outcome.add_column("")

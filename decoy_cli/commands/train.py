@@ -7,8 +7,9 @@ model folder and the report) and prints what it gave.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import typer
 from rich.console import Console
@@ -18,28 +19,17 @@ from decoy_cli.commands._damage_output import (
     DATA_HELP,
     DRAWS_HELP,
     MIN_CELL_HELP,
-    MODE_HELP,
-    SEED_HELP,
-    SPLIT_HELP,
-    TEST_HELP,
-    VAL_HELP,
-    WINDOW_HELP,
+    SampleOptions,
     cells_table,
     dip_table,
     dog_table,
     print_samples,
     progress_bars,
 )
+from decoy_cli.commands._groups import with_groups
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import SampleChoice
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S
 from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import (
-    DEFAULT_SEED,
-    DEFAULT_SPLIT,
-    DEFAULT_TEST_FRACTION,
-    DEFAULT_VAL_FRACTION,
-)
 from decoy_cli.damage.train_options import (
     BATCH_SIZE,
     DAMAGE_WEIGHT,
@@ -66,9 +56,44 @@ app = typer.Typer(
 )
 
 REPORT_HELP = "Folder for metrics, history and figures (default OUT/report)."
-PATIENCE_HELP = "Stop after this many epochs without a better validation loss."
-XAVIER_HELP = "Xavier-uniform initial weights (the paper's)."
-THREADS_HELP = "torch threads (1 is fastest for these small networks)."
+
+
+@dataclass(frozen=True)
+class Fitting:
+    """How both networks are fitted, but for the number of epochs (the paper's differ)."""
+
+    batch_size: Annotated[int, typer.Option("--batch-size", help="Mini-batch size (paper's).")] = (
+        BATCH_SIZE
+    )
+    learning_rate: Annotated[float, typer.Option("--lr", help="Adam learning rate (paper's).")] = (
+        LEARNING_RATE
+    )
+    patience: Annotated[
+        int,
+        typer.Option(
+            "--patience", help="Stop after this many epochs without a better validation loss."
+        ),
+    ] = PATIENCE
+    xavier: Annotated[
+        bool,
+        typer.Option("--xavier/--no-xavier", help="Xavier-uniform initial weights (the paper's)."),
+    ] = XAVIER
+    threads: Annotated[
+        int,
+        typer.Option("--threads", help="torch threads (1 is fastest for these small networks)."),
+    ] = THREADS
+
+    def options(self, epochs: int, seed: int) -> TrainOptions:
+        """The library's training options: these, `epochs` and `seed`."""
+        return TrainOptions(
+            epochs=epochs,
+            batch_size=self.batch_size,
+            learning_rate=self.learning_rate,
+            patience=self.patience,
+            seed=seed,
+            xavier=self.xavier,
+            threads=self.threads,
+        )
 
 
 def _print_start(console: Console, result: TrainingResult, choice: SampleChoice) -> None:
@@ -81,30 +106,20 @@ def _print_start(console: Console, result: TrainingResult, choice: SampleChoice)
 
 
 @app.command("dip")
+@with_groups
 def dip(
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="Model folder to write dip.pt/json in."),
     report: Path | None = typer.Option(None, "--report", help=REPORT_HELP),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
     epochs: int = typer.Option(DIP_EPOCHS, "--epochs", help="Most epochs (the paper's)."),
-    batch_size: int = typer.Option(BATCH_SIZE, "--batch-size", help="Mini-batch size (paper's)."),
-    learning_rate: float = typer.Option(
-        LEARNING_RATE, "--lr", help="Adam learning rate (paper's)."
-    ),
-    patience: int = typer.Option(PATIENCE, "--patience", help=PATIENCE_HELP),
-    split_by: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
-    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
-    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
-    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
-    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+    fitting: Fitting = Fitting(),
+    samples: SampleOptions = SampleOptions(),
     balanced: str = typer.Option(
         DEFAULT_BALANCE,
         "--balance",
         help="1:1 balancing of positives and negatives: all parts (the paper's), eval (train "
         "on every sample, balance validation and test) or none.",
     ),
-    xavier: bool = typer.Option(XAVIER, "--xavier/--no-xavier", help=XAVIER_HELP),
-    threads: int = typer.Option(THREADS, "--threads", help=THREADS_HELP),
     units: Literal["normalised", "relative"] = typer.Option(
         "normalised",
         "--units",
@@ -117,24 +132,8 @@ def dip(
 
     Binary cross-entropy with early stopping on the validation part; the decision threshold is
     the best F1 on the validation part; test metrics are printed and saved with the model."""
-    options = TrainOptions(
-        epochs=epochs,
-        batch_size=batch_size,
-        learning_rate=learning_rate,
-        patience=patience,
-        seed=seed,
-        xavier=xavier,
-        threads=threads,
-    )
-    choice = SampleChoice(
-        data=data,
-        mode=mode,
-        window_s=window,
-        split_by=split_by,
-        seed=seed,
-        val_fraction=val_fraction,
-        test_fraction=test_fraction,
-    )
+    options = fitting.options(epochs, samples.seed)
+    choice = samples.choice(data)
     _check_outputs(out, report)
     bars, on_file, on_step = progress_bars()
     with bars:
@@ -160,22 +159,14 @@ def dip(
 
 
 @app.command("dog")
+@with_groups
 def dog(
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
     out: Path = typer.Option(DEFAULT_OUT, "--out", help="Model folder to write dog.pt/json in."),
     report: Path | None = typer.Option(None, "--report", help=REPORT_HELP),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help=SEED_HELP),
     epochs: int = typer.Option(DOG_EPOCHS, "--epochs", help="Most epochs (the paper's)."),
-    batch_size: int = typer.Option(BATCH_SIZE, "--batch-size", help="Mini-batch size (paper's)."),
-    learning_rate: float = typer.Option(
-        LEARNING_RATE, "--lr", help="Adam learning rate (paper's)."
-    ),
-    patience: int = typer.Option(PATIENCE, "--patience", help=PATIENCE_HELP),
-    split_by: str = typer.Option(DEFAULT_SPLIT, "--split", help=SPLIT_HELP),
-    val_fraction: float = typer.Option(DEFAULT_VAL_FRACTION, "--val-fraction", help=VAL_HELP),
-    test_fraction: float = typer.Option(DEFAULT_TEST_FRACTION, "--test-fraction", help=TEST_HELP),
-    mode: str = typer.Option(DEFAULT_MODE, "--mode", help=MODE_HELP),
-    window: float = typer.Option(DEFAULT_WINDOW_S, "--window", help=WINDOW_HELP),
+    fitting: Fitting = Fitting(),
+    samples: SampleOptions = SampleOptions(),
     damage_weight: float = typer.Option(
         DAMAGE_WEIGHT, "--damage-weight", help="Weight of the damage MSE in the loss."
     ),
@@ -185,32 +176,14 @@ def dog(
     kl_weight: float = typer.Option(KL_WEIGHT, "--kl-weight", help="Weight of the KL term."),
     draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
     min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),
-    xavier: bool = typer.Option(XAVIER, "--xavier/--no-xavier", help=XAVIER_HELP),
-    threads: int = typer.Option(THREADS, "--threads", help=THREADS_HELP),
 ) -> None:
     """Train DOG, the Damage Outcome Generator (how much damage, which hit group).
 
     A conditional VAE trained on the damaging samples with early stopping on the validation
     part; test metrics are printed and saved with the model."""
     weights = DogLossWeights(damage=damage_weight, hit_group=hit_group_weight, kl=kl_weight)
-    options = TrainOptions(
-        epochs=epochs,
-        batch_size=batch_size,
-        learning_rate=learning_rate,
-        patience=patience,
-        seed=seed,
-        xavier=xavier,
-        threads=threads,
-    )
-    choice = SampleChoice(
-        data=data,
-        mode=mode,
-        window_s=window,
-        split_by=split_by,
-        seed=seed,
-        val_fraction=val_fraction,
-        test_fraction=test_fraction,
-    )
+    options = fitting.options(epochs, samples.seed)
+    choice = samples.choice(data)
     _check_outputs(out, report)
     bars, on_file, on_step = progress_bars()
     with bars:

@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Literal, get_args
 
 from decoy_cli.damage.events_mode import event_samples
 from decoy_cli.damage.frames_mode import frame_samples, has_both_teams
@@ -41,8 +42,10 @@ from decoy_cli.damage.split import (
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
 
-MODES = ("auto", "frames", "events")
-DEFAULT_MODE = "auto"
+SampleMode = Literal["auto", "frames", "events"]
+"""How rounds become samples (`build_samples`)."""
+MODES: tuple[SampleMode, ...] = get_args(SampleMode)
+DEFAULT_MODE: SampleMode = "auto"
 
 DEFAULT_WINDOW_S = 2.0
 """Events-only mode: how far (seconds) an event row places a player, and how long an attacker

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 
 from decoy_cli.damage.sample_set import Samples
 from decoy_cli.errors import DecoyError
 
-SPLITS = ("match", "round")
-DEFAULT_SPLIT = "match"
+SplitUnit = Literal["match", "round"]
+"""What a split never cuts in two."""
+SPLITS: tuple[SplitUnit, ...] = get_args(SplitUnit)
+DEFAULT_SPLIT: SplitUnit = "match"
 DEFAULT_SEED = 0
 """The seed of the split, the balancing and (training) the weights and shuffling."""
 DEFAULT_VAL_FRACTION = 0.15
