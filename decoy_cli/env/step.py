@@ -322,14 +322,15 @@ def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
     `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
     where the step ends and its state is written as `_finish` writes it. After a glide a
-    carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended, the bad or
+    carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended (a
+    `StepEnd` value as a plain int: an enum costs a Python call per step to return), the bad or
     untaken agent (else -1), the tick reached and the decisions made."""
     if hand_in:
         bad = _hand_in(e, chosen)
         if bad >= 0:
-            return StepEnd.BAD_ACTION, bad, tick, 0
+            return StepEnd.BAD_ACTION.value, bad, tick, 0
         if _hands_back(e, chosen, watch):
-            return StepEnd.LEFT_TO_RUN, -1, tick, 0
+            return StepEnd.LEFT_TO_RUN.value, -1, tick, 0
     r = e.round
     c = (e.given, e.draws, e.plant, e.defuse, e.top, e.hold_ticks)
     reached, _, made, _, glide_end, status = _play(r, c, tick, horizon, 0, NEVER, watch)
@@ -337,13 +338,13 @@ def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
         bomb_pos[:] = r.pos[carrier]
     if status == StretchEnd.AIRBORNE:
-        return StepEnd.IN_THE_AIR, -1, reached, made
+        return StepEnd.IN_THE_AIR.value, -1, reached, made
     if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played
-        return StepEnd.HALF_PLAYED, -1, reached, made
+        return StepEnd.HALF_PLAYED.value, -1, reached, made
     # (an agent due with no action: Python says whom)
     if status != StretchEnd.DUE or reached == tick:
-        return StepEnd.LEFT_TO_RUN, -1, reached, made
+        return StepEnd.LEFT_TO_RUN.value, -1, reached, made
     unused = _finish(e, -1, bomb, False, reached, out)
     if unused >= 0:
-        return StepEnd.NOT_TAKEN, unused, reached, made
-    return StepEnd.PLAYED, -1, reached, made
+        return StepEnd.NOT_TAKEN.value, unused, reached, made
+    return StepEnd.PLAYED.value, -1, reached, made
