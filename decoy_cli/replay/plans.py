@@ -61,6 +61,14 @@ class PathCache:
     def __init__(self, graph: WaypointGraph) -> None:
         self.graph = graph
         self._paths: dict[tuple[int, int], np.ndarray | None] = {}
+        ladders = np.flatnonzero(graph.edge_kind == EdgeKind.LADDER)
+        ends = graph.edge_source[ladders], graph.edge_target[ladders]
+        cheapest = graph.edges_between(*ends)
+        self._ladders = {  # the ends of a ladder, where the cheapest edge between them is it
+            (int(a), int(b)): np.array([edge])
+            for a, b, edge in zip(*ends, cheapest, strict=True)
+            if graph.edge_kind[edge] == EdgeKind.LADDER
+        }
 
     def __len__(self) -> int:
         """Number of (source, target) pairs computed so far."""
@@ -77,9 +85,9 @@ class PathCache:
         return self._paths[key]
 
     def _compute(self, source: int, target: int) -> np.ndarray | None:
-        ladder = self.graph.edges_between(np.array([source]), np.array([target]))
-        if ladder[0] >= 0 and self.graph.edge_kind[ladder[0]] == EdgeKind.LADDER:
-            return ladder  # from one end to the other: on it
+        ladder = self._ladders.get((source, target))
+        if ladder is not None:
+            return ladder.copy()  # from one end to the other: on it
         try:
             nodes = np.asarray(self.graph.shortest_path(source, target), dtype=np.int64)
         except GraphError:
