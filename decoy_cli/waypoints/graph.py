@@ -360,8 +360,9 @@ class WaypointGraph:
         if source == target:
             return [int(source)]
         straight = float(np.linalg.norm(self.positions[target] - self.positions[source]))
-        # A bounded search first (most calls join nearby waypoints), then an unbounded one.
-        for limit in (4.0 * straight + 5.0, np.inf):
+        # Bounded searches first (most calls join nearby waypoints along a nearly straight
+        # path), then an unbounded one.
+        for limit in (1.5 * straight + 2.0, 4.0 * straight + 5.0, np.inf):
             dist, pred = dijkstra(
                 self.adjacency,
                 directed=True,
