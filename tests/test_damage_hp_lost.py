@@ -162,12 +162,12 @@ def test_a_model_used_on_other_maps_warns_naming_them(tmp_path: Path) -> None:
     silent = folder_with(tmp_path / "b", None)
     assert all("does not say which maps" in line for line in map_warnings(str(silent), ["x"]))
     assert map_warnings("none", ["de_ancient"]) == []
-    # the shipped folder: DIP and DOG of de_dust2, rules of de_ancient and de_dust2; off
-    # de_dust2 the map-independent DIP decides hits (tests/test_damage_map_dip.py)
+    # the shipped folder: DIP and rules of de_ancient and de_dust2, DOG of de_dust2
     assert trained_maps(ROOT / "models", "rules") == ["de_ancient", "de_dust2"]
-    (rules_line,) = map_warnings("rules", ["de_ancient"])
-    assert rules_line.startswith("hits on de_ancient are decided by the map-independent DIP")
-    assert len(map_warnings("shipped", ["de_ancient"])) == 2
+    assert trained_maps(ROOT / "models", "dip") == ["de_ancient", "de_dust2"]
+    assert map_warnings("rules", ["de_ancient"]) == []
+    (dog_line,) = map_warnings("shipped", ["de_ancient"])
+    assert "DOG" in dog_line and "not on de_ancient" in dog_line
 
 
 @pytest.mark.skipif(not ANCIENT.is_dir(), reason="needs ../shared/data/events_ancient")
@@ -180,16 +180,14 @@ def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
     )
     assert result.exit_code == 0, result.output
     assert "no hit group (scored on HP lost, over all hit groups)" in result.output
-    assert "hits on de_ancient are decided by the map-independent DIP" in result.output
+    assert "warning" not in result.output  # the shipped DIP and rules know de_ancient
     report = json.loads((out / "metrics.json").read_text())
     assert report["damage_by"] == "rules" and set(report["hp_lost"]) == {"step", "hit"}
     step = report["hp_lost"]["step"]["de_ancient"]
     assert step["steps"] == report["dip"]["positives"]  # every damaging step scored
     assert report["dip_by_map"]["de_ancient"]["positives"] == step["steps"]
-    assert report["dip_of_map"] == {
-        "de_ancient": "the map-independent DIP of the shipped models (any_map)"
-    }
-    assert "DIP on de_ancient (the map-independent DIP of the shipped" in result.output
+    assert report["dip_of_map"] == {"de_ancient": "the DIP of the shipped models"}
+    assert "DIP on de_ancient (the DIP of the shipped models" in result.output
     assert 0 < step["mean_floor_hp"] < step["mean_wasserstein_hp"]
 
 
@@ -315,11 +313,13 @@ def test_the_evaluation_report_names_who_decides_hits_and_damage() -> None:
         **common,
     )  # fmt: skip
     lines = model_lines(ancient)
-    assert lines["hits decided by"] == "the map-independent DIP of the shipped models (any_map)"
+    assert lines["hits decided by"] == "the DIP of the shipped models"
     assert lines["damage decided by"].startswith("the game's damage rules")
-    assert "hits on de_ancient are decided by the map-independent DIP" in lines["model warnings"]
-    dust2 = dataclasses.replace(ancient, map_name="de_dust2", grid=HeatGrid.for_map("de_dust2"))
-    assert model_lines(dust2)["hits decided by"] == "the DIP of the shipped models"
+    assert "model warnings" not in lines  # trained on de_ancient and de_dust2
+    nuke = dataclasses.replace(ancient, map_name="de_nuke", grid=HeatGrid.for_map("de_nuke"))
+    warned = model_lines(nuke)["model warnings"]
+    assert "the DIP (who hits) of --models rules was trained on de_ancient, de_dust2 only" in warned
+    assert model_lines(nuke)["hits decided by"] == "the DIP of the shipped models"
     off = dataclasses.replace(ancient, combat=False, models="none", models_fingerprint="")
     assert model_lines(off) == {
         "hits decided by": "none (no shooting)",

@@ -35,8 +35,6 @@ REQUIRED = (
     "decoy_cli/models/dog.pt",
     "decoy_cli/models/dog.json",
     "decoy_cli/models/DOG_CARD.md",
-    "decoy_cli/models/any_map/dip.pt",
-    "decoy_cli/models/any_map/dip.json",
     "decoy_cli/cli.py",
     "decoy_cli/view/page.html",
     "decoy_cli/view/page.js",

@@ -9,14 +9,16 @@ import pybullet
 import pytest
 from worlds import box, floor, wall
 
-from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M
+from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M, TICK_RATE
 from decoy_cli.sim.combat import (
     HIT_GROUPS,
+    REACTION_S,
     CombatBatch,
     CombatStep,
     DamageResult,
     LineOfSight,
     VisiblePairs,
+    aimed_yaw,
     apply_damage,
     make_batch,
 )
@@ -483,3 +485,59 @@ def test_armour_goes_down_by_the_result_and_stays_at_or_above_zero() -> None:
         DamageResult(np.array([5]), np.array([2]), np.array([True]), np.array([-1]))
     with pytest.raises(ValueError, match="armor_damage"):
         DamageResult(np.array([0]), np.array([-1]), np.array([False]), np.array([3]))
+
+
+# ---- aim ---------------------------------------------------------------------------------------
+
+
+class Bearings:
+    """A model that hits nobody and keeps each step's bearings, by (attacker, victim)."""
+
+    def __init__(self) -> None:
+        self.steps: list[dict[tuple[int, int], float]] = []
+
+    def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
+        pairs = zip(batch.attacker.tolist(), batch.victim.tolist(), strict=True)
+        self.steps.append(dict(zip(pairs, np.degrees(batch.bearing).tolist(), strict=True)))
+        k = len(batch)
+        return DamageResult(np.zeros(k, np.int64), np.full(k, -1), np.zeros(k, bool))
+
+
+def test_an_agent_aims_at_an_enemy_in_sight_for_a_reaction_time(physics: PhysicsWorld) -> None:
+    """At first sight both look where they were going; an enemy still in sight a reaction time
+    later is aimed at, the nearest where several are; out of sight, the aim starts again."""
+    agents = _agents(
+        ["T", "CT", "CT"], [(-6.0, 6.0, 0.0), (6.0, 6.0, 0.0), (-6.0, 9.0, 0.0)],
+        yaw=np.array([90.0, 90.0, 0.0]),
+    )  # fmt: skip
+    model = Bearings()
+    los = LineOfSight(physics, 3)
+    step = CombatStep(los, model, "de_dust2")
+    reaction = int(np.ceil(REACTION_S * TICK_RATE))
+    rng = np.random.default_rng(0)
+    try:
+        for tick in (30, 30 + reaction - 1, 30 + reaction):
+            step.run(agents, tick, rng)
+        agents.position[2] = [6.0, 0.0, 0.0]  # behind the wall for one step, then back
+        agents.position[1] = [0.0, 12.0, 0.0]
+        step.run(agents, 90, rng)
+        agents.position[2] = [-6.0, 9.0, 0.0]
+        step.run(agents, 120, rng)
+    finally:
+        los.close()
+    first, early, aimed, _, back = model.steps
+    assert first[(0, 1)] == pytest.approx(-90.0) and first[(0, 2)] == pytest.approx(0.0)
+    assert early == first  # not yet a reaction time
+    assert aimed[(0, 2)] == pytest.approx(0.0)  # the nearer one, 3 m north
+    assert aimed[(0, 1)] == pytest.approx(-90.0) and aimed[(1, 0)] == pytest.approx(0.0)
+    assert aimed[(2, 0)] == pytest.approx(0.0)  # looking south at him since 30
+    assert (2, 0) not in model.steps[3]
+    assert back[(2, 0)] == pytest.approx(-90.0)  # seen anew: its yaw 0, him due south
+
+
+def test_aimed_yaw_turns_only_the_agents_that_aim() -> None:
+    agents = _agents(["T", "CT", "CT"], [(0, 0, 0), (0, 4, 0), (3, 0, 0)], yaw=np.full(3, 45.0))
+    pairs = VisiblePairs(np.array([0, 0, 1, 2]), np.array([1, 2, 0, 0]))
+    yaw = aimed_yaw(agents, pairs, np.array([True, True, False, True]))
+    np.testing.assert_allclose(yaw, [0.0, 45.0, 180.0])  # 0 aims at the nearer, 2 due west
+    assert agents.yaw.tolist() == [45.0] * 3  # the agents' own yaw is left alone

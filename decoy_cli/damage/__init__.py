@@ -37,18 +37,18 @@ SHIPPED_MODELS = packaged_dir("models")
 """The project's own trained DIP and DOG (top-level `models/`, installed as decoy_cli.models)."""
 
 DEFAULT_MODELS = ModelName.RULES
-"""What `--models` is unless told: the shipped DIP (off its maps, the shipped map-independent
-one: `model_maps.dip_for_map`) with damage by the game's rules, the combination that measures
-best on the real damage events (README, "Damage models")."""
+"""What `--models` is unless told: the shipped DIP (on features that name no place, so one for
+every map) with damage by the game's rules, the combination that measures best on the real
+damage events (README, "Damage models")."""
 
 SHIPPED_CHOICES = (ModelName.SHIPPED, ModelName.RULES)
 """The `--models` choices that name the shipped folder (its DOG, or its rules)."""
 
 CHOICES_HELP = (
-    '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIPs with damage by '
+    '"shipped" (the DIP and DOG shipped with decoy), "rules" (the shipped DIP with damage by '
     'the game\'s rules), "paper" (the paper\'s, once imported), "none" (no shooting) or a '
-    "model folder; the shipped DIPs: de_dust2's own on de_dust2, the map-independent one "
-    "(models/any_map) on the other maps"
+    "model folder; the shipped DIP takes features that name no place (distance, height, "
+    "bearings, HP), one for every map"
 )
 
 
@@ -99,7 +99,7 @@ def damages_by_rules(choice: ModelChoice, folder: Path) -> bool:
 def model_roles(choice: ModelChoice, map_name: str) -> dict[str, str]:
     """Which model decides who hits on `map_name` and which how much, in words, for a
     `--models` choice (a folder that cannot be read names itself only)."""
-    from decoy_cli.damage.model_maps import dip_for_map
+    from decoy_cli.damage.model_maps import dip_of
 
     if choice == ModelName.NONE:
         return {"hits": "none (no shooting)", "damage": "none (no shooting)"}
@@ -112,15 +112,14 @@ def model_roles(choice: ModelChoice, map_name: str) -> dict[str, str]:
         damage = f"the game's damage rules with the learned parts of {name} (rules.json)"
     else:
         damage = f"the DOG of {name}"
-    return {"hits": dip_for_map(choice, map_name).name, "damage": damage}
+    return {"hits": dip_of(choice).name, "damage": damage}
 
 
 def load_damage_model(choice: ModelChoice | str) -> DamageModel | None:
     """The damage model a user chose: "shipped", "rules", "none" (None: no shooting), "paper"
     or the path of a model folder holding a DIP and a DOG (e.g. written by `decoy models
     import-decoy`) or a DIP and `rules.json` (`decoy models fit-rules`: damage by the game's
-    rules). The shipped choices decide hits by the shipped map-independent DIP on the maps
-    their own DIP was not trained on (`model_maps.dip_for_map`).
+    rules).
 
     The choice may be given as its text (`parse_models`). A missing or incompatible folder is
     one ModelError line.
@@ -129,16 +128,13 @@ def load_damage_model(choice: ModelChoice | str) -> DamageModel | None:
     if choice == ModelName.NONE:
         return None
     folder = resolve_models(choice)
-    from decoy_cli.damage.combat import LearnedDamage, StandIn
+    from decoy_cli.damage.combat import LearnedDamage
     from decoy_cli.damage.model_folder import load_dip, load_dog
-    from decoy_cli.damage.model_maps import stand_in_of
     from decoy_cli.damage.rules_model import RulesDamage, RulesFile
 
-    found = stand_in_of(choice)
-    stand_in = StandIn(load_dip(found[0]), found[1]) if found is not None else None
     if damages_by_rules(choice, folder):
-        return RulesDamage(load_dip(folder), RulesFile.load(folder), stand_in=stand_in)
-    return LearnedDamage(load_dip(folder), load_dog(folder), stand_in=stand_in)
+        return RulesDamage(load_dip(folder), RulesFile.load(folder))
+    return LearnedDamage(load_dip(folder), load_dog(folder))
 
 
 __all__ = [

@@ -2,10 +2,6 @@
 
 Per combat step (decoy_cli/sim/combat.py calls it with every visible ordered pair):
 
-0. the DIP of the batch's map is chosen (`MapDecisions`): the model's own, or on a map it was
-   not trained on a stand-in DIP when one is given (`StandIn`: the shipped choices' map-
-   independent DIP, decoy_cli/damage/model_maps.py);
-
 1. one batched DIP forward pass over all pairs gives the probability that the attacker damages
    the victim in this 0.5 s step (`DipDecision`, which `RulesDamage` shares); a pair hits when
    it reaches the threshold (the model folder's, 0.444 for the paper's DIP), or by the rule of
@@ -37,7 +33,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -182,41 +177,9 @@ class DipDecision:
         return armed & (probability >= self.threshold)
 
 
-@dataclass(frozen=True)
-class StandIn:
-    """A DIP that decides hits on every map but `home_maps`, those the main DIP was trained on."""
-
-    dip: LoadedDip
-    home_maps: frozenset[str]
-
-
-class MapDecisions:
-    """The `DipDecision` of each map: the main DIP's, and without a stand-in everywhere; with
-    one, the stand-in's on every map but its `home_maps`. `threshold` and `threads` as
-    `DipDecision`'s, for both."""
-
-    def __init__(
-        self,
-        dip: LoadedDip,
-        threshold: float | None = None,
-        threads: int | None = 1,
-        stand_in: StandIn | None = None,
-    ) -> None:
-        self.home = DipDecision(dip, threshold, threads)
-        self.away = None if stand_in is None else DipDecision(stand_in.dip, threshold, threads)
-        self.home_maps = frozenset() if stand_in is None else stand_in.home_maps
-
-    def on(self, map_name: str) -> DipDecision:
-        """The decision that rules on `map_name`."""
-        if self.away is None or map_name in self.home_maps:
-            return self.home
-        return self.away
-
-
 class LearnedDamage:
     """A `DamageModel` from a loaded DIP and DOG: DIP decides who hits (`DipDecision`, which
-    takes `threshold` and `threads`; with a `stand_in`, `MapDecisions`), DOG how much and
-    where."""
+    takes `threshold` and `threads`), DOG how much and where."""
 
     def __init__(
         self,
@@ -224,10 +187,8 @@ class LearnedDamage:
         dog: LoadedDog,
         threshold: float | None = None,
         threads: int | None = 1,
-        stand_in: StandIn | None = None,
     ) -> None:
-        self.decisions = MapDecisions(dip, threshold, threads, stand_in)
-        self.decision = self.decisions.home
+        self.decision = DipDecision(dip, threshold, threads)
         self.dip = dip
         self.dog = dog
         self.threshold = self.decision.threshold
@@ -235,9 +196,8 @@ class LearnedDamage:
             self._dog = _FoldedDogDecoder(dog.net)
 
     def hit_probability(self, batch: CombatBatch) -> np.ndarray:
-        """(K,) the probability that each attacker damages its victim in this step, by the DIP
-        of the batch's map."""
-        return self.decisions.on(batch.map_name).hit_probability(batch)
+        """(K,) the probability that each attacker damages its victim in this step."""
+        return self.decision.hit_probability(batch)
 
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
         k = len(batch)
@@ -246,7 +206,7 @@ class LearnedDamage:
         group = np.full(k, NO_HIT, dtype=np.int8)
         if k == 0:
             return DamageResult(damage, group, np.zeros(0, dtype=bool))
-        decision = self.decisions.on(batch.map_name)
+        decision = self.decision
         features = encode(batch, decision.dip.spec)
         hit = decision.hits(batch, features, seed)
         rows = np.flatnonzero(hit)

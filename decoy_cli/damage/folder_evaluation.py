@@ -186,40 +186,22 @@ def evaluate_model_folder(
 def evaluate_map_dips(
     models: ModelChoice, samples: Samples, chosen: np.ndarray, threshold: float | None
 ) -> tuple[DipEvaluation, dict[str, dict[str, float]], dict[str, str]]:
-    """The `chosen` samples scored map by map by the DIP each map gets
-    (`model_maps.dip_for_map`), at its threshold (or `threshold`): the evaluation of them all,
-    each map's metrics and the name of each map's DIP. With one DIP for every map the
-    evaluation is that DIP's; with several, each sample is decided at its own DIP's threshold,
-    the curves and calibration pool their probabilities (a DIP's calibration is left out)."""
-    from decoy_cli.damage.calibration import calibration_scores
+    """The `chosen` samples scored by the choice's DIP (`model_maps.dip_of`) at its threshold
+    (or `threshold`): the evaluation of them all, each map's metrics and the name of the DIP
+    that decided each map's hits."""
     from decoy_cli.damage.evaluation import evaluate_dip
-    from decoy_cli.damage.model_folder import LoadedDip, load_dip
-    from decoy_cli.damage.model_maps import dip_for_map
-    from decoy_cli.damage.scores import classification_metrics
+    from decoy_cli.damage.model_folder import load_dip
+    from decoy_cli.damage.model_maps import dip_of
 
+    dip = dip_of(models)
+    loaded = load_dip(dip.folder)
     maps = np.array([str(m) for m in samples.map_name[chosen]], dtype=object)
-    loaded: dict[Path, LoadedDip] = {}
-    probabilities = np.zeros(len(chosen))
-    thresholds = np.zeros(len(chosen))
     by_map: dict[str, dict[str, float]] = {}
-    dip_of_map: dict[str, str] = {}
     for where in sorted(set(maps.tolist())):
-        which = dip_for_map(models, where)
-        if which.folder not in loaded:
-            loaded[which.folder] = load_dip(which.folder)
-        rows = np.flatnonzero(maps == where)
-        result = evaluate_dip(loaded[which.folder], samples.take(chosen[rows]), threshold)
-        probabilities[rows] = result.probabilities
-        thresholds[rows] = result.metrics["threshold"]
-        by_map[where] = result.metrics
-        dip_of_map[where] = which.name
-    if len(loaded) == 1:
-        (only,) = loaded.values()
-        return evaluate_dip(only, samples.take(chosen), threshold), by_map, dip_of_map
-    labels = samples.hit[chosen].copy()
-    metrics = classification_metrics(labels, probabilities, thresholds)
-    metrics |= calibration_scores(labels, probabilities, None)
-    return DipEvaluation(metrics, labels, probabilities), by_map, dip_of_map
+        rows = chosen[np.flatnonzero(maps == where)]
+        by_map[where] = evaluate_dip(loaded, samples.take(rows), threshold).metrics
+    names = dict.fromkeys(by_map, dip.name)
+    return evaluate_dip(loaded, samples.take(chosen), threshold), by_map, names
 
 
 def _hit_samples(choice: SampleChoice, samples: Samples, subset: str, index: np.ndarray) -> Samples:

@@ -41,7 +41,6 @@ from decoy_cli.files import write_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.combat import StandIn
     from decoy_cli.damage.damage_rows import DamageRows
     from decoy_cli.damage.model_folder import LoadedDip
 
@@ -297,8 +296,7 @@ def rules_generate(
 
 
 class RulesDamage:
-    """A `DamageModel`: DIP decides who hits (with a `stand_in`, the DIP of the batch's map:
-    `MapDecisions`), the rules how much and where (module doc)."""
+    """A `DamageModel`: DIP decides who hits, the rules how much and where (module doc)."""
 
     def __init__(
         self,
@@ -306,12 +304,10 @@ class RulesDamage:
         rules: RulesFile,
         threshold: float | None = None,
         threads: int | None = 1,
-        stand_in: StandIn | None = None,
     ) -> None:
-        from decoy_cli.damage.combat import MapDecisions
+        from decoy_cli.damage.combat import DipDecision
 
-        self.decisions = MapDecisions(dip, threshold, threads, stand_in)
-        self.decision = self.decisions.home
+        self.decision = DipDecision(dip, threshold, threads)
         self.dip = dip
         self.rules = rules
 
@@ -327,7 +323,7 @@ class RulesDamage:
             return DamageResult(damage, group, np.zeros(0, dtype=bool), armor_damage)
         # two independent streams: the hit decisions' and the outcomes'
         decide_seed, outcome_seed = np.random.SeedSequence(seed).spawn(2)
-        decision = self.decisions.on(batch.map_name)
+        decision = self.decision
         hit = decision.hits(batch, encode(batch, decision.dip.spec), decide_seed)
         draw = np.random.default_rng(outcome_seed)
         for row in np.flatnonzero(hit):

@@ -4,7 +4,9 @@ Every 0.5 s of game time (the engine decides when, by integer tick count) `Comba
 
 1. `LineOfSight.visible_pairs` finds the ordered (attacker, victim) pairs of alive enemies whose
    eyes see each other, with one batched ray per unordered pair;
-2. `make_batch` gathers everything a damage model needs about those pairs into a `CombatBatch`;
+2. `aimed_yaw` turns each agent who has had an enemy in sight for a reaction time toward the
+   nearest such enemy (`REACTION_S`), and `make_batch` gathers everything a damage model needs
+   about the pairs, with those view yaws, into a `CombatBatch`;
 3. a `DamageModel` (DIP and DOG in `decoy_cli.damage`) says, per pair, whether the attacker hits
    and for how much and where;
 4. `apply_damage` applies all damage of the step at once (two agents can kill each other) and
@@ -21,6 +23,7 @@ from typing import Protocol
 
 import numpy as np
 
+from decoy_cli.csgo import seconds_to_ticks
 from decoy_cli.sim.sight import LOS_GROUP, LineOfSight, VisiblePairs
 from decoy_cli.sim.state import Agents, SimEvent
 
@@ -28,12 +31,14 @@ __all__ = [
     "HIT_GROUPS",
     "LOS_GROUP",
     "NO_HIT",
+    "REACTION_S",
     "CombatBatch",
     "CombatStep",
     "DamageModel",
     "DamageResult",
     "LineOfSight",
     "VisiblePairs",
+    "aimed_yaw",
     "apply_damage",
     "make_batch",
 ]
@@ -42,6 +47,12 @@ HIT_GROUPS = ("Head", "Neck", "Chest", "Stomach", "Arm", "Leg")
 """Hit groups of the damage models, by code 0..5 (-1 = no hit)."""
 
 NO_HIT = -1
+
+REACTION_S = 0.25
+"""How long an agent has an enemy in sight before he aims at him: a human's visual reaction
+time, about a quarter of a second (chosen from that, not measured on this data). Until then he
+looks where he was going, as the movers turn him. The damage models learned from real shots,
+taken by players aiming at their victims: a replay whose agents never aim hits far less."""
 
 
 # ---- the damage-model interface ---------------------------------------------------------------
@@ -77,8 +88,11 @@ class CombatBatch:
         return len(self.attacker)
 
 
-def make_batch(agents: Agents, pairs: VisiblePairs, map_name: str) -> CombatBatch:
-    """Gather the state of both agents of every pair (copies: later state changes do not leak)."""
+def make_batch(
+    agents: Agents, pairs: VisiblePairs, map_name: str, yaw: np.ndarray | None = None
+) -> CombatBatch:
+    """Gather the state of both agents of every pair (copies: later state changes do not leak);
+    `yaw` (N,) the agents' view yaws in degrees (`aimed_yaw`; default: `agents.yaw`)."""
     a = np.asarray(pairs.attacker, dtype=np.int64)
     v = np.asarray(pairs.victim, dtype=np.int64)
     if a.shape != v.shape or a.ndim != 1:
@@ -86,7 +100,7 @@ def make_batch(agents: Agents, pairs: VisiblePairs, map_name: str) -> CombatBatc
     if len(a) and (min(a.min(), v.min()) < 0 or max(a.max(), v.max()) >= agents.count):
         raise ValueError(f"pair indices outside 0..{agents.count - 1}")
     position = np.asarray(agents.position, dtype=np.float64)
-    yaw = np.asarray(agents.yaw, dtype=np.float64)
+    yaw = np.asarray(agents.yaw if yaw is None else yaw, dtype=np.float64)
     delta = position[v] - position[a]
     ahead = np.arctan2(delta[:, 1], delta[:, 0]) - np.radians(yaw[a])
     bearing = np.where(np.hypot(delta[:, 0], delta[:, 1]) > 0, _wrap(ahead), 0.0)
@@ -106,6 +120,21 @@ def make_batch(agents: Agents, pairs: VisiblePairs, map_name: str) -> CombatBatc
         bearing=bearing,
         map_name=map_name,
     )
+
+
+def aimed_yaw(agents: Agents, pairs: VisiblePairs, aims: np.ndarray) -> np.ndarray:
+    """(N,) view yaws in degrees: an agent toward the nearest victim of the pairs where `aims`
+    is True (the pairs he has had in sight long enough to aim), else his own yaw."""
+    yaw = np.asarray(agents.yaw, dtype=np.float64).copy()
+    attacker, victim = pairs.attacker[aims], pairs.victim[aims]
+    if len(attacker) == 0:
+        return yaw
+    position = np.asarray(agents.position, dtype=np.float64)
+    delta = position[victim, :2] - position[attacker, :2]
+    order = np.lexsort((np.hypot(delta[:, 0], delta[:, 1]), attacker))  # nearest first
+    nearest = order[np.r_[True, attacker[order][1:] != attacker[order][:-1]]]
+    yaw[attacker[nearest]] = np.degrees(np.arctan2(delta[nearest, 1], delta[nearest, 0]))
+    return yaw
 
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
@@ -237,7 +266,8 @@ def apply_damage(
 
 
 class CombatStep:
-    """One combat step: line of sight, the damage model on the visible pairs, damage applied."""
+    """One combat step: line of sight, aim, the damage model on the visible pairs, damage
+    applied. Remembers since when each pair has been in sight at every step (one round)."""
 
     def __init__(
         self, los: LineOfSight, model: DamageModel, map_name: str, *, kills: bool = True
@@ -246,12 +276,19 @@ class CombatStep:
         self.model = model
         self.map_name = map_name
         self.kills = kills
+        self._in_sight_since = np.full((los.count, los.count), -1, dtype=np.int64)
 
     def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]:
         """Run the step on the agents (changed in place); the model is not called when no
         pair is visible."""
         pairs = self.los.visible_pairs(agents)
+        since = self._in_sight_since
+        seen_before = since[pairs.attacker, pairs.victim]
+        since[:] = -1
+        since[pairs.attacker, pairs.victim] = np.where(seen_before >= 0, seen_before, tick)
         if len(pairs) == 0:
             return []
-        batch = make_batch(agents, pairs, self.map_name)
+        aims = since[pairs.attacker, pairs.victim] <= tick - seconds_to_ticks(REACTION_S)
+        yaw = aimed_yaw(agents, pairs, aims)
+        batch = make_batch(agents, pairs, self.map_name, yaw)
         return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)
