@@ -283,12 +283,14 @@ class CombatStep:
         pair is visible."""
         pairs = self.los.visible_pairs(agents)
         since = self._in_sight_since
-        seen_before = since[pairs.attacker, pairs.victim]
-        since[:] = -1
-        since[pairs.attacker, pairs.victim] = np.where(seen_before >= 0, seen_before, tick)
         if len(pairs) == 0:
+            since.fill(-1)
             return []
-        aims = since[pairs.attacker, pairs.victim] <= tick - seconds_to_ticks(REACTION_S)
+        seen_before = since[pairs.attacker, pairs.victim]
+        since.fill(-1)
+        seen = np.where(seen_before >= 0, seen_before, tick)
+        since[pairs.attacker, pairs.victim] = seen
+        aims = seen <= tick - seconds_to_ticks(REACTION_S)
         yaw = aimed_yaw(agents, pairs, aims)
         batch = make_batch(agents, pairs, self.map_name, yaw)
         return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)
