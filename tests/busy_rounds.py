@@ -138,7 +138,7 @@ def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 def count_quiet_steps(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """From now on, how each of the environment's compiled steps ended (`env_step`'s
-    `_quiet_step`: `env_step.PLAYED` when it played the step to its end), call by call."""
+    `_quiet_step`: `StepEnd.PLAYED` when it played the step to its end), call by call."""
     from decoy_cli.env import step as env_step
 
     return _recorded(monkeypatch, env_step, "_quiet_step", 0)

@@ -57,7 +57,7 @@ def test_the_shipped_choices_decide_by_one_dip_on_every_map(shipped: Path, choic
     unarmed = dataclasses.replace(on_map("de_dust2"), attacker_weapon=np.full(12, "", dtype=object))
     assert not model(unarmed, rng).hit.any()  # a DIP that always fires: no weapon, no hit
     assert dip_of(choice).folder == shipped
-    assert model_roles(choice, "de_nuke")["hits"] == "the DIP of the shipped models"
+    assert model_roles(choice)["hits"] == "the DIP of the shipped models"
 
 
 def test_the_maps_a_part_never_saw_are_named(shipped: Path, tmp_path: Path) -> None:
@@ -68,7 +68,7 @@ def test_the_maps_a_part_never_saw_are_named(shipped: Path, tmp_path: Path) -> N
     (dog,) = map_warnings("shipped", ["de_ancient", "de_dust2"])
     assert "DOG (how much damage)" in dog and "not on de_ancient" in dog
     user = shutil.copytree(shipped, tmp_path / "mine")
-    assert model_roles(str(user), "de_nuke")["hits"] == f"the DIP of {user}"
+    assert model_roles(str(user))["hits"] == f"the DIP of {user}"
     assert len(map_warnings(str(user), ["de_nuke"])) == 2
 
 

@@ -58,3 +58,20 @@ def test_an_option_given_by_a_group_and_the_command_is_refused() -> None:
 
     with pytest.raises(TypeError, match="'speed' given twice"):
         with_groups(twice)
+
+
+def test_a_command_called_from_python_takes_a_group_whole_or_its_fields() -> None:
+    received: list[object] = []
+
+    @with_groups
+    def move(name: str, pace: Pace = Pace(gait="walk"), laps: int = 1) -> None:
+        received.append((name, pace, laps))
+
+    move("ann")
+    move("bob", pace=Pace(speed=1.0), laps=2)
+    move("cy", speed=4.0)  # a field alone: the rest from the group's default
+    assert received == [
+        ("ann", Pace(gait="walk"), 1),
+        ("bob", Pace(speed=1.0), 2),
+        ("cy", Pace(speed=4.0, gait="walk"), 1),
+    ]

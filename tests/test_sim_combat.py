@@ -541,3 +541,20 @@ def test_aimed_yaw_turns_only_the_agents_that_aim() -> None:
     yaw = aimed_yaw(agents, pairs, np.array([True, True, False, True]))
     np.testing.assert_allclose(yaw, [0.0, 45.0, 180.0])  # 0 aims at the nearer, 2 due west
     assert agents.yaw.tolist() == [45.0] * 3  # the agents' own yaw is left alone
+
+
+def test_a_step_with_nobody_in_sight_forgets_who_was(physics: PhysicsWorld) -> None:
+    agents = _agents(["T", "CT"], [(0.0, 0.0, 0.0), (0.0, 8.0, 0.0)], yaw=np.zeros(2))
+    model = Bearings()
+    los = LineOfSight(physics, 2)
+    step = CombatStep(los, model, "de_dust2")
+    rng = np.random.default_rng(0)
+    try:
+        for tick, north in ((30, True), (60, False), (90, True), (120, True)):
+            agents.position[1] = [0.0, 8.0, 0.0] if north else [6.0, 0.0, 0.0]  # or behind the wall
+            step.run(agents, tick, rng)
+    finally:
+        los.close()
+    first, seen_anew, aimed = model.steps  # the step at 60 saw nobody: no model call
+    assert first[(0, 1)] == pytest.approx(90.0) and seen_anew[(0, 1)] == pytest.approx(90.0)
+    assert aimed[(0, 1)] == pytest.approx(0.0)

@@ -6,11 +6,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Literal
 
-import typer
 from rich.console import Console
 from rich.progress import (
     BarColumn,
@@ -25,77 +23,13 @@ from rich.table import Table
 from decoy_cli.commands._console import make_console
 from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG, DogMetrics
 from decoy_cli.damage.hp_lost import HpLostScores
-from decoy_cli.damage.provenance import SampleChoice
 from decoy_cli.damage.sample_set import SampleStats
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode
 from decoy_cli.damage.scores import CellRecord
-from decoy_cli.damage.split import (
-    DEFAULT_SEED,
-    DEFAULT_SPLIT,
-    DEFAULT_TEST_FRACTION,
-    DEFAULT_VAL_FRACTION,
-    SplitUnit,
-)
 
 if TYPE_CHECKING:
     from decoy_cli.damage.training import Progress as TrainingProgress
 
 DATA_HELP = "ESTA match files (.json.xz or .json) or folders of them."
-
-
-@dataclass(frozen=True)
-class SampleOptions:
-    """How `decoy train` and `decoy models` read and split the damage samples: the same
-    options give the same train, validation and test parts in every command."""
-
-    mode: Annotated[
-        SampleMode,
-        typer.Option(
-            "--mode",
-            help="How rounds become samples: auto (frames of both teams -> frames, else "
-            "events), frames (the paper's, per frame every enemy pair) or events (events-only "
-            "proxy for files without frames).",
-        ),
-    ] = DEFAULT_MODE
-    window: Annotated[
-        float,
-        typer.Option(
-            "--window", help="Events mode: seconds within which an event row places a player."
-        ),
-    ] = DEFAULT_WINDOW_S
-    split: Annotated[
-        SplitUnit, typer.Option("--split", help="Split unit (never single samples).")
-    ] = DEFAULT_SPLIT
-    seed: Annotated[
-        int,
-        typer.Option(
-            "--seed",
-            help="Seed of the split, the 1:1 balancing, and (training) weights and shuffling.",
-        ),
-    ] = DEFAULT_SEED
-    val_fraction: Annotated[
-        float,
-        typer.Option(
-            "--val-fraction",
-            help="Share of the split units for validation (early stopping, DIP threshold).",
-        ),
-    ] = DEFAULT_VAL_FRACTION
-    test_fraction: Annotated[
-        float,
-        typer.Option("--test-fraction", help="Share of the split units held out for the test."),
-    ] = DEFAULT_TEST_FRACTION
-
-    def choice(self, data: Sequence[Path]) -> SampleChoice:
-        """The library's choice of samples: these options over `data`."""
-        return SampleChoice(
-            data=data,
-            mode=self.mode,
-            window_s=self.window,
-            split_by=self.split,
-            seed=self.seed,
-            val_fraction=self.val_fraction,
-            test_fraction=self.test_fraction,
-        )
 
 
 BALANCE_HELP = "DIP: keep all positives and as many random negatives per part (the paper's 1:1)."

@@ -27,16 +27,19 @@ Command = TypeVar("Command", bound=Callable[..., None])
 
 def with_groups(command: Command) -> Command:
     """`command` as Typer should see it: every dataclass-typed parameter replaced by its fields
-    (keyword options, in the group's place); called, it builds each group from them."""
+    (keyword options, in the group's place); called, it builds each group from them. Called
+    from Python it takes its own parameters too: a group given whole, or its fields, each
+    missing field from the group's default."""
     hints = typing.get_type_hints(command, include_extras=True)
-    groups: dict[str, type] = {}
+    groups: dict[str, Any] = {}  # parameter name -> the group's default instance
     parameters: list[inspect.Parameter] = []
     for parameter in inspect.signature(command).parameters.values():
         kind = hints[parameter.name]
         if not (isinstance(kind, type) and dataclasses.is_dataclass(kind)):
             parameters.append(parameter.replace(annotation=kind, kind=_KEYWORD))
             continue
-        groups[parameter.name] = kind
+        default = parameter.default
+        groups[parameter.name] = default if isinstance(default, kind) else kind()
         fields = typing.get_type_hints(kind, include_extras=True)
         for field in dataclasses.fields(kind):
             if field.name in hints:
@@ -48,11 +51,13 @@ def with_groups(command: Command) -> Command:
             )
 
     @functools.wraps(command)
-    def run(**options: Any) -> None:
-        for name, kind in groups.items():
-            names = [field.name for field in dataclasses.fields(kind)]
-            options[name] = kind(**{field: options.pop(field) for field in names})
-        command(**options)
+    def run(*args: Any, **options: Any) -> None:
+        for name, default in groups.items():
+            if name not in options:
+                names = [field.name for field in dataclasses.fields(default)]
+                given = {field: options.pop(field) for field in names if field in options}
+                options[name] = dataclasses.replace(default, **given)
+        command(*args, **options)
 
     run.__signature__ = inspect.Signature(parameters)  # type: ignore[attr-defined]
     run.__annotations__ = {p.name: p.annotation for p in parameters}

@@ -1,10 +1,12 @@
 """Options shared by several commands, each defined once: how a round runs (`RunOptions`, the
-group `decoy replay` and `decoy evaluate` share), the mover and the damage models for the other
-commands, and the help of the maps (the mover, deaths, missing fields and implausible data are
+group `decoy replay` and `decoy evaluate` share), how damage samples are read and split
+(`SampleOptions`, for `decoy train` and `decoy models`), the mover and the damage models for the
+other commands, and the help of the maps (the mover, deaths, missing fields and implausible data are
 `Literal` types, which Typer lists)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated
@@ -14,6 +16,15 @@ import typer
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.damage.choice import MODELS_METAVAR, ModelName
+from decoy_cli.damage.provenance import SampleChoice
+from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode
+from decoy_cli.damage.split import (
+    DEFAULT_SEED,
+    DEFAULT_SPLIT,
+    DEFAULT_TEST_FRACTION,
+    DEFAULT_VAL_FRACTION,
+    SplitUnit,
+)
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
@@ -96,6 +107,66 @@ class RunOptions:
     seed: Annotated[
         int,
         typer.Option(
-            "--seed", help="Seed of the simulator's random numbers (and of evaluate's --sample)."
+            "--seed",
+            help="Seed of the simulator's random numbers (and of the rounds evaluate --sample "
+            "draws).",
         ),
     ] = 0
+
+
+@dataclass(frozen=True)
+class SampleOptions:
+    """How `decoy train` and `decoy models` read and split the damage samples: the same
+    options give the same train, validation and test parts in every command."""
+
+    mode: Annotated[
+        SampleMode,
+        typer.Option(
+            "--mode",
+            help="How rounds become samples: auto (frames of both teams -> frames, else "
+            "events), frames (the paper's, per frame every enemy pair) or events (events-only "
+            "proxy for files without frames).",
+        ),
+    ] = DEFAULT_MODE
+    window: Annotated[
+        float,
+        typer.Option(
+            "--window",
+            help="Events mode: seconds within which an event row places a player (negatives).",
+        ),
+    ] = DEFAULT_WINDOW_S
+    split: Annotated[
+        SplitUnit, typer.Option("--split", help="Split unit (never single samples).")
+    ] = DEFAULT_SPLIT
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed",
+            help="Seed of the split, the 1:1 balancing, and (training) weights and shuffling.",
+        ),
+    ] = DEFAULT_SEED
+    val_fraction: Annotated[
+        float,
+        typer.Option(
+            "--val-fraction",
+            help="Share of the split units for validation (early stopping, DIP threshold).",
+        ),
+    ] = DEFAULT_VAL_FRACTION
+    test_fraction: Annotated[
+        float,
+        typer.Option(
+            "--test-fraction", help="Share of the split units held out for the test metrics."
+        ),
+    ] = DEFAULT_TEST_FRACTION
+
+    def choice(self, data: Sequence[Path]) -> SampleChoice:
+        """The library's choice of samples: these options over `data`."""
+        return SampleChoice(
+            data=data,
+            mode=self.mode,
+            window_s=self.window,
+            split_by=self.split,
+            seed=self.seed,
+            val_fraction=self.val_fraction,
+            test_fraction=self.test_fraction,
+        )

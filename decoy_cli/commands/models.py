@@ -14,7 +14,6 @@ from decoy_cli.commands._damage_output import (
     DATA_HELP,
     DRAWS_HELP,
     MIN_CELL_HELP,
-    SampleOptions,
     cells_table,
     dip_table,
     dog_table,
@@ -23,6 +22,7 @@ from decoy_cli.commands._damage_output import (
     progress_bars,
 )
 from decoy_cli.commands._groups import with_groups
+from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
 from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY

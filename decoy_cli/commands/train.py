@@ -19,7 +19,6 @@ from decoy_cli.commands._damage_output import (
     DATA_HELP,
     DRAWS_HELP,
     MIN_CELL_HELP,
-    SampleOptions,
     cells_table,
     dip_table,
     dog_table,
@@ -27,6 +26,7 @@ from decoy_cli.commands._damage_output import (
     progress_bars,
 )
 from decoy_cli.commands._groups import with_groups
+from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import SampleChoice
 from decoy_cli.damage.scores import MIN_CELL

@@ -4,7 +4,7 @@
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
 * networks.py: DipNet and DogNet (torch);
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
-* model_maps.py: the maps a model knows, the DIP each map gets, and the warnings;
+* model_maps.py: the maps a model knows, the DIP of a choice, and the warnings;
 * paper.py, download_paper.py: import of the paper's published checkpoints, and their download;
 * combat.py: `DipDecision` (who hits) and `LearnedDamage`, the simulator's `DamageModel` over a
   DIP and a DOG;
@@ -96,9 +96,9 @@ def damages_by_rules(choice: ModelChoice, folder: Path) -> bool:
     )
 
 
-def model_roles(choice: ModelChoice, map_name: str) -> dict[str, str]:
-    """Which model decides who hits on `map_name` and which how much, in words, for a
-    `--models` choice (a folder that cannot be read names itself only)."""
+def model_roles(choice: ModelChoice) -> dict[str, str]:
+    """Which model decides who hits and which how much, in words, for a `--models` choice (a
+    folder that cannot be read names itself only); the same on every map."""
     from decoy_cli.damage.model_maps import dip_of
 
     if choice == ModelName.NONE:

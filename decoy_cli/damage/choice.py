@@ -12,7 +12,7 @@ class ModelName(StrEnum):
     """The named `--models` choices."""
 
     RULES = "rules"
-    """The shipped DIPs with damage by the game's rules (`rules.json`)."""
+    """The shipped DIP with damage by the game's rules (`rules.json`)."""
     SHIPPED = "shipped"
     """The DIP and DOG shipped with decoy."""
     PAPER = "paper"

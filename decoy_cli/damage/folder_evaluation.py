@@ -55,7 +55,7 @@ class FolderEvaluation:
     out: Path
     figures: list[Path]
     dip_by_map: dict[str, dict[str, float]] = field(default_factory=dict)
-    """DIP's metrics on each map's samples (`evaluate_map_dips`)."""
+    """DIP's metrics on each map's samples (`evaluate_dip_by_map`)."""
     dip_of_map: dict[str, str] = field(default_factory=dict)
     """The DIP that decides hits on each map."""
 
@@ -122,7 +122,7 @@ def evaluate_model_folder(
         chosen = balance(samples, index, choice.seed) if balanced else index
         if not samples.hit[chosen].any():
             raise ModelError(f"no damaging samples in the {subset} samples: DIP cannot be scored")
-        dip_result, by_map, dip_of_map = evaluate_map_dips(models, samples, chosen, threshold)
+        dip_result, by_map, dip_of_map = evaluate_dip_by_map(models, samples, chosen, threshold)
         report["dip"] = {"balanced": balanced, **dip_result.metrics}
         report["dip_by_map"] = by_map
         report["dip_of_map"] = dip_of_map
@@ -183,7 +183,7 @@ def evaluate_model_folder(
     )
 
 
-def evaluate_map_dips(
+def evaluate_dip_by_map(
     models: ModelChoice, samples: Samples, chosen: np.ndarray, threshold: float | None
 ) -> tuple[DipEvaluation, dict[str, dict[str, float]], dict[str, str]]:
     """The `chosen` samples scored by the choice's DIP (`model_maps.dip_of`) at its threshold

@@ -21,7 +21,7 @@ from decoy_cli.damage.rules_model import RULES_FILE
 
 
 @dataclass(frozen=True)
-class MapDip:
+class ChosenDip:
     """The DIP that decides hits for a `--models` choice: the folder whose dip.json it is, and
     its name in words."""
 
@@ -29,13 +29,13 @@ class MapDip:
     name: str
 
 
-def dip_of(choice: ModelChoice) -> MapDip:
+def dip_of(choice: ModelChoice) -> ChosenDip:
     """The DIP that decides hits for a `--models` choice (not "none"), on every map."""
     from decoy_cli.damage import SHIPPED_MODELS, resolve_models
 
     folder = resolve_models(choice)
     name = "the shipped models" if folder == SHIPPED_MODELS else str(folder)
-    return MapDip(folder, f"the DIP of {name}")
+    return ChosenDip(folder, f"the DIP of {name}")
 
 
 def part_file(folder: Path, part: str) -> Path:

@@ -81,7 +81,7 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
     from decoy_cli.damage.model_maps import map_warnings
 
     models = settings.models if settings.combat else ModelName.NONE
-    roles = model_roles(models, settings.map_name)
+    roles = model_roles(models)
     lines = {"hits decided by": roles["hits"], "damage decided by": roles["damage"]}
     warnings = map_warnings(models, [settings.map_name]) if settings.models_fingerprint else []
     if warnings:

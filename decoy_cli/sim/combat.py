@@ -51,8 +51,10 @@ NO_HIT = -1
 REACTION_S = 0.25
 """How long an agent has an enemy in sight before he aims at him: a human's visual reaction
 time, about a quarter of a second (chosen from that, not measured on this data). Until then he
-looks where he was going, as the movers turn him. The damage models learned from real shots,
-taken by players aiming at their victims: a replay whose agents never aim hits far less."""
+looks where he was going, as the movers turn him. Sight is tested at combat steps only, so at
+the paper's cadence (0.5 s) he aims from the second step in a row that finds the enemy in sight.
+The damage models learned from real shots, taken by players aiming at their victims: a replay
+whose agents never aim hits far less."""
 
 
 # ---- the damage-model interface ---------------------------------------------------------------
