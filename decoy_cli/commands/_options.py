@@ -28,6 +28,7 @@ from decoy_cli.damage.split import (
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
+from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.sim.setup import MoverName
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
@@ -74,11 +75,11 @@ def models_option(default: ModelName) -> str:
     return typer.Option(default.value, "--models", metavar=MODELS_METAVAR, help=MODELS_HELP)
 
 
-@dataclass(frozen=True)
-class RunOptions:
-    """How `decoy replay` and `decoy evaluate` run a round: shooting and its models, the bomb,
-    the mover, who decides deaths, what to do with missing fields and implausible data, the
-    geometry of sight, and the seed."""
+@dataclass(frozen=True, kw_only=True)
+class RunOptions(ReplaySpec):
+    """How `decoy replay` and `decoy evaluate` run a round: the replay's spec (`ReplaySpec`:
+    the mover, shooting, the bomb, the seed, who decides deaths, missing fields and implausible
+    data), each field an option, and the damage models and the geometry of sight."""
 
     combat: Annotated[
         bool,

@@ -55,16 +55,7 @@ def replay(
             "--models none: replaying without shooting (deaths in the data are scripted)",
             style="yellow",
         )
-    options = ReplayOptions(
-        combat=damage_model is not None,
-        bomb=given.bomb,
-        mover=given.mover,
-        damage_model=damage_model,
-        seed=given.seed,
-        deaths=given.deaths,
-        missing=given.missing,
-        implausible=given.implausible,
-    )
+    options = ReplayOptions.of(given, damage_model)
     run = replay_address(
         address,
         options,

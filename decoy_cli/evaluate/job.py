@@ -259,15 +259,6 @@ def _replay(
 ) -> ReplayResult:
     from decoy_cli.replay.replayer import ReplayOptions, replay_round
 
-    options = ReplayOptions(
-        combat=model is not None,
-        bomb=settings.bomb,
-        mover=settings.mover,
-        damage_model=model,
-        seed=round_seed(settings, task.file_sha, task.round_num),
-        deaths=settings.deaths,
-        missing=settings.missing,
-        implausible=settings.implausible,
-        sight=state.sight,
-    )
+    seed = round_seed(settings, task.file_sha, task.round_num)
+    options = ReplayOptions.of(settings, model, seed=seed, sight=state.sight)
     return replay_round(round_, state.graph, options, physics=state.physics)

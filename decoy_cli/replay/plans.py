@@ -36,7 +36,7 @@ import pandas as pd
 
 from decoy_cli.errors import EstaError, GraphError
 from decoy_cli.replay.pace import asks_more, edge_durations, less_climbed, running_seconds
-from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, EdgeKind, WaypointGraph
+from decoy_cli.waypoints.graph import DIRECTION_NAMES, STOP_ACTION, WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
 
 RELOCATE_ACTION = 9
@@ -61,14 +61,6 @@ class PathCache:
     def __init__(self, graph: WaypointGraph) -> None:
         self.graph = graph
         self._paths: dict[tuple[int, int], np.ndarray | None] = {}
-        ladders = np.flatnonzero(graph.edge_kind == EdgeKind.LADDER)
-        ends = graph.edge_source[ladders], graph.edge_target[ladders]
-        cheapest = graph.edges_between(*ends)
-        self._ladders = {  # the ends of a ladder, where the cheapest edge between them is it
-            (int(a), int(b)): np.array([edge])
-            for a, b, edge in zip(*ends, cheapest, strict=True)
-            if graph.edge_kind[edge] == EdgeKind.LADDER
-        }
 
     def __len__(self) -> int:
         """Number of (source, target) pairs computed so far."""
@@ -85,9 +77,9 @@ class PathCache:
         return self._paths[key]
 
     def _compute(self, source: int, target: int) -> np.ndarray | None:
-        ladder = self._ladders.get((source, target))
+        ladder = self.graph.ladder_between.get((source, target))
         if ladder is not None:
-            return ladder.copy()  # from one end to the other: on it
+            return np.array([ladder], dtype=np.int64)  # from one end to the other: on it
         try:
             nodes = np.asarray(self.graph.shortest_path(source, target), dtype=np.int64)
         except GraphError:

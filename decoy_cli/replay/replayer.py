@@ -167,6 +167,29 @@ class ReplayOptions(ReplaySpec):
     sight: OcclusionScene | None = None
     """The map's geometry line of sight is tested in (`RoundSetup.sight`; None: the world)."""
 
+    @classmethod
+    def of(
+        cls,
+        spec: ReplaySpec,
+        damage_model: DamageModel | None,
+        *,
+        seed: int | None = None,
+        sight: OcclusionScene | None = None,
+    ) -> ReplayOptions:
+        """The options of a replay as `spec` says (a command's, an evaluation's settings),
+        shooting with `damage_model` (None: no shooting), at `seed` when given."""
+        return cls(
+            mover=spec.mover,
+            combat=spec.combat and damage_model is not None,
+            bomb=spec.bomb,
+            seed=spec.seed if seed is None else seed,
+            deaths=spec.deaths,
+            missing=spec.missing,
+            implausible=spec.implausible,
+            damage_model=damage_model,
+            sight=sight,
+        )
+
     def setup(self, graph: WaypointGraph, round_: Round) -> RoundSetup:
         """The simulator setup of a replay of `round_` on `graph`."""
         rules = RulesConfig(auto_pickup=False)  # the data says who picks the bomb up

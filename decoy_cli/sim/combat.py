@@ -279,6 +279,7 @@ class CombatStep:
         self.map_name = map_name
         self.kills = kills
         self._in_sight_since = np.full((los.count, los.count), -1, dtype=np.int64)
+        self._reaction_ticks = seconds_to_ticks(REACTION_S)
 
     def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]:
         """Run the step on the agents (changed in place); the model is not called when no
@@ -292,7 +293,7 @@ class CombatStep:
         since.fill(-1)
         seen = np.where(seen_before >= 0, seen_before, tick)
         since[pairs.attacker, pairs.victim] = seen
-        aims = seen <= tick - seconds_to_ticks(REACTION_S)
+        aims = seen <= tick - self._reaction_ticks
         yaw = aimed_yaw(agents, pairs, aims)
         batch = make_batch(agents, pairs, self.map_name, yaw)
         return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)

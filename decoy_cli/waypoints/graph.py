@@ -249,6 +249,19 @@ class WaypointGraph:
         """(L,) one edge of each ladder (the one from its lower end), in edge order."""
         return np.flatnonzero((self.edge_kind == EdgeKind.LADDER) & (self.edge_rise_m > 0))
 
+    @cached_property
+    def ladder_between(self) -> dict[tuple[int, int], int]:
+        """The ladder edge from one end of a ladder to the other, either way, by (source,
+        target): where the cheapest edge between the two is the ladder."""
+        edges = np.flatnonzero(self.edge_kind == EdgeKind.LADDER)
+        ends = self.edge_source[edges], self.edge_target[edges]
+        cheapest = self.edges_between(*ends)
+        return {
+            (int(a), int(b)): int(edge)
+            for a, b, edge in zip(*ends, cheapest, strict=True)
+            if self.edge_kind[edge] == EdgeKind.LADDER
+        }
+
     def on_ladders(self, points: np.ndarray, reach: float = LADDER_REACH_M) -> np.ndarray:
         """(M, L) which of the `ladders` each of the points (M, 3) is on: between the heights of
         its two ends and within `reach` of the line between them across the floor (ladders
