@@ -24,7 +24,10 @@ reality's geometry would have prevented.
 
 Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
 frames) against those in which the replay's fight damaged one, and the HP real victims had one
-frame before they died (how fast real fights end). Nothing here is timed.
+frame before they died (how fast real fights end). And where each damages: per player-second
+alive in both (a frame to the next), by how many enemies see him at the frame (real positions,
+nav world), the share in which he lost HP in the data and the share in which the replay's fight
+damaged him. Nothing here is timed.
 """
 
 from __future__ import annotations
@@ -106,6 +109,39 @@ def sightings(round_, graph, model, sight) -> list[tuple[float, set[tuple[int, i
     return steps
 
 
+SIGHT_BUCKETS = 3
+"""Enemies in sight counted 0, 1, 2 or more."""
+
+
+def _damage_by_sight(round_, result, world, by_sight) -> None:
+    """Add the round's player-seconds (frame to next frame, the player alive in the data and
+    the replay) to `by_sight[enemies in sight at the frame]` = [count, lost HP in the data,
+    damaged by the replay's fight]."""
+    seconds, hp = round_.frame_seconds, round_.hp.astype(float)
+    alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
+    replay_alive = result.recording.alive.T
+    side = np.array([p.side for p in round_.players])
+    eyes = round_.position + EYE
+    damaged = np.zeros(alive.shape, bool)
+    for event in result.events:
+        if event.kind == "damage":
+            frame = int(np.searchsorted(seconds, event.tick / TICK_RATE, side="right")) - 1
+            if 0 <= frame < len(seconds):
+                damaged[int(event.other), frame] = True
+    for frame in range(len(seconds) - 1):
+        for victim in np.flatnonzero(alive[:, frame] & replay_alive[:, frame]):
+            enemies = np.flatnonzero(alive[:, frame] & (side != side[victim]))
+            starts = eyes[enemies, frame]
+            ends = np.repeat(eyes[victim, frame][None], len(enemies), axis=0)
+            known = np.isfinite(starts).all(axis=1) & np.isfinite(ends).all(axis=1)
+            seen_by = int(world.line_of_sight(starts[known], ends[known]).sum())
+            lost = not alive[victim, frame + 1] or hp[victim, frame + 1] < hp[victim, frame]
+            row = by_sight[min(seen_by, SIGHT_BUCKETS - 1)]
+            row[0] += 1
+            row[1] += lost
+            row[2] += bool(damaged[victim, frame])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("inputs", nargs="+", type=Path)
@@ -131,6 +167,7 @@ def main() -> None:
     fates = collections.Counter()
     fight_kills = collections.Counter()
     kills = real_seconds = replay_seconds = 0
+    by_sight: dict[int, list[int]] = collections.defaultdict(lambda: [0, 0, 0])
     files, _ = collect_match_files(args.inputs)
     for round_ in iter_rounds(files, map_name="de_dust2"):
         if isinstance(round_, RoundFailure) or len(round_.side_indices("CT")) == 0:
@@ -210,6 +247,7 @@ def main() -> None:
         replay_seconds += len(
             {(e.other, e.tick // 60) for e in result.events if e.kind == "damage"}
         )
+        _damage_by_sight(round_, result, worlds["nav world"], by_sight)
     print(f"{kills} real firearm kills")
     for name, count in seen.items():
         print(f"  line of sight at the kill, {name}: {count / max(kills, 1):.2f}")
@@ -231,6 +269,13 @@ def main() -> None:
             f"{fight_kills[(kind, 'all')]}; at a real frame within 1 s: {line}"
         )
     print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
+    print("damaged within the next frame, by enemies in sight at the frame (nav world):")
+    for seen_by, (seconds, real, replay) in sorted(by_sight.items()):
+        label = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
+        print(
+            f"  {label} in sight: {seconds} player-seconds, data {real / seconds:.3f}, "
+            f"replay's fight {replay / seconds:.3f}"
+        )
     full = np.asarray(hp_before_death) >= 100
     print(f"real deaths from full HP within one frame: {full.sum()} of {len(full)}")
 
