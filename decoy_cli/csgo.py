@@ -122,3 +122,9 @@ def fall_damage(height_m: float) -> int:
         return 0
     per_speed = 100 / (FATAL_FALL_SPEED_U_S - SAFE_FALL_SPEED_U_S)
     return round((speed_u_s - SAFE_FALL_SPEED_U_S) * per_speed)
+
+
+def is_pistol_round(round_num: int, tick_rate: int) -> bool:
+    """Round 1 and the first of the second half: 13 in CS2's MR12 (its demos run at 64 ticks),
+    16 in CS:GO's MR15. Its $800 start money buys a vest ($650), not a vest and helmet ($1000)."""
+    return round_num in ((1, 13) if tick_rate == 64 else (1, 16))

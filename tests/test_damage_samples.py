@@ -14,6 +14,7 @@ from esta_fixtures import (
     CT_PLAYERS,
     ROUND2_TICKS,
     T_PLAYERS,
+    TICK_RATE,
     _damage,
     expected_hammer_position,
     make_match,
@@ -202,6 +203,36 @@ def test_events_mode_by_hand(tmp_path: Path) -> None:
     # t1 took 27 HP at tick 5070: 73 left at both anchors
     assert sorted(negatives.victim_hp.tolist()) == [73, 73, 100]
     assert set(negatives.attacker_weapon) == {"M4A4"}
+
+
+def _t1_helmet(tmp_path: Path, armour_taken: int, round_num: int) -> bool:
+    """The helmet events mode infers for t1 in round 2, whose two hits by ct1 (27 HP, then
+    10 HP that took 4 armour) record no hit group, the first taking `armour_taken` armour."""
+    document = make_match()
+    document["gameRounds"] = document["gameRounds"][:2]  # round 2 last, whatever its number
+    round2 = document["gameRounds"][1]
+    round2["roundNum"] = round_num
+    second = {**_damage(5080.0, "ct1", "t1", "M4A4", 10)}
+    round2["damages"] = [_damage(5070.0, "ct1", "t1", "M4A4", 27), second, *round2["damages"][1:]]
+    for row in round2["damages"][:2]:
+        row["hitGroup"] = None
+    round2["damages"][0]["armorDamage"] = round2["damages"][0]["armorDamageTaken"] = armour_taken
+    tmp_path.mkdir()
+    samples, _ = build_samples([write(tmp_path, document)], mode="events")
+    hits = samples.take(samples.hit)
+    (row,) = np.flatnonzero(hits.victim_position[:, 0] == metres("t1", 1)[0])
+    assert hits.victim_armor[row] == 100  # the second hit took armour
+    return bool(hits.victim_helmet[row])
+
+
+def test_events_mode_infers_the_helmet_by_the_armour_rules(tmp_path: Path) -> None:
+    """Without hit groups: 27 HP that took no armour from an armoured player is more than an
+    M4A4 leg shot does (24 HP at this range), so it was a bare head; hits that say nothing
+    leave the helmet with the armour, except in a pistol round ($800 buys no helmet)."""
+    assert _t1_helmet(tmp_path / "a", armour_taken=0, round_num=2) is False
+    assert _t1_helmet(tmp_path / "b", armour_taken=4, round_num=2) is True
+    pistol_round = 16 if TICK_RATE == 128 else 13  # CS:GO's MR15, CS2's MR12
+    assert _t1_helmet(tmp_path / "c", armour_taken=4, round_num=pistol_round) is False
 
 
 def test_events_mode_uses_flashes(tmp_path: Path) -> None:

@@ -246,7 +246,7 @@ def test_replay_shoots_with_the_default_models_and_decides_the_round(tmp_path: P
     """By default the replay shoots with the shipped DIP and the game's damage rules; a round the
     data leaves open is played on until the rules end it, and the summary says so."""
     out = tmp_path / "out"
-    result = _invoke(f"{SAMPLE}:5", "--out", str(out))
+    result = _invoke(f"{SAMPLE}:7", "--out", str(out))
     assert result.exit_code == 0, result.output
     assert "combat on" in result.stdout
     summary = json.loads((out / "summary.json").read_text())

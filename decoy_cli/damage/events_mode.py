@@ -14,8 +14,11 @@ negative attacker). Bomb events carry no view yaw: they give anchor times, not s
 attacker's weapon is the firearm of its nearest-in-time damage or kill row of the round (a
 player who never hits or kills with a firearm in the round is never an attacker). HP is 100
 minus the player's hpDamageTaken in the round before the tick. Armor and helmet, not in events,
-are inferred per round and player: armor if any hit on the player removed armor; helmet if a
-head hit removed armor, no helmet if a head hit removed none, else helmet = armor; a player
+are inferred per round and player by the game's armour rules: armor if any hit on the player
+removed armor; helmet if a head hit removed armor, no helmet if a head hit removed none or, where
+the data records no hit group, a hit removed no armour from the armoured player yet cost more HP
+than a leg shot of its weapon at its distance can (only a bare head takes that); else helmet =
+armor, but none in a pistol round (`is_pistol_round`: its start money buys no helmet); a player
 never hit counts as armored with a helmet. The biases of this proxy are stated in
 models/DIP_CARD.md.
 """
@@ -26,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from decoy_cli.csgo import is_pistol_round
 from decoy_cli.damage.damage_rows import (
     VOCABULARY,
     DamageRows,
@@ -37,6 +41,7 @@ from decoy_cli.damage.damage_rows import (
     step_clock,
     strings,
 )
+from decoy_cli.damage.rules import WEAPON_RULES, shot_damage
 from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
 from decoy_cli.esta import Round
 from decoy_cli.sim.combat import NO_HIT
@@ -143,16 +148,38 @@ class _EventRound:
         return (100 if has_armor else 0), helmet
 
     def _infer_armor(self) -> dict[object, tuple[bool, bool]]:
-        """Per player hit in the round: (armor, helmet) from the armor its hits removed."""
+        """Per player hit in the round: (armor, helmet) from what its hits say (module doc)."""
         hit_group = strings(self.round.damages, "hitGroup")
+        bare_head = self._bare_head_hits(hit_group)
+        pistol_round = is_pistol_round(self.round.round_num, self.round.tick_rate)
         out: dict[object, tuple[bool, bool]] = {}
         for player in {k for k in self.damages.victim if k is not None}:
             rows = self.damages.victim == player
             armor = bool(np.any(self.damages.armor_damage[rows] > 0))
             head = rows & (hit_group == "Head")
-            helmet = bool(np.any(self.damages.armor_damage[head] > 0)) if head.any() else armor
+            if head.any():
+                helmet = bool(np.any(self.damages.armor_damage[head] > 0))
+            else:
+                helmet = armor and not pistol_round and not np.any(bare_head[rows])
             out[player] = (armor or helmet, helmet)
         return out
+
+    def _bare_head_hits(self, hit_group: np.ndarray) -> np.ndarray:
+        """(D,) bool: hits without a recorded group that took no armour and more HP than a leg
+        shot of their weapon at their distance does (unarmoured, the most a leg takes)."""
+        table, rows = self.round.damages, self.damages
+        ends = [
+            table[[f"{who}{axis}" for axis in "XYZ"]].to_numpy(np.float64)
+            for who in ("attacker", "victim")
+        ]
+        distance = np.linalg.norm(ends[1] - ends[0], axis=1)
+        bare = np.zeros(len(distance), dtype=bool)
+        for d in np.flatnonzero((hit_group == "") & rows.usable & (rows.armor_damage <= 0)):
+            weapon = str(rows.weapon[d])
+            if weapon in WEAPON_RULES and np.isfinite(distance[d]):
+                leg = shot_damage(weapon, "Leg", float(distance[d]), armor=0, helmet=False).health
+                bare[d] = rows.hp_taken[d] > leg + 1
+        return bare
 
 
 def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples:

@@ -40,6 +40,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
+from decoy_cli.csgo import is_pistol_round
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Round
 from decoy_cli.esta.frames import Side
@@ -109,12 +110,6 @@ def lacking(round_: Round) -> tuple[str, ...]:
     if round_.end_reason == "BombDefused" and not defused:
         names.append("defuser")
     return tuple(names)
-
-
-def is_pistol_round(round_num: int, tick_rate: int) -> bool:
-    """Round 1 and the first of the second half: 13 in CS2's MR12 (its demos run at 64 ticks),
-    16 in CS:GO's MR15."""
-    return round_num in ((1, 13) if tick_rate == 64 else (1, 16))
 
 
 def _firearm(name: object) -> bool:
