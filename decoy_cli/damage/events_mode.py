@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from decoy_cli.csgo import is_pistol_round
+from decoy_cli.csgo import HAMMER_TO_M, is_pistol_round
 from decoy_cli.damage.damage_rows import (
     VOCABULARY,
     DamageRows,
@@ -169,10 +169,10 @@ class _EventRound:
         shot of their weapon at their distance does (unarmoured, the most a leg takes)."""
         table, rows = self.round.damages, self.damages
         ends = [
-            table[[f"{who}{axis}" for axis in "XYZ"]].to_numpy(np.float64)
+            table[[f"{who}{axis}_m" for axis in "XYZ"]].to_numpy(np.float64)
             for who in ("attacker", "victim")
         ]
-        distance = np.linalg.norm(ends[1] - ends[0], axis=1)
+        distance = np.linalg.norm(ends[1] - ends[0], axis=1) / HAMMER_TO_M
         bare = np.zeros(len(distance), dtype=bool)
         for d in np.flatnonzero((hit_group == "") & rows.usable & (rows.armor_damage <= 0)):
             weapon = str(rows.weapon[d])
