@@ -166,7 +166,6 @@ def test_evaluate_the_paper_models(data: Path, tmp_path: Path) -> None:
     [
         (["train", "dip", "{missing}"], "error: {missing}: no such file or folder"),
         (["train", "dip", "{data}"], "error: a split by match needs at least 3 matches"),
-        (["train", "dip", "{data}", "--split", "round", "--balance", "x"], "error: balance"),
         (["train", "dip", "{data}", "--epochs", "0"], "error: epochs must be at least 1"),
         (["train", "dog", "{data}", "--kl-weight", "-1"], "error: the KL weight must not"),
         (["train", "dip", "{empty}"], "error: {empty}: no usable samples"),
@@ -209,6 +208,26 @@ def test_the_sample_options_are_one_group_with_choices(
     shown = runner.invoke(app, [*command[:2], "--help"], env=WIDE).output
     for text in ("--mode", "auto|frames|events", "--split", "match|round", "--val-fraction"):
         assert text in shown
+
+
+@pytest.mark.parametrize(
+    ("command", "option", "value", "choices"),
+    [
+        (["train", "dip"], "--balance", "x", "all|eval|none"),
+        (["models", "evaluate", "rules"], "--subset", "some", "all|train|val|test"),
+        (["models", "calibrate", "models"], "--method", "isotonic", "platt|temperature|none"),
+        (["models", "calibrate", "models"], "--decision", "coin", "threshold|bernoulli"),
+    ],
+)
+def test_a_choice_of_a_damage_command_is_listed_and_a_bad_one_refused(
+    command: list[str], option: str, value: str, choices: str, data: Path
+) -> None:
+    """--balance, --subset, --method and --decision take one of a listed few: a bad value is
+    one usage line before anything is read, and the help lists them."""
+    result = runner.invoke(app, [*command, str(data), option, value], env=WIDE)
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.output
+    assert f"Invalid value for '{option}'" in result.stderr
+    assert choices in runner.invoke(app, [*command[:2], "--help"], env=WIDE).output
 
 
 def test_a_corrupt_file_is_reported_and_training_goes_on(data: Path, tmp_path: Path) -> None:

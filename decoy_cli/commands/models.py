@@ -24,11 +24,13 @@ from decoy_cli.commands._damage_output import (
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
+from decoy_cli.damage.calibration import CalibrationKind, Decision
 from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
 from decoy_cli.damage.scores import MIN_CELL
+from decoy_cli.damage.split import SplitPart
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
 
@@ -149,10 +151,10 @@ def fit_rules_command(
 def calibrate(
     model_folder: Path = typer.Argument(..., help="A model folder with dip.pt/json."),
     data: list[Path] = typer.Argument(..., help=DATA_HELP),
-    method: str = typer.Option(
+    method: CalibrationKind = typer.Option(
         "platt", "--method", help="platt (two parameters), temperature (one) or none."
     ),
-    decision: str = typer.Option(
+    decision: Decision = typer.Option(
         "threshold",
         "--decision",
         help="How the combat step decides a hit from the calibrated probability: threshold "
@@ -164,14 +166,8 @@ def calibrate(
     scaling) and write dip_calibration.json into the folder; prints the Brier score and the
     expected calibration error before and after on the validation and test parts (the same
     split options as training give the same parts)."""
-    from decoy_cli.damage.calibration import DECISIONS, KINDS
     from decoy_cli.damage.folder_calibration import calibrate_dip_folder
 
-    if method not in KINDS or decision not in DECISIONS:
-        raise DecoyError(
-            f"--method {method!r} / --decision {decision!r}: the methods are "
-            f"{', '.join(KINDS)}, the decisions {', '.join(DECISIONS)}"
-        )
     if (model_folder / "dip.json").is_file():
         check_folder_writable(model_folder)
     choice = samples.choice(data)
@@ -216,7 +212,7 @@ def evaluate(
     out: Path = typer.Option(
         DEFAULT_EVALUATE_OUT, "--out", help="Folder for metrics.json and the figures."
     ),
-    subset: str = typer.Option(
+    subset: SplitPart = typer.Option(
         DEFAULT_SUBSET,
         "--subset",
         help="Samples to evaluate on: all, or the train, val or test part of the split below "

@@ -42,6 +42,7 @@ from decoy_cli.damage.train_options import (
     PATIENCE,
     THREADS,
     XAVIER,
+    Balance,
     DogLossWeights,
     TrainOptions,
 )
@@ -114,7 +115,7 @@ def dip(
     epochs: int = typer.Option(DIP_EPOCHS, "--epochs", help="Most epochs (the paper's)."),
     fitting: Fitting = Fitting(),
     samples: SampleOptions = SampleOptions(),
-    balanced: str = typer.Option(
+    balanced: Balance = typer.Option(
         DEFAULT_BALANCE,
         "--balance",
         help="1:1 balancing of positives and negatives: all parts (the paper's), eval (train "

@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -114,8 +115,10 @@ def _logit(p: np.ndarray) -> np.ndarray:
     return np.log(q / (1 - q))
 
 
-DECISIONS = ("threshold", "bernoulli")
-KINDS = ("platt", "temperature", "none")
+Decision = Literal["threshold", "bernoulli"]
+CalibrationKind = Literal["platt", "temperature", "none"]
+DECISIONS: tuple[Decision, ...] = get_args(Decision)
+KINDS: tuple[CalibrationKind, ...] = get_args(CalibrationKind)
 
 
 @dataclass(frozen=True)
@@ -123,11 +126,11 @@ class Calibration:
     """p' = σ(a·logit(p) + b), its kind ("platt", "temperature" or "none"), the decision
     threshold on the calibrated probability and the combat step's decision rule."""
 
-    kind: str
+    kind: CalibrationKind
     a: float
     b: float
     threshold: float
-    decision: str = "threshold"
+    decision: Decision = "threshold"
 
     def decide(self, probabilities: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """(K,) bool: which pairs hit, by `decision` on the calibrated probabilities."""
@@ -178,9 +181,9 @@ def _log_loss(y: np.ndarray, z: np.ndarray) -> float:
 def fit_calibration(
     labels: np.ndarray,
     probabilities: np.ndarray,
-    kind: str,
+    kind: CalibrationKind,
     threshold: float,
-    decision: str = "threshold",
+    decision: Decision = "threshold",
 ) -> Calibration:
     """Fit Platt or temperature scaling on validation samples by minimising the log loss;
     `threshold` (the raw model's) is carried over to the calibrated scale."""

@@ -13,12 +13,19 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.calibration import Calibration, calibration_scores, fit_calibration
+from decoy_cli.damage.calibration import (
+    Calibration,
+    CalibrationKind,
+    Decision,
+    calibration_scores,
+    fit_calibration,
+)
 from decoy_cli.damage.provenance import FileCallback, SampleChoice
 from decoy_cli.damage.sample_set import SampleStats
+from decoy_cli.damage.split import SplitPart
 from decoy_cli.errors import ModelError
 
-PARTS = ("val", "test")
+PARTS: tuple[SplitPart, ...] = ("val", "test")
 
 
 @dataclass(frozen=True)
@@ -36,8 +43,8 @@ def calibrate_dip_folder(
     *,
     folder: Path,
     choice: SampleChoice,
-    kind: str,
-    decision: str = "threshold",
+    kind: CalibrationKind,
+    decision: Decision = "threshold",
     on_file: FileCallback | None = None,
 ) -> CalibrationResult:
     """Fit the DIP calibration of `folder` on the validation samples and save it (module doc).
@@ -63,7 +70,7 @@ def calibrate_dip_folder(
         )
     except ValueError as error:
         raise ModelError(str(error)) from None
-    scores = {}
+    scores: dict[str, dict[str, float]] = {}
     for part, (labels, probabilities) in parts.items():
         scores[part] = {
             "samples": float(len(labels)),

@@ -23,10 +23,10 @@ from decoy_cli.damage.hp_lost import HpLostScores
 from decoy_cli.damage.provenance import FileCallback, SampleChoice, write_json
 from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import balance
+from decoy_cli.damage.split import SplitPart, balance
 from decoy_cli.errors import ModelError
 
-DEFAULT_SUBSET = "all"
+DEFAULT_SUBSET: SplitPart = "all"
 """Score on every sample; or "train", "val", "test": that part of the split."""
 BALANCED = True
 """DIP is scored on all positives and as many random negatives (the paper's 1:1)."""
@@ -41,7 +41,7 @@ class FolderEvaluation:
     report written to `out`/metrics.json and the figures."""
 
     name: str
-    subset: str
+    subset: SplitPart
     samples: int
     stats: SampleStats
     dip: DipEvaluation | None
@@ -65,7 +65,7 @@ def evaluate_model_folder(
     models: ModelChoice,
     choice: SampleChoice,
     out: Path,
-    subset: str = DEFAULT_SUBSET,
+    subset: SplitPart = DEFAULT_SUBSET,
     balanced: bool = BALANCED,
     threshold: float | None = None,
     draws: int = DRAWS,
@@ -204,7 +204,9 @@ def evaluate_dip_by_map(
     return evaluate_dip(loaded, samples.take(chosen), threshold), by_map, names
 
 
-def _hit_samples(choice: SampleChoice, samples: Samples, subset: str, index: np.ndarray) -> Samples:
+def _hit_samples(
+    choice: SampleChoice, samples: Samples, subset: SplitPart, index: np.ndarray
+) -> Samples:
     """One sample per firearm hit of the data's rounds (`events_mode.hit_samples`), of the
     rounds of `subset`'s samples only."""
     from decoy_cli.damage.events_mode import hit_samples

@@ -17,6 +17,8 @@ from decoy_cli.damage.sample_set import Samples
 from decoy_cli.errors import DecoyError
 
 SplitUnit = Literal["match", "round"]
+SplitPart = Literal["all", "train", "val", "test"]
+"""A part of a split to score on; "all" is every sample."""
 """What a split never cuts in two."""
 SPLITS: tuple[SplitUnit, ...] = get_args(SplitUnit)
 DEFAULT_SPLIT: SplitUnit = "match"
@@ -35,7 +37,7 @@ class Split:
     test: np.ndarray
     units: dict[str, list[str]]
 
-    def part(self, name: str) -> np.ndarray:
+    def part(self, name: SplitPart) -> np.ndarray:
         """The indices of "train", "val", "test" or "all" (every index, sorted)."""
         if name == "all":
             return np.sort(np.concatenate([self.train, self.val, self.test]))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Literal, get_args
 
 from decoy_cli.damage.split import DEFAULT_SEED
 from decoy_cli.errors import DecoyError
@@ -28,10 +29,11 @@ DAMAGE_WEIGHT = 1.0
 HIT_GROUP_WEIGHT = 0.7
 KL_WEIGHT = 0.2
 
-BALANCE = ("all", "eval", "none")
+Balance = Literal["all", "eval", "none"]
+BALANCE: tuple[Balance, ...] = get_args(Balance)
 """DIP's 1:1 balancing: every part (the paper's), validation and test only (train on all
 samples), or none."""
-DEFAULT_BALANCE = "all"
+DEFAULT_BALANCE: Balance = "all"
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -50,6 +50,7 @@ from decoy_cli.damage.split import Split, balance
 from decoy_cli.damage.train_options import (
     BALANCE,
     DEFAULT_BALANCE,
+    Balance,
     DogLossWeights,
     TrainOptions,
 )
@@ -284,7 +285,9 @@ DipRun = Run[DipEvaluation, LoadedDip]
 DogRun = Run[DogEvaluation, LoadedDog]
 
 
-def dip_parts(samples: Samples, split: Split, balanced: str, seed: int) -> dict[str, np.ndarray]:
+def dip_parts(
+    samples: Samples, split: Split, balanced: Balance, seed: int
+) -> dict[str, np.ndarray]:
     """Train, validation and test indices for DIP, balanced 1:1 with the seed as `balanced`
     says (BALANCE)."""
     if balanced not in BALANCE:
@@ -309,7 +312,7 @@ def fit_dip(
     split: Split,
     options: TrainOptions,
     spec: FeatureSpec,
-    balanced: str = DEFAULT_BALANCE,
+    balanced: Balance = DEFAULT_BALANCE,
     progress: ProgressCallback | None = None,
 ) -> DipRun:
     """Train DIP on the training part, choose its threshold by the best F1 on the validation

@@ -28,6 +28,7 @@ from decoy_cli.damage.split import Split
 from decoy_cli.damage.train_options import (
     BALANCE,
     DEFAULT_BALANCE,
+    Balance,
     DogLossWeights,
     TrainOptions,
 )
@@ -68,7 +69,7 @@ def train_dip_model(
     options: TrainOptions,
     out: Path,
     report: Path | None = None,
-    balanced: str = DEFAULT_BALANCE,
+    balanced: Balance = DEFAULT_BALANCE,
     on_file: FileCallback | None = None,
     progress: ProgressCallback | None = None,
     units: str = "normalised",
