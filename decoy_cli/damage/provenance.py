@@ -13,13 +13,14 @@ from pathlib import Path
 
 from decoy_cli import __version__, files
 from decoy_cli.damage.sample_set import Samples, SampleStats
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, build_samples
+from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode, build_samples
 from decoy_cli.damage.split import (
     DEFAULT_SEED,
     DEFAULT_SPLIT,
     DEFAULT_TEST_FRACTION,
     DEFAULT_VAL_FRACTION,
     Split,
+    SplitUnit,
     split_samples,
 )
 from decoy_cli.damage.train_options import TrainOptions
@@ -34,9 +35,9 @@ class SampleChoice:
     samples are split (by match or round, with `seed`)."""
 
     data: Sequence[Path]
-    mode: str = DEFAULT_MODE
+    mode: SampleMode = DEFAULT_MODE
     window_s: float = DEFAULT_WINDOW_S
-    split_by: str = DEFAULT_SPLIT
+    split_by: SplitUnit = DEFAULT_SPLIT
     seed: int = DEFAULT_SEED
     val_fraction: float = DEFAULT_VAL_FRACTION
     test_fraction: float = DEFAULT_TEST_FRACTION

@@ -59,7 +59,7 @@ _FAILURES_SHOWN = 3
 
 def build_samples(
     data: Sequence[str | Path],
-    mode: str = DEFAULT_MODE,
+    mode: SampleMode = DEFAULT_MODE,
     window_s: float = DEFAULT_WINDOW_S,
     on_file: Callable[[Path, int, int], None] | None = None,
 ) -> tuple[Samples, SampleStats]:

@@ -47,7 +47,7 @@ class Split:
 
 
 def split_samples(
-    samples: Samples, by: str, seed: int, val_fraction: float, test_fraction: float
+    samples: Samples, by: SplitUnit, seed: int, val_fraction: float, test_fraction: float
 ) -> Split:
     """Split by match or by round (never by sample): the units, sorted, are shuffled with the
     seed; the first round(test_fraction * n) (at least 1) go to test, the next
