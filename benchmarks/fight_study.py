@@ -24,10 +24,10 @@ reality's geometry would have prevented.
 
 Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
 frames) against those in which the replay's fight damaged one, and the HP real victims had one
-frame before they died (how fast real fights end). And where each damages: per player-second
-alive in both (a frame to the next), by how many enemies see him at the frame (real positions,
-nav world), the share in which he lost HP in the data and the share in which the replay's fight
-damaged him. Nothing here is timed.
+frame before they died (how fast real fights end). And where each damages: per player-frame
+alive in both (a frame to the next; a player-second at 1 frame/s), by how many enemies see him
+at the frame (real positions, nav world), the share in which he lost HP in the data and the
+share in which the replay's fight damaged him. Nothing here is timed.
 """
 
 from __future__ import annotations
@@ -114,27 +114,30 @@ SIGHT_BUCKETS = 3
 
 
 def _damage_by_sight(round_, result, world, by_sight) -> None:
-    """Add the round's player-seconds (frame to next frame, the player alive in the data and
-    the replay) to `by_sight[enemies in sight at the frame]` = [count, lost HP in the data,
-    damaged by the replay's fight]."""
-    seconds, hp = round_.frame_seconds, round_.hp.astype(float)
-    alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
-    replay_alive = result.recording.alive.T
+    """Add the round's player-frames (a frame to the next, the player alive in the data and the
+    replay, his position and both HP known) to `by_sight[enemies in sight at the frame]` =
+    [count, lost HP in the data, damaged by the replay's fight]."""
+    hp = round_.hp.astype(float)
+    present = np.asarray(round_.present, bool)
+    alive = np.asarray(round_.alive, bool) & present
+    replay_alive = result.recording.alive.T  # one row per data frame (replay_round)
     side = np.array([p.side for p in round_.players])
     eyes = round_.position + EYE
     damaged = np.zeros(alive.shape, bool)
     for event in result.events:
-        if event.kind == "damage":
-            frame = int(np.searchsorted(seconds, event.tick / TICK_RATE, side="right")) - 1
-            if 0 <= frame < len(seconds):
+        if event.kind == "damage":  # on the simulator's clock, as the frames' ticks
+            frame = int(np.searchsorted(result.frame_ticks, event.tick, side="right")) - 1
+            if 0 <= frame < alive.shape[1]:
                 damaged[int(event.other), frame] = True
-    for frame in range(len(seconds) - 1):
-        for victim in np.flatnonzero(alive[:, frame] & replay_alive[:, frame]):
+    known_next = present[:, 1:] & (hp[:, 1:] >= 0) & (hp[:, :-1] >= 0)
+    for frame in range(alive.shape[1] - 1):
+        seen_at = alive[:, frame] & replay_alive[:, frame] & known_next[:, frame]
+        for victim in np.flatnonzero(seen_at & np.isfinite(eyes[:, frame]).all(axis=1)):
             enemies = np.flatnonzero(alive[:, frame] & (side != side[victim]))
             starts = eyes[enemies, frame]
-            ends = np.repeat(eyes[victim, frame][None], len(enemies), axis=0)
-            known = np.isfinite(starts).all(axis=1) & np.isfinite(ends).all(axis=1)
-            seen_by = int(world.line_of_sight(starts[known], ends[known]).sum())
+            starts = starts[np.isfinite(starts).all(axis=1)]
+            ends = np.repeat(eyes[victim, frame][None], len(starts), axis=0)
+            seen_by = int(world.line_of_sight(starts, ends).sum())
             lost = not alive[victim, frame + 1] or hp[victim, frame + 1] < hp[victim, frame]
             row = by_sight[min(seen_by, SIGHT_BUCKETS - 1)]
             row[0] += 1
@@ -273,7 +276,7 @@ def main() -> None:
     for seen_by, (seconds, real, replay) in sorted(by_sight.items()):
         label = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
         print(
-            f"  {label} in sight: {seconds} player-seconds, data {real / seconds:.3f}, "
+            f"  {label} in sight: {seconds} player-frames, data {real / seconds:.3f}, "
             f"replay's fight {replay / seconds:.3f}"
         )
     full = np.asarray(hp_before_death) >= 100

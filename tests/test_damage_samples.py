@@ -206,14 +206,14 @@ def test_events_mode_by_hand(tmp_path: Path) -> None:
 
 
 def _t1_helmet(tmp_path: Path, armour_taken: int, round_num: int) -> bool:
-    """The helmet events mode infers for t1 in round 2, whose two hits by ct1 (27 HP, then
+    """The helmet events mode infers for t1 in round 2, whose two hits by ct1 (25 HP, then
     10 HP that took 4 armour) record no hit group, the first taking `armour_taken` armour."""
     document = make_match()
     document["gameRounds"] = document["gameRounds"][:2]  # round 2 last, whatever its number
     round2 = document["gameRounds"][1]
     round2["roundNum"] = round_num
     second = {**_damage(5080.0, "ct1", "t1", "M4A4", 10)}
-    round2["damages"] = [_damage(5070.0, "ct1", "t1", "M4A4", 27), second, *round2["damages"][1:]]
+    round2["damages"] = [_damage(5070.0, "ct1", "t1", "M4A4", 25), second, *round2["damages"][1:]]
     for row in round2["damages"][:2]:
         row["hitGroup"] = None
     round2["damages"][0]["armorDamage"] = round2["damages"][0]["armorDamageTaken"] = armour_taken
@@ -226,13 +226,33 @@ def _t1_helmet(tmp_path: Path, armour_taken: int, round_num: int) -> bool:
 
 
 def test_events_mode_infers_the_helmet_by_the_armour_rules(tmp_path: Path) -> None:
-    """Without hit groups: 27 HP that took no armour from an armoured player is more than an
-    M4A4 leg shot does (24 HP at this range), so it was a bare head; hits that say nothing
-    leave the helmet with the armour, except in a pistol round ($800 buys no helmet)."""
+    """Without hit groups: 25 HP that took no armour from an armoured player is more than an
+    M4A4 leg shot does at this range (23 HP at 776 u; 24 HP at 19.7 u, the distance in metres
+    misread as Hammer units), so it was a bare head; hits that say nothing leave the helmet with
+    the armour, except in a pistol round ($800 buys no helmet)."""
     assert _t1_helmet(tmp_path / "a", armour_taken=0, round_num=2) is False
     assert _t1_helmet(tmp_path / "b", armour_taken=4, round_num=2) is True
-    pistol_round = 16 if TICK_RATE == 128 else 13  # CS:GO's MR15, CS2's MR12
-    assert _t1_helmet(tmp_path / "c", armour_taken=4, round_num=pistol_round) is False
+    assert _t1_helmet(tmp_path / "c", armour_taken=4, round_num=PISTOL_ROUND) is False
+
+
+PISTOL_ROUND = 16 if TICK_RATE == 128 else 13  # CS:GO's MR15, CS2's MR12
+
+
+@pytest.mark.parametrize(("round_num", "helmet"), [(2, True), (PISTOL_ROUND, False)])
+def test_a_player_never_hit_wears_what_a_hit_one_would(
+    tmp_path: Path, round_num: int, helmet: bool
+) -> None:
+    """t3, flashed but never hit, is a victim of negatives only: a helmet as the armoured hit
+    players have, but none in a pistol round, where no hit player has one either (else the
+    helmet would tell the samples apart)."""
+    document = make_match()
+    document["gameRounds"] = document["gameRounds"][:2]
+    document["gameRounds"][1]["roundNum"] = round_num
+    document["gameRounds"][1]["flashes"] = [flash(5100, "ct3", "t3")]
+    samples, _ = build_samples([write(tmp_path, document)], mode="events")
+    t3 = np.flatnonzero(np.all(np.isclose(samples.victim_position, metres("t3", 1)), axis=1))
+    assert len(t3) == 4 and not samples.hit[t3].any()
+    assert samples.victim_helmet[t3].tolist() == [helmet] * 4
 
 
 def test_events_mode_uses_flashes(tmp_path: Path) -> None:

@@ -67,9 +67,9 @@ def cliff_edge(graph) -> int:
     return int(deep[0])
 
 
-def _round(graph, mover, hp: list[int], edge: int):
+def _round(graph, mover, hp: list[int], edge: int, kills: bool = True):
     """Two agents on the source of `edge` walking it (health `hp`), and a CT far away (100);
-    returns the sim."""
+    returns the sim (`kills` False: nothing in it kills, as when deaths follow the data)."""
     start = int(graph.edge_source[edge])
     direction = int(graph.edge_direction[edge])
     far = int(np.argmin(graph.positions[:, 0]))
@@ -85,7 +85,8 @@ def _round(graph, mover, hp: list[int], edge: int):
             plan = plans.get(agent, [])
             return plan.pop(0) if plan else Decision(STOP_ACTION, hold_ticks=10**6)
 
-    return Simulator(graph, agents, mover, Walk(), BombRules(zones, RulesConfig()), seed=0)
+    rules = BombRules(zones, RulesConfig())
+    return Simulator(graph, agents, mover, Walk(), rules, kills=kills, seed=0)
 
 
 @pytest.mark.parametrize("mover_kind", ["kinematic", "physics"])
@@ -105,6 +106,18 @@ def test_landing_from_the_cliff_costs_health_and_can_kill(cliff, mover_kind: str
     deaths = [e for e in sim.events if e.kind == "death"]
     assert [(e.agent, e.data["reason"]) for e in deaths] == [(1, "fall")]
     assert deaths[0].tick == falls[1].tick  # (with capsules, b waits for a to clear the way)
+
+
+def test_a_fall_kills_nobody_when_deaths_follow_the_data(cliff) -> None:
+    """With `kills` off (`--deaths data`: the fight leaves 1 HP, the data says who dies) a fall
+    that would kill leaves its 1 HP too: a wounded player who falls is not a death the data
+    does not have."""
+    _, graph = cliff
+    sim = _round(graph, KinematicMover(), [100, 1], cliff_edge(graph), kills=False)
+    sim.run(to_tick=300)
+    assert [e.agent for e in sim.events if e.kind == "fall_damage"] == [0, 1]
+    assert sim.agents.alive.all() and sim.agents.hp[1] == 1
+    assert not [e for e in sim.events if e.kind == "death"]
 
 
 def test_a_fall_that_kills_the_last_t_ends_the_round_on_the_landing_tick(cliff) -> None:

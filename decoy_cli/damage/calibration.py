@@ -162,7 +162,10 @@ class Calibration:
         """A calibration written by `to_json`; anything else is a ValueError."""
         data = json.loads(text)
         if not isinstance(data, dict) or data.get("kind") not in KINDS:
-            raise ValueError(f"not a DIP calibration: kind {data.get('kind')!r}")
+            kind = data.get("kind") if isinstance(data, dict) else None
+            raise ValueError(f"not a DIP calibration: kind {kind!r}")
+        if not all(k in data for k in ("a", "b", "threshold")):
+            raise ValueError("a DIP calibration needs a, b and threshold")
         a, b, threshold = (float(data[k]) for k in ("a", "b", "threshold"))
         if not all(math.isfinite(v) for v in (a, b, threshold)) or not 0 <= threshold <= 1:
             raise ValueError("a DIP calibration with non-finite parameters or threshold")

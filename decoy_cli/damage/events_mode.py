@@ -17,9 +17,12 @@ minus the player's hpDamageTaken in the round before the tick. Armor and helmet,
 are inferred per round and player by the game's armour rules: armor if any hit on the player
 removed armor; helmet if a head hit removed armor, no helmet if a head hit removed none or, where
 the data records no hit group, a hit removed no armour from the armoured player yet cost more HP
-than a leg shot of its weapon at its distance can (only a bare head takes that); else helmet =
-armor, but none in a pistol round (`is_pistol_round`: its start money buys no helmet); a player
-never hit counts as armored with a helmet. The biases of this proxy are stated in
+than a leg shot of its weapon at its distance and than any body shot that takes no armour (a
+few weapons' body shots take none at some ranges) can: only a bare head takes that; else helmet
+= armor, but none in a pistol round (`is_pistol_round`: its start money buys no helmet); a
+player never hit counts as armored, with a helmet but in a pistol round (so that the helmet
+does not tell the hit from the never hit). A vest worn out earlier in the round (its body hits
+then take no armour) is not followed. The biases of this proxy are stated in
 models/DIP_CARD.md.
 """
 
@@ -41,7 +44,7 @@ from decoy_cli.damage.damage_rows import (
     step_clock,
     strings,
 )
-from decoy_cli.damage.rules import WEAPON_RULES, shot_damage
+from decoy_cli.damage.rules import ARMORED_GROUPS, WEAPON_RULES, shot_damage
 from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
 from decoy_cli.esta import Round
 from decoy_cli.sim.combat import NO_HIT
@@ -115,6 +118,7 @@ class _EventRound:
         self.weapon_tick = np.concatenate(ticks)
         self.weapon_key = np.concatenate(keys)
         self.weapon_name = np.concatenate(names)
+        self.pistol_round = is_pistol_round(round_.round_num, round_.tick_rate)
         self.armor = self._infer_armor()
 
     def frame(self, ticks: np.ndarray) -> np.ndarray:
@@ -143,15 +147,15 @@ class _EventRound:
         return str(self.weapon_name[rows[np.argmin(np.abs(self.weapon_tick[rows] - tick))]])
 
     def armor_of(self, player: object) -> tuple[int, bool]:
-        """(armor as 100 or 0, helmet) as inferred; armored with a helmet when never hit."""
-        has_armor, helmet = self.armor.get(player, (True, True))
+        """(armor as 100 or 0, helmet) as inferred; armored, with a helmet but in a pistol
+        round, when never hit."""
+        has_armor, helmet = self.armor.get(player, (True, not self.pistol_round))
         return (100 if has_armor else 0), helmet
 
     def _infer_armor(self) -> dict[object, tuple[bool, bool]]:
         """Per player hit in the round: (armor, helmet) from what its hits say (module doc)."""
         hit_group = strings(self.round.damages, "hitGroup")
         bare_head = self._bare_head_hits(hit_group)
-        pistol_round = is_pistol_round(self.round.round_num, self.round.tick_rate)
         out: dict[object, tuple[bool, bool]] = {}
         for player in {k for k in self.damages.victim if k is not None}:
             rows = self.damages.victim == player
@@ -160,13 +164,14 @@ class _EventRound:
             if head.any():
                 helmet = bool(np.any(self.damages.armor_damage[head] > 0))
             else:
-                helmet = armor and not pistol_round and not np.any(bare_head[rows])
+                helmet = armor and not self.pistol_round and not np.any(bare_head[rows])
             out[player] = (armor or helmet, helmet)
         return out
 
     def _bare_head_hits(self, hit_group: np.ndarray) -> np.ndarray:
         """(D,) bool: hits without a recorded group that took no armour and more HP than a leg
-        shot of their weapon at their distance does (unarmoured, the most a leg takes)."""
+        shot of their weapon at their distance does, or a body shot on a full vest that takes no
+        armour: only a bare head does that."""
         table, rows = self.round.damages, self.damages
         ends = [
             table[[f"{who}{axis}_m" for axis in "XYZ"]].to_numpy(np.float64)
@@ -177,9 +182,19 @@ class _EventRound:
         for d in np.flatnonzero((hit_group == "") & rows.usable & (rows.armor_damage <= 0)):
             weapon = str(rows.weapon[d])
             if weapon in WEAPON_RULES and np.isfinite(distance[d]):
-                leg = shot_damage(weapon, "Leg", float(distance[d]), armor=0, helmet=False).health
-                bare[d] = rows.hp_taken[d] > leg + 1
+                bare[d] = rows.hp_taken[d] > _most_without_armour(weapon, float(distance[d])) + 1
         return bare
+
+
+def _most_without_armour(weapon: str, distance_u: float) -> int:
+    """The most HP a leg shot, or a body shot on a full vest that takes none of it, of the
+    weapon at the distance costs: what a hit that took no armour can cost but from a bare head."""
+    most = shot_damage(weapon, "Leg", distance_u, armor=0, helmet=False).health
+    for group in ARMORED_GROUPS:
+        hit = shot_damage(weapon, group, distance_u, armor=100, helmet=False)
+        if hit.armor == 0:
+            most = max(most, hit.health)
+    return most
 
 
 def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples:

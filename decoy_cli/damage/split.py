@@ -17,9 +17,9 @@ from decoy_cli.damage.sample_set import Samples
 from decoy_cli.errors import DecoyError
 
 SplitUnit = Literal["match", "round"]
+"""What a split never cuts in two."""
 SplitPart = Literal["all", "train", "val", "test"]
 """A part of a split to score on; "all" is every sample."""
-"""What a split never cuts in two."""
 SPLITS: tuple[SplitUnit, ...] = get_args(SplitUnit)
 DEFAULT_SPLIT: SplitUnit = "match"
 DEFAULT_SEED = 0

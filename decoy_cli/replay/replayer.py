@@ -205,7 +205,7 @@ class ReplayOptions(ReplaySpec):
             combat=self.combat,
             bomb=self.bomb,
             damage_model=self.damage_model,
-            combat_kills=self.deaths == "simulated",
+            kills=self.deaths == "simulated",
             rules=rules,
             sight=self.sight,
         )

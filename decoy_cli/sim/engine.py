@@ -74,6 +74,7 @@ class Simulator:
         bomb_carrier: int = -1,
         combat: CombatRunner | None = None,
         combat_every_ticks: int = COMBAT_EVERY_TICKS,
+        kills: bool = True,
         start_tick: int = 0,
         record_ticks: Sequence[int] = (),
         seed: int | None = None,
@@ -87,6 +88,7 @@ class Simulator:
         self.rules = rules
         self.combat = combat
         self.combat_every_ticks = int(combat_every_ticks)
+        self.kills = kills  # False: a fall stops at 1 HP (deaths come from elsewhere)
         self.rng = np.random.default_rng(seed)
         self.tick = start_tick
         self.events: list[SimEvent] = []
@@ -405,8 +407,9 @@ class Simulator:
 
     def _land(self, arrived: np.ndarray) -> None:
         """Fall damage for the agents that arrived at the end of a drop deeper than the safe
-        fall (`csgo.fall_damage`); a fall that takes the last health kills. Before the round's
-        end only: afterwards nothing changes health."""
+        fall (`csgo.fall_damage`); a fall that takes the last health kills, unless nothing in
+        the simulation kills (`kills`: deaths follow the data), where it leaves 1 HP. Before the
+        round's end only: afterwards nothing changes health."""
         for agent in np.flatnonzero(arrived).tolist():
             height = float(self.fall_m[agent])
             if not height:
@@ -415,7 +418,7 @@ class Simulator:
             damage = fall_damage(height)
             if self.outcome is not None or not damage or not self.agents.alive[agent]:
                 continue
-            left = max(0, int(self.agents.hp[agent]) - damage)
+            left = max(0 if self.kills else 1, int(self.agents.hp[agent]) - damage)
             self.agents.hp[agent] = left
             data = {"damage": damage, "height_m": round(height, 3)}
             self.events.append(SimEvent(self.tick, "fall_damage", agent, data=data))

@@ -89,8 +89,8 @@ class RoundSetup(Switches):
     graph: WaypointGraph
     damage_model: DamageModel | None = None
     combat_every_ticks: int = COMBAT_EVERY_TICKS
-    combat_kills: bool = True
-    """False: shooting wounds but never kills (HP stops at 1): deaths come from elsewhere, as
+    kills: bool = True
+    """False: neither shooting nor a fall kills (HP stops at 1): deaths come from elsewhere, as
     in a replay whose deaths follow the data (`--deaths data`, the paper's protocol)."""
     world: World | None = None
     sight: OcclusionScene | None = None
@@ -177,7 +177,7 @@ def open_round(
             assert physics is not None and setup.damage_model is not None
             los = LineOfSight(physics, agents.count, scene=setup.sight)
             stack.callback(los.close)
-            combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.combat_kills)
+            combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.kills)
         rules = BombRules(setup.site_zones(), setup.rules_config())
         yield Simulator(
             setup.graph,
@@ -188,6 +188,7 @@ def open_round(
             bomb_carrier=bomb_carrier if setup.bomb else -1,
             combat=combat,
             combat_every_ticks=setup.combat_every_ticks,
+            kills=setup.kills,
             start_tick=start_tick,
             record_ticks=record_ticks,
             seed=seed,
