@@ -257,7 +257,7 @@ def evaluate(
         console.print(dip_table(result.dip.metrics, f"DIP of {result.name} ({subset} samples)"))
         for where, m in result.dip_by_map.items():
             console.print(
-                f"DIP on {where} ({result.dip_of_map[where]}, threshold "
+                f"DIP on {where} ({result.dip_name}, threshold "
                 f"{m['threshold']:.3f}): recall {m['recall']:.3f}, precision "
                 f"{m['precision']:.3f}, ROC AUC {m['roc_auc']:.3f} ({m['positives']:,} "
                 f"damaging, {m['negatives']:,} not)",

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,9 @@ from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.damage.split import SplitPart, balance
 from decoy_cli.errors import ModelError
+
+if TYPE_CHECKING:
+    from decoy_cli.damage.model_folder import LoadedDip
 
 DEFAULT_SUBSET: SplitPart = "all"
 """Score on every sample; or "train", "val", "test": that part of the split."""
@@ -56,8 +60,8 @@ class FolderEvaluation:
     figures: list[Path]
     dip_by_map: dict[str, dict[str, float]] = field(default_factory=dict)
     """DIP's metrics on each map's samples (`evaluate_dip_by_map`)."""
-    dip_of_map: dict[str, str] = field(default_factory=dict)
-    """The DIP that decides hits on each map."""
+    dip_name: str = ""
+    """The DIP that decides hits (the choice's one, on every map; "" without one)."""
 
 
 def evaluate_model_folder(
@@ -96,8 +100,8 @@ def evaluate_model_folder(
     from decoy_cli.damage.evaluation import evaluate_dog
     from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
     from decoy_cli.damage.hp_lost import draw_outcomes, score_by_map
-    from decoy_cli.damage.model_folder import load_dog
-    from decoy_cli.damage.model_maps import map_warnings
+    from decoy_cli.damage.model_folder import load_dip, load_dog
+    from decoy_cli.damage.model_maps import dip_of, map_warnings
     from decoy_cli.damage.rules_model import RulesFile
 
     report: dict[str, object] = {
@@ -117,15 +121,17 @@ def evaluate_model_folder(
     name = str(models) if named else folder.name or str(folder)
     dip_result = dog_result = None
     by_map: dict[str, dict[str, float]] = {}
-    dip_of_map: dict[str, str] = {}
+    dip_name = ""
     if has_dip:
         chosen = balance(samples, index, choice.seed) if balanced else index
         if not samples.hit[chosen].any():
             raise ModelError(f"no damaging samples in the {subset} samples: DIP cannot be scored")
-        dip_result, by_map, dip_of_map = evaluate_dip_by_map(models, samples, chosen, threshold)
+        dip = dip_of(models)
+        dip_name = dip.name
+        dip_result, by_map = evaluate_dip_by_map(load_dip(dip.folder), samples, chosen, threshold)
         report["dip"] = {"balanced": balanced, **dip_result.metrics}
         report["dip_by_map"] = by_map
-        report["dip_of_map"] = dip_of_map
+        report["dip_of_map"] = dict.fromkeys(by_map, dip_name)
         figures += write_dip_figures(dip_result, out, f"DIP of {name}")
     hits = index[samples.hit[index]]
     outcome = RulesFile.load(folder) if by_rules else load_dog(folder) if has_dog else None
@@ -179,29 +185,23 @@ def evaluate_model_folder(
         out,
         figures,
         by_map,
-        dip_of_map,
+        dip_name,
     )
 
 
 def evaluate_dip_by_map(
-    models: ModelChoice, samples: Samples, chosen: np.ndarray, threshold: float | None
-) -> tuple[DipEvaluation, dict[str, dict[str, float]], dict[str, str]]:
-    """The `chosen` samples scored by the choice's DIP (`model_maps.dip_of`) at its threshold
-    (or `threshold`): the evaluation of them all, each map's metrics and the name of the DIP
-    that decided each map's hits."""
+    dip: LoadedDip, samples: Samples, chosen: np.ndarray, threshold: float | None
+) -> tuple[DipEvaluation, dict[str, dict[str, float]]]:
+    """The `chosen` samples scored by `dip` at its threshold (or `threshold`): the evaluation
+    of them all, and each map's metrics."""
     from decoy_cli.damage.evaluation import evaluate_dip
-    from decoy_cli.damage.model_folder import load_dip
-    from decoy_cli.damage.model_maps import dip_of
 
-    dip = dip_of(models)
-    loaded = load_dip(dip.folder)
     maps = np.array([str(m) for m in samples.map_name[chosen]], dtype=object)
     by_map: dict[str, dict[str, float]] = {}
     for where in sorted(set(maps.tolist())):
         rows = chosen[np.flatnonzero(maps == where)]
-        by_map[where] = evaluate_dip(loaded, samples.take(rows), threshold).metrics
-    names = dict.fromkeys(by_map, dip.name)
-    return evaluate_dip(loaded, samples.take(chosen), threshold), by_map, names
+        by_map[where] = evaluate_dip(dip, samples.take(rows), threshold).metrics
+    return evaluate_dip(dip, samples.take(chosen), threshold), by_map
 
 
 def _hit_samples(
