@@ -1,0 +1,92 @@
+"""Where real players look, and how much the DIP leans on it.
+
+    python benchmarks/aim_study.py [--models rules]
+
+1. On the round of both teams with the real view (`cs2_dust2_both/...-8hz-r02.json.xz`): how far
+   the view is from the direction of motion (moving frames, over 0.5 s), and for every real
+   kill how far the killer's view was from the victim, and the victim's from the killer, 2, 1,
+   0.5 and 0 s before it. The replay's agents look along their motion until they aim.
+2. On the real damage events (`esta_dust2_events`, `events_ancient`, as `decoy models evaluate`
+   reads them): the share of damaging and other steps DIP says "hit" for, as recorded and with
+   every victim's view turned 45, 90 and 180 degrees away (de_ancient's views are filled as
+   facing each other, de_dust2's are real).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.damage import resolve_models
+from decoy_cli.damage.evaluation import dip_probabilities
+from decoy_cli.damage.model_folder import load_dip
+from decoy_cli.damage.samples import build_samples
+from decoy_cli.esta import iter_rounds
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+ROUND_8HZ = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-8hz-r02.json.xz"
+BEFORE_S = (2.0, 1.0, 0.5, 0.0)
+MOVING_M_S = 1.0
+
+
+def _off(yaw: np.ndarray, frm: np.ndarray, to: np.ndarray) -> np.ndarray:
+    """Degrees between a view yaw and the direction from `frm` to `to`, in [-180, 180)."""
+    bearing = np.degrees(np.arctan2(to[..., 1] - frm[..., 1], to[..., 0] - frm[..., 0]))
+    return (yaw - bearing + 180.0) % 360.0 - 180.0
+
+
+def real_views() -> None:
+    (round_,) = list(iter_rounds([ROUND_8HZ]))
+    seconds, position, yaw = round_.frame_seconds, round_.position, round_.yaw
+    back = max(1, round(0.5 / float(np.median(np.diff(seconds)))))
+    moved = position[:, back:] - position[:, :-back]
+    speed = np.hypot(moved[..., 0], moved[..., 1]) / (seconds[back:] - seconds[:-back])
+    off = np.abs(_off(yaw[:, back:], position[:, :-back], position[:, back:]))
+    moving = (speed >= MOVING_M_S) & np.isfinite(off)
+    print(
+        f"view against motion, {int(moving.sum())} moving player-frames: median "
+        f"{np.median(off[moving]):.0f} deg, within 53 deg {np.mean(off[moving] <= 53):.3f}"
+    )
+    names = [p.name for p in round_.players]
+    for kill in round_.kills.itertuples():
+        a, v = names.index(kill.attackerName), names.index(kill.victimName)
+        at = [int(np.searchsorted(seconds, kill.seconds - s)) - 1 for s in BEFORE_S]
+        killer = [_off(yaw[a, f], position[a, f], position[v, f]) for f in at]
+        victim = [_off(yaw[v, f], position[v, f], position[a, f]) for f in at]
+        print(
+            f"  {kill.seconds:6.1f} s {kill.attackerName} -> {kill.victimName}: killer's view off "
+            f"the victim {[round(float(x)) for x in killer]}, victim's off the killer "
+            f"{[round(float(x)) for x in victim]} deg at {BEFORE_S} s before"
+        )
+
+
+def dip_on_facing(models: str) -> None:
+    samples, _ = build_samples([DATA / "esta_dust2_events", DATA / "events_ancient"])
+    dip = load_dip(resolve_models(models))
+    for where in sorted(set(samples.map_name.tolist())):
+        for damaging in (True, False):
+            part = samples.take(
+                np.flatnonzero((samples.map_name == where) & (samples.hit == damaging))
+            )
+            shares = []
+            for turn in (0, 45, 90, 180):
+                turned = dataclasses.replace(part, victim_yaw=part.victim_yaw + turn)
+                hit = dip_probabilities(dip, turned) >= dip.threshold
+                shares.append(f"{turn} deg {hit.mean():.3f}")
+            label = "damaging" if damaging else "other"
+            print(f"DIP says hit, {where} {label} ({len(part)}): " + ", ".join(shares))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--models", default="rules")
+    args = parser.parse_args()
+    real_views()
+    dip_on_facing(args.models)
+
+
+if __name__ == "__main__":
+    main()
