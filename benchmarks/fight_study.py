@@ -22,12 +22,11 @@ For every kill of that replay's fight: whether it reproduces a real death (withi
 at a real frame within 1 s of it in each world: the fight's kills that are wrong and that
 reality's geometry would have prevented.
 
-Then the damage over all rounds: player-seconds in which a player lost HP in the data (between
-frames) against those in which the replay's fight damaged one, and the HP real victims had one
-frame before they died (how fast real fights end). And where each damages: per player-frame
-alive in both (a frame to the next; a player-second at 1 frame/s), by how many enemies see him
-at the frame (real positions, nav world), the share in which he lost HP in the data and the
-share in which the replay's fight damaged him. Nothing here is timed.
+Then the damage over all rounds, per player-frame alive in the data and the replay (a frame to
+the next; a player-second at 1 frame/s): in how many the player lost HP in the data and in how
+many the replay's fight damaged him, in all and by how many enemies see him at the frame (real
+positions, nav world); and the HP real victims had one frame before they died (how fast real
+fights end). Nothing here is timed.
 """
 
 from __future__ import annotations
@@ -169,7 +168,7 @@ def main() -> None:
     dip = collections.Counter()
     fates = collections.Counter()
     fight_kills = collections.Counter()
-    kills = real_seconds = replay_seconds = 0
+    kills = 0
     by_sight: dict[int, list[int]] = collections.defaultdict(lambda: [0, 0, 0])
     files, _ = collect_match_files(args.inputs)
     for round_ in iter_rounds(files, map_name="de_dust2"):
@@ -246,10 +245,6 @@ def main() -> None:
             dead = np.flatnonzero(~np.asarray(round_.alive[player], bool))
             if len(dead) and dead[0] > 0:
                 hp_before_death.append(hp[player, dead[0] - 1])
-        real_seconds += int((np.diff(hp, axis=1) < 0).sum())
-        replay_seconds += len(
-            {(e.other, e.tick // 60) for e in result.events if e.kind == "damage"}
-        )
         _damage_by_sight(round_, result, worlds["nav world"], by_sight)
     print(f"{kills} real firearm kills")
     for name, count in seen.items():
@@ -271,7 +266,8 @@ def main() -> None:
             f"  fight's kills {'that are wrong' if kind == 'wrong' else kind}: "
             f"{fight_kills[(kind, 'all')]}; at a real frame within 1 s: {line}"
         )
-    print(f"damaged player-seconds: data {real_seconds}, replay's fight {replay_seconds}")
+    frames, real, replay = np.sum(list(by_sight.values()), axis=0)
+    print(f"damaged player-frames of {frames} alive in both: data {real}, replay's fight {replay}")
     print("damaged within the next frame, by enemies in sight at the frame (nav world):")
     for seen_by, (seconds, real, replay) in sorted(by_sight.items()):
         label = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
