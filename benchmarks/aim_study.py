@@ -8,8 +8,11 @@
    0.5 and 0 s before it. The replay's agents look along their motion until they aim.
 2. On the real damage events (`esta_dust2_events`, `events_ancient`, as `decoy models evaluate`
    reads them): the share of damaging and other steps DIP says "hit" for, as recorded and with
-   every victim's view turned 45, 90 and 180 degrees away (de_ancient's views are filled as
-   facing each other, de_dust2's are real).
+   every victim's view turned 45, 90 and 180 degrees away (de_dust2's views are real;
+   de_ancient's, filled by its export as facing each other, are redrawn by
+   `decoy_cli/damage/filled_views.py`).
+3. The real hits' view deviations behind that redraw (de_dust2's events), and how the DIP scores
+   de_dust2's real damaging steps with their real views and with views filled as facing.
 """
 
 from __future__ import annotations
@@ -22,9 +25,10 @@ import numpy as np
 
 from decoy_cli.damage import resolve_models
 from decoy_cli.damage.evaluation import dip_probabilities
+from decoy_cli.damage.filled_views import QUANTILES, hit_view_deviations
 from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.damage.samples import build_samples
-from decoy_cli.esta import iter_rounds
+from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 ROUND_8HZ = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-8hz-r02.json.xz"
@@ -80,12 +84,36 @@ def dip_on_facing(models: str) -> None:
             print(f"DIP says hit, {where} {label} ({len(part)}): " + ", ".join(shares))
 
 
+def filled_views(models: str) -> None:
+    """The real hits' view deviations behind `filled_views.py`'s tables, and how a DIP scores
+    de_dust2's real damaging steps with their real views and with views filled as
+    de_ancient's export fills them (facing each other exactly)."""
+    files, _ = collect_match_files([DATA / "esta_dust2_events"])
+    rounds = [r for r in iter_rounds(files) if not isinstance(r, RoundFailure)]
+    found = [hit_view_deviations(r) for r in rounds]
+    attacker = np.concatenate([a for a, _ in found])
+    victim = np.concatenate([v for _, v in found])
+    for name, values in (("attacker", attacker), ("victim", victim)):
+        quantiles = np.round(np.quantile(values, QUANTILES), 1).tolist()
+        print(f"{name} view minus facing, {len(values)} real hits, quantiles {quantiles}")
+    samples, _ = build_samples([DATA / "esta_dust2_events"])
+    hits = samples.take(np.flatnonzero(samples.hit))
+    delta = hits.victim_position - hits.attacker_position
+    facing = np.degrees(np.arctan2(delta[:, 1], delta[:, 0]))
+    filled = dataclasses.replace(hits, attacker_yaw=facing, victim_yaw=facing + 180.0)
+    dip = load_dip(resolve_models(models))
+    for label, part in (("real views", hits), ("views filled facing", filled)):
+        hit = dip_probabilities(dip, part) >= dip.threshold
+        print(f"DIP of {models} says hit on de_dust2's damaging steps, {label}: {hit.mean():.3f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--models", default="rules")
+    parser.add_argument("--models", default="rules", help="a --models choice or a DIP folder")
     args = parser.parse_args()
     real_views()
     dip_on_facing(args.models)
+    filled_views(args.models)
 
 
 if __name__ == "__main__":

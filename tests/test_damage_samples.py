@@ -23,6 +23,14 @@ from esta_fixtures import (
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.features import FeatureSpec, map_index
+from decoy_cli.damage.filled_views import (
+    ATTACKER_DEVIATION_DEG,
+    FILLED_NOTE,
+    QUANTILES,
+    VICTIM_DEVIATION_DEG,
+    filled_views,
+    hit_view_deviations,
+)
 from decoy_cli.damage.samples import (
     Samples,
     SampleStats,
@@ -281,6 +289,66 @@ def test_reader_reads_flashes(tmp_path: Path) -> None:
     assert row["playerX_m"] == pytest.approx(expected_hammer_position("t3", 1)[0] * HAMMER_TO_M)
     assert row["frame_index"] == 2  # tick 5100 is nearest frame 2 (5128)
     assert len(read_match(write(tmp_path, make_match())).round(1).flashes) == 0
+
+
+def _facing_views(document: dict[str, Any]) -> None:
+    """Fill every damage and kill row's views as an export without them does: facing each
+    other exactly."""
+    for round_ in document["gameRounds"]:
+        for row in round_["damages"] + round_["kills"]:
+            if row.get("attackerX") is None:
+                continue
+            to_victim = float(
+                np.degrees(
+                    np.arctan2(row["victimY"] - row["attackerY"], row["victimX"] - row["attackerX"])
+                )
+            )
+            row["attackerViewX"], row["victimViewX"] = to_victim, to_victim + 180.0
+
+
+def test_views_filled_as_facing_are_redrawn_as_real_views_deviate(tmp_path: Path) -> None:
+    """Views an export filled as facing each other teach that a hit victim looks at his
+    attacker: they are redrawn from real hits' deviations, the same on every build, within
+    the measured range, and counted; one recorded view (1 degree off) keeps them all."""
+    document = make_match()
+    _facing_views(document)
+    faced = write(tmp_path, document, "faced.json.xz")
+    first, stats = build_samples([faced], mode="events")
+    again, _ = build_samples([faced], mode="events")
+    np.testing.assert_array_equal(first.victim_yaw, again.victim_yaw)
+    rows = sum(
+        row.get("attackerX") is not None
+        for r in document["gameRounds"]
+        for row in r["damages"] + r["kills"]
+    )
+    assert stats.partial[FILLED_NOTE] == rows
+    hits = first.take(first.hit)
+    to_victim = np.degrees(
+        np.arctan2(*(hits.victim_position - hits.attacker_position)[:, [1, 0]].T)
+    )
+    off = (hits.victim_yaw - to_victim) % 360.0 - 180.0  # the victim's view off his attacker
+    assert np.all(off != 0.0) and np.all((off >= -161.5) & (off <= 170.1))
+    attacker_off = (hits.attacker_yaw - to_victim + 180.0) % 360.0 - 180.0
+    assert np.all(np.abs(attacker_off) <= 12.1)
+
+    document["gameRounds"][1]["damages"][0]["victimViewX"] += 1.0
+    recorded = write(tmp_path, document, "recorded.json.xz")
+    kept, stats = build_samples([recorded], mode="events")
+    assert FILLED_NOTE not in stats.partial
+    assert sorted(kept.take(kept.hit).victim_yaw.tolist()) != sorted(hits.victim_yaw.tolist())
+
+
+@pytest.mark.skipif(not EVENTS.is_dir(), reason="../shared/data/esta_dust2_events is absent")
+def test_the_redrawn_views_deviate_as_the_real_hits_views_do() -> None:
+    """The deviation tables are the quantiles of de_dust2's real firearm hits (396)."""
+    rounds = read_match(next(EVENTS.glob("*.json.xz"))).rounds
+    found = [hit_view_deviations(r) for r in rounds]
+    attacker = np.concatenate([a for a, _ in found])
+    victim = np.concatenate([v for _, v in found])
+    assert len(attacker) == len(victim) == 396
+    np.testing.assert_allclose(np.quantile(attacker, QUANTILES), ATTACKER_DEVIATION_DEG, atol=0.051)
+    np.testing.assert_allclose(np.quantile(victim, QUANTILES), VICTIM_DEVIATION_DEG, atol=0.051)
+    assert not any(filled_views(r) for r in rounds)  # recorded views stay as they are
 
 
 @pytest.mark.skipif(not EVENTS.is_dir(), reason="../shared/data/esta_dust2_events is absent")

@@ -44,6 +44,7 @@ from decoy_cli.damage.damage_rows import (
     step_clock,
     strings,
 )
+from decoy_cli.damage.filled_views import redraw_filled_views
 from decoy_cli.damage.rules import ARMORED_GROUPS, WEAPON_RULES, shot_damage
 from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
 from decoy_cli.esta import Round
@@ -199,6 +200,7 @@ def _most_without_armour(weapon: str, distance_u: float) -> int:
 
 def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples:
     """Events-only mode (module docstring): positives from the damage rows, then negatives."""
+    round_ = redraw_filled_views(round_, stats)
     events = _EventRound(round_, damage_rows(round_, stats))
     rows: list[dict[str, object]] = []
     rows += _event_positives(events, stats)
@@ -215,6 +217,7 @@ def event_samples(round_: Round, window_s: float, stats: SampleStats) -> Samples
 def hit_samples(round_: Round, stats: SampleStats) -> Samples:
     """One damaging sample per usable damage row (a hit, not a step): the unit of a model that
     draws one bullet, as `event_samples` builds its positives."""
+    round_ = redraw_filled_views(round_, stats)
     events = _EventRound(round_, damage_rows(round_, stats))
     common = {
         "map_name": round_.map_name,
