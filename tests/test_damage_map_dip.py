@@ -20,6 +20,7 @@ import decoy_cli.damage
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model, model_roles
 from decoy_cli.damage.combat import LearnedDamage
+from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.damage.model_maps import dip_of, map_warnings
 from decoy_cli.damage.rules_model import RULES_FILE, RulesDamage
 
@@ -98,7 +99,7 @@ def test_the_evaluation_report_names_the_dip_and_the_maps_it_never_saw(shipped: 
 
 def test_models_evaluate_scores_each_map_with_the_one_dip(tmp_path: Path) -> None:
     """The repository's shipped models on the fixture match as de_dust2 and as de_ancient:
-    both maps scored by the shipped DIP at its threshold, and named."""
+    both maps scored by the shipped DIP at the threshold the fight decides by, and named."""
     dust = write_match(tmp_path / "dust.json.xz", make_match())
     ancient = make_match()
     ancient["mapName"] = "de_ancient"
@@ -109,7 +110,7 @@ def test_models_evaluate_scores_each_map_with_the_one_dip(tmp_path: Path) -> Non
     result = CliRunner().invoke(app, [*args, "--mode", "events"], env=WIDE)
     assert result.exit_code == 0, result.output
     report = json.loads((out / "metrics.json").read_text())
-    threshold = json.loads((ROOT / "models" / "dip.json").read_text())["threshold"]
+    threshold = load_dip(ROOT / "models").decision_threshold
     for name in ("de_dust2", "de_ancient"):
         assert report["dip_by_map"][name]["threshold"] == pytest.approx(threshold)
         assert report["dip_by_map"][name]["positives"] == 2

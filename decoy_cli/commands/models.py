@@ -32,6 +32,7 @@ from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluat
 from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.damage.split import SplitPart
 from decoy_cli.errors import DecoyError
+from decoy_cli.evaluate.fight_threshold import MIN_RECALL
 from decoy_cli.files import check_folder_writable
 
 DEFAULT_IMPORT_OUT = PAPER_FOLDER
@@ -142,6 +143,63 @@ def fit_rules_command(
         f"{rules.provenance['hits_by_hp_lost']} whose HP lost the rules explain (left out: "
         f"{rules.provenance['hits_unexplained']} they do not), penetration from the former, "
         f"bullets per step from {rules.provenance['steps']} damaging steps; written to {path}",
+        highlight=False,
+    )
+
+
+@app.command("fight-threshold")
+def fight_threshold_command(
+    model_folder: Path = typer.Argument(..., help="A model folder with dip.pt/json."),
+    data: list[Path] = typer.Argument(
+        ...,
+        help="ESTA files or folders: real rounds whose frames hold both teams, and real damage "
+        "events (e.g. ../shared/data/cs2_dust2_both ../shared/data/esta_dust2_events).",
+    ),
+    min_recall: float = typer.Option(
+        MIN_RECALL,
+        "--min-recall",
+        min=0.0,
+        max=1.0,
+        help="Least share of each map's real damaging steps DIP must still call hits.",
+    ),
+) -> None:
+    """Choose the DIP threshold the simulator's fight decides by, where the fight works: the
+    best F1 on real rounds of both teams (a player with one enemy in sight at a frame, both
+    aimed as the fight aims; did he lose HP by the next frame?), among the thresholds at which
+    DIP still calls --min-recall of every map's real damaging steps hits. Written as the
+    folder's dip_calibration.json (kind none); prints every candidate and the choice on each
+    half of the rounds (decoy_cli/evaluate/fight_threshold.py)."""
+    from decoy_cli.damage.calibration import Calibration
+    from decoy_cli.damage.model_folder import load_dip, save_calibration
+    from decoy_cli.evaluate.fight_threshold import choose_for_files
+    from decoy_cli.waypoints.build import builtin_graph
+
+    if not (model_folder / "dip.json").is_file():
+        raise DecoyError(f"{model_folder}: holds no dip.json to choose a threshold for")
+    check_folder_writable(model_folder)
+    try:
+        found = choose_for_files(load_dip(model_folder), data, builtin_graph(), min_recall)
+    except ValueError as error:
+        raise DecoyError(str(error)) from None
+    chosen = found.chosen
+    table = Table(
+        title=f"The fight's threshold: {found.rounds} rounds, {found.pairs} player-frames"
+    )
+    for column in ("threshold", "F1 in sight", *(f"recall {m}" for m in found.maps), ""):
+        table.add_column(column, justify="right")
+    for row in chosen.rows:
+        mark = ["chosen"] if row["threshold"] == chosen.threshold else []
+        mark += ["DIP's own"] if row["threshold"] == chosen.own_threshold else []
+        mark += [] if row["allowed"] else ["recall too low"]
+        recalls = (f"{row[f'recall:{m}']:.3f}" for m in found.maps)
+        table.add_row(f"{row['threshold']:.3f}", f"{row['f1']:.3f}", *recalls, ", ".join(mark))
+    console = make_console()
+    console.print(table)
+    path = save_calibration(model_folder, Calibration("none", 1.0, 0.0, chosen.threshold))
+    console.print(
+        f"{found.lost_share:.1%} of the player-frames lost HP; chosen on each half of the rounds "
+        f"alone: {found.halves[0]:.3f}, {found.halves[1]:.3f}; {len(found.failures)} rounds "
+        f"unreadable; the fight decides at {chosen.threshold:.3f}; written to {path}",
         highlight=False,
     )
 

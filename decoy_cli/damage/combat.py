@@ -134,7 +134,7 @@ class DipDecision:
             raise ValueError(f"threads must be >= 1 or None, got {threads}")
         self.dip = dip
         self.threads = threads
-        self.threshold = dip.threshold if threshold is None else float(threshold)
+        self.threshold = dip.decision_threshold if threshold is None else float(threshold)
         self.calibration = dip.calibration if threshold is None else None
         if not 0.0 <= self.threshold <= 1.0:
             raise ValueError(f"a DIP threshold is a probability, got {self.threshold}")

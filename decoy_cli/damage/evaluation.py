@@ -100,11 +100,12 @@ class DipEvaluation:
 
 
 def evaluate_dip(dip: LoadedDip, samples: Samples, threshold: float | None = None) -> DipEvaluation:
-    """DIP's metrics on the samples at `threshold` (default: the model's own)."""
+    """DIP's metrics on the samples at `threshold` (default: the one the combat step decides by,
+    `LoadedDip.decision_threshold`)."""
     if len(samples) == 0:
         raise ValueError("no samples to evaluate DIP on")
     probabilities = dip_probabilities(dip, samples)
-    chosen = dip.threshold if threshold is None else threshold
+    chosen = dip.decision_threshold if threshold is None else threshold
     metrics = classification_metrics(samples.hit, probabilities, chosen)
     metrics |= calibration_scores(samples.hit, probabilities, dip.calibration)
     return DipEvaluation(metrics, samples.hit.copy(), probabilities)

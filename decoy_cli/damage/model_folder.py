@@ -46,7 +46,18 @@ class LoadedDip:
     threshold: float
     metadata: JsonObject = field(default_factory=dict)
     calibration: Calibration | None = None
-    """The folder's `dip_calibration.json` (`decoy models calibrate`), when it has one."""
+    """The folder's `dip_calibration.json` (`decoy models calibrate`, `fight-threshold`), when
+    it has one."""
+
+    @property
+    def decision_threshold(self) -> float:
+        """The threshold on DIP's own probability the combat step decides by: an operating point
+        set without rescaling (kind "none", `decoy models fight-threshold`), else DIP's own
+        (Platt and temperature scaling keep the order and carry it over)."""
+        calibration = self.calibration
+        if calibration is not None and calibration.kind == "none":
+            return calibration.threshold
+        return self.threshold
 
 
 @dataclass

@@ -1,0 +1,121 @@
+"""The fight's operating point (decoy_cli/evaluate/fight_threshold.py, `decoy models
+fight-threshold`): the pairs of a hand-made round of both teams, the choice by hand, the command
+end to end, and the shipped choice on the shared real rounds."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from both_teams import BothTeams, Mate
+from esta_fixtures import make_match, write_match
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.damage.combat import DipDecision
+from decoy_cli.damage.model_folder import load_dip
+from decoy_cli.esta import read_match
+from decoy_cli.evaluate.fight_threshold import choose_fight_threshold, fight_pairs
+from decoy_cli.waypoints.build import builtin_graph
+
+runner = CliRunner()
+WIDE = {"COLUMNS": "200"}
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data"
+
+
+def facing_off() -> BothTeams:
+    """A T and a CT in bomb site A, in sight of each other; the T kills the CT at 9.5 s."""
+    a = builtin_graph().region_of("bombsite_a")
+    return BothTeams(
+        frames=12,
+        players=[Mate("t1", "T", [int(a[0])]), Mate("ct1", "CT", [int(a[3])], dead_from=10)],
+        kills=[(9.5, "t1", "ct1", "AK-47")],
+        winner="T",
+        reason="TerroristsWin",
+    )
+
+
+def test_the_pairs_are_players_with_one_enemy_in_sight_labelled_by_lost_hp(
+    tmp_path: Path,
+) -> None:
+    """Frames 0-9 give both players as victims of the other (frame 10 has no enemy alive for
+    t1, frame 11 no frame a second later); only ct1 at frame 9 loses HP within the second. Each
+    attacker aims at his victim, as the fight's do, with the weapon the missing-field rules
+    give (t1's kill: AK-47; ct1 none of his own: the CT side's usual rifle)."""
+    round_ = read_match(facing_off().write(tmp_path / "m.json")).rounds[0]
+    pairs = fight_pairs([round_], builtin_graph())
+    names = [p.name for p in round_.players]
+    victims = [names[v] for v in pairs.batch.victim]
+    assert len(pairs.lost_hp) == 20 and victims.count("t1") == victims.count("ct1") == 10
+    (lost,) = np.flatnonzero(pairs.lost_hp)
+    assert victims[lost] == "ct1"
+    assert sorted(set(pairs.batch.attacker_weapon)) == ["AK-47", "M4A1"]
+    delta = pairs.batch.victim_position - pairs.batch.attacker_position
+    facing = np.degrees(np.arctan2(delta[:, 1], delta[:, 0]))
+    np.testing.assert_allclose(pairs.batch.attacker_yaw, facing)
+    np.testing.assert_allclose(pairs.batch.victim_yaw, facing + 180.0)
+    assert pairs.rounds == 1 and set(pairs.round_index) == {0}
+
+
+def test_the_choice_is_the_best_f1_the_recall_allows() -> None:
+    """F1 by hand: 1.0 for thresholds in (0.3, 0.85], 0.8 in (0.2, 0.3], 0.667 in (0.1, 0.2];
+    the real damaging steps' recall stays at 3 of 5 up to 0.3."""
+    probability = np.array([0.9, 0.85, 0.3, 0.2, 0.1])
+    lost = np.array([True, True, False, False, False])
+    damaging = {"de_x": np.array([0.5, 0.4, 0.3, 0.2, 0.1])}
+    free = choose_fight_threshold(probability, lost, damaging, 0.12, min_recall=0.0)
+    assert free.threshold == 0.35  # the lowest of the best
+    held = choose_fight_threshold(probability, lost, damaging, 0.12, min_recall=0.6)
+    assert held.threshold == 0.25
+    row = next(r for r in held.rows if r["threshold"] == 0.35)
+    assert row["f1"] == 1.0 and row["recall:de_x"] == 0.4 and not row["allowed"]
+    own = choose_fight_threshold(probability, lost, damaging, 0.12, min_recall=1.0)
+    assert own.threshold == 0.12  # only DIP's own and 0.05, 0.1 remain: it scores best
+
+
+def test_the_command_writes_the_fights_threshold(tmp_path: Path) -> None:
+    folder = tmp_path / "models"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    rounds = facing_off().write(tmp_path / "both.json")
+    events = write_match(tmp_path / "events.json.xz", make_match())
+    result = runner.invoke(
+        app, ["models", "fight-threshold", str(folder), str(rounds), str(events)], env=WIDE
+    )
+    assert result.exit_code == 0, result.output
+    assert "chosen" in result.output and "recall de_dust2" in result.output
+    written = json.loads((folder / "dip_calibration.json").read_text())
+    assert written["kind"] == "none" and written["decision"] == "threshold"
+    dip = load_dip(folder)
+    assert dip.decision_threshold == written["threshold"]
+    assert DipDecision(dip).threshold == written["threshold"]  # the fight decides by it
+
+    alone = runner.invoke(app, ["models", "fight-threshold", str(folder), str(rounds)], env=WIDE)
+    assert alone.exit_code == 1  # no damage events to hold DIP's recall on
+    assert alone.output.startswith("error:") and len(alone.output.strip().splitlines()) == 1
+
+
+@pytest.mark.skipif(
+    not (DATA / "cs2_dust2_both").is_dir() or not (DATA / "events_ancient").is_dir(),
+    reason="needs ../shared/data/cs2_dust2_both, esta_dust2_events and events_ancient",
+)
+def test_the_shipped_threshold_is_what_the_command_chooses_on_the_real_rounds(
+    tmp_path: Path,
+) -> None:
+    folder = tmp_path / "models"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    data = [DATA / "cs2_dust2_both", DATA / "esta_dust2_events", DATA / "events_ancient"]
+    result = runner.invoke(
+        app, ["models", "fight-threshold", str(folder), *map(str, data)], env=WIDE
+    )
+    assert result.exit_code == 0, result.output
+    shipped = json.loads((ROOT / "models" / "dip_calibration.json").read_text())
+    assert json.loads((folder / "dip_calibration.json").read_text()) == shipped
+    assert f"alone: {shipped['threshold']:.3f}, {shipped['threshold']:.3f}" in result.output
