@@ -78,7 +78,7 @@ def dip_on_facing(models: str) -> None:
             shares = []
             for turn in (0, 45, 90, 180):
                 turned = dataclasses.replace(part, victim_yaw=part.victim_yaw + turn)
-                hit = dip_probabilities(dip, turned) >= dip.threshold
+                hit = dip_probabilities(dip, turned) >= dip.decision_threshold
                 shares.append(f"{turn} deg {hit.mean():.3f}")
             label = "damaging" if damaging else "other"
             print(f"DIP says hit, {where} {label} ({len(part)}): " + ", ".join(shares))
@@ -103,7 +103,7 @@ def filled_views(models: str) -> None:
     filled = dataclasses.replace(hits, attacker_yaw=facing, victim_yaw=facing + 180.0)
     dip = load_dip(resolve_models(models))
     for label, part in (("real views", hits), ("views filled facing", filled)):
-        hit = dip_probabilities(dip, part) >= dip.threshold
+        hit = dip_probabilities(dip, part) >= dip.decision_threshold
         print(f"DIP of {models} says hit on de_dust2's damaging steps, {label}: {hit.mean():.3f}")
 
 

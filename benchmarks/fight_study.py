@@ -24,9 +24,9 @@ reality's geometry would have prevented.
 
 Then the damage over all rounds, per player-frame alive in the data and the replay (a frame to
 the next; a player-second at 1 frame/s): in how many the player lost HP in the data and in how
-many the replay's fight damaged him, in all and by how many enemies see him at the frame (real
-positions, nav world); and the HP real victims had one frame before they died (how fast real
-fights end). Nothing here is timed.
+many the replay's fight damaged him, in all, by how many enemies see him at the frame (real
+positions, nav world) and by how far the nearest of them is; and the HP real victims had one
+frame before they died (how fast real fights end). Nothing here is timed.
 """
 
 from __future__ import annotations
@@ -110,12 +110,15 @@ def sightings(round_, graph, model, sight) -> list[tuple[float, set[tuple[int, i
 
 SIGHT_BUCKETS = 3
 """Enemies in sight counted 0, 1, 2 or more."""
+DISTANCE_BANDS_M = (10.0, 20.0, 30.0)
+"""Bands of the nearest enemy in sight: under 10 m, 10-20, 20-30, 30 m and more."""
 
 
-def _damage_by_sight(round_, result, world, by_sight) -> None:
+def _damage_by_sight(round_, result, world, by_sight, by_distance) -> None:
     """Add the round's player-frames (a frame to the next, the player alive in the data and the
     replay, his position and both HP known) to `by_sight[enemies in sight at the frame]` =
-    [count, lost HP in the data, damaged by the replay's fight]."""
+    [count, lost HP in the data, damaged by the replay's fight], and those with an enemy in
+    sight to `by_distance[band of the nearest such enemy]`."""
     hp = round_.hp.astype(float)
     present = np.asarray(round_.present, bool)
     alive = np.asarray(round_.alive, bool) & present
@@ -136,12 +139,19 @@ def _damage_by_sight(round_, result, world, by_sight) -> None:
             starts = eyes[enemies, frame]
             starts = starts[np.isfinite(starts).all(axis=1)]
             ends = np.repeat(eyes[victim, frame][None], len(starts), axis=0)
-            seen_by = int(world.line_of_sight(starts, ends).sum())
+            clear = world.line_of_sight(starts, ends)
+            seen_by = int(clear.sum())
             lost = not alive[victim, frame + 1] or hp[victim, frame + 1] < hp[victim, frame]
             row = by_sight[min(seen_by, SIGHT_BUCKETS - 1)]
             row[0] += 1
             row[1] += lost
             row[2] += bool(damaged[victim, frame])
+            if seen_by:
+                nearest = float(np.linalg.norm(starts[clear] - ends[clear], axis=1).min())
+                band = by_distance[int(np.searchsorted(DISTANCE_BANDS_M, nearest, side="right"))]
+                band[0] += 1
+                band[1] += lost
+                band[2] += bool(damaged[victim, frame])
 
 
 def main() -> None:
@@ -170,6 +180,7 @@ def main() -> None:
     fight_kills = collections.Counter()
     kills = 0
     by_sight: dict[int, list[int]] = collections.defaultdict(lambda: [0, 0, 0])
+    by_distance: dict[int, list[int]] = collections.defaultdict(lambda: [0, 0, 0])
     files, _ = collect_match_files(args.inputs)
     for round_ in iter_rounds(files, map_name="de_dust2"):
         if isinstance(round_, RoundFailure) or len(round_.side_indices("CT")) == 0:
@@ -245,7 +256,7 @@ def main() -> None:
             dead = np.flatnonzero(~np.asarray(round_.alive[player], bool))
             if len(dead) and dead[0] > 0:
                 hp_before_death.append(hp[player, dead[0] - 1])
-        _damage_by_sight(round_, result, worlds["nav world"], by_sight)
+        _damage_by_sight(round_, result, worlds["nav world"], by_sight, by_distance)
     print(f"{kills} real firearm kills")
     for name, count in seen.items():
         print(f"  line of sight at the kill, {name}: {count / max(kills, 1):.2f}")
@@ -273,6 +284,15 @@ def main() -> None:
         label = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
         print(
             f"  {label} in sight: {seconds} player-frames, data {real / seconds:.3f}, "
+            f"replay's fight {replay / seconds:.3f}"
+        )
+    print("with an enemy in sight, by the nearest one's distance:")
+    edges = (0.0, *DISTANCE_BANDS_M)
+    for band, (seconds, real, replay) in sorted(by_distance.items()):
+        last = band == len(DISTANCE_BANDS_M)
+        label = f"{edges[band]:g}+ m" if last else f"{edges[band]:g}-{DISTANCE_BANDS_M[band]:g} m"
+        print(
+            f"  {label}: {seconds} player-frames, data {real / seconds:.3f}, "
             f"replay's fight {replay / seconds:.3f}"
         )
     full = np.asarray(hp_before_death) >= 100
