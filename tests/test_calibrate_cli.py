@@ -6,6 +6,7 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -26,8 +27,12 @@ def test_calibrating_the_shipped_dip(tmp_path: Path) -> None:
     result = runner.invoke(app, ["models", "calibrate", str(folder), str(EVENTS), *split], env=WIDE)
     assert result.exit_code == 0, result.output
     assert "DIP calibration (platt)" in result.output
+    fight = json.loads((ROOT / "models" / "dip_calibration.json").read_text())["threshold"]
+    assert f"replaces the folder's none calibration (threshold {fight:.3f})" in result.output
     dip = load_dip(folder)
     assert dip.calibration is not None and dip.calibration.kind == "platt"
+    # the fight's operating point carries over onto the calibrated scale: the same pairs hit
+    assert dip.calibration.threshold == pytest.approx(dip.calibration.apply(np.array([fight]))[0])
     out = tmp_path / "evaluation"
     args = ["--subset", "test", "--no-balance", *split, "--out", str(out)]
     evaluated = runner.invoke(

@@ -20,7 +20,6 @@ import decoy_cli.damage
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model, model_roles
 from decoy_cli.damage.combat import LearnedDamage
-from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.damage.model_maps import dip_of, map_warnings
 from decoy_cli.damage.rules_model import RULES_FILE, RulesDamage
 
@@ -110,7 +109,7 @@ def test_models_evaluate_scores_each_map_with_the_one_dip(tmp_path: Path) -> Non
     result = CliRunner().invoke(app, [*args, "--mode", "events"], env=WIDE)
     assert result.exit_code == 0, result.output
     report = json.loads((out / "metrics.json").read_text())
-    threshold = load_dip(ROOT / "models").decision_threshold
+    threshold = json.loads((ROOT / "models" / "dip_calibration.json").read_text())["threshold"]
     for name in ("de_dust2", "de_ancient"):
         assert report["dip_by_map"][name]["threshold"] == pytest.approx(threshold)
         assert report["dip_by_map"][name]["positives"] == 2

@@ -24,7 +24,7 @@ from decoy_cli.commands._damage_output import (
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
-from decoy_cli.damage.calibration import CalibrationKind, Decision
+from decoy_cli.damage.calibration import MIN_RECALL, CalibrationKind, Decision
 from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
@@ -32,7 +32,6 @@ from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluat
 from decoy_cli.damage.scores import MIN_CELL
 from decoy_cli.damage.split import SplitPart
 from decoy_cli.errors import DecoyError
-from decoy_cli.evaluate.fight_threshold import MIN_RECALL
 from decoy_cli.files import check_folder_writable
 
 DEFAULT_IMPORT_OUT = PAPER_FOLDER
@@ -165,7 +164,7 @@ def fight_threshold_command(
 ) -> None:
     """Choose the DIP threshold the simulator's fight decides by, where the fight works: the
     best F1 on real rounds of both teams (a player with one enemy in sight at a frame, both
-    aimed as the fight aims; did he lose HP by the next frame?), among the thresholds at which
+    aimed as the fight aims; did he lose HP within 1 s?), among the thresholds at which
     DIP still calls --min-recall of every map's real damaging steps hits. Written as the
     folder's dip_calibration.json (kind none); prints every candidate and the choice on each
     half of the rounds (decoy_cli/evaluate/fight_threshold.py)."""
@@ -177,10 +176,8 @@ def fight_threshold_command(
     if not (model_folder / "dip.json").is_file():
         raise DecoyError(f"{model_folder}: holds no dip.json to choose a threshold for")
     check_folder_writable(model_folder)
-    try:
-        found = choose_for_files(load_dip(model_folder), data, builtin_graph(), min_recall)
-    except ValueError as error:
-        raise DecoyError(str(error)) from None
+    dip = load_dip(model_folder)
+    found = choose_for_files(dip, data, builtin_graph(), min_recall)
     chosen = found.chosen
     table = Table(
         title=f"The fight's threshold: {found.rounds} rounds, {found.pairs} player-frames"
@@ -196,6 +193,13 @@ def fight_threshold_command(
     console = make_console()
     console.print(table)
     path = save_calibration(model_folder, Calibration("none", 1.0, 0.0, chosen.threshold))
+    if dip.calibration is not None:
+        before = dip.calibration
+        console.print(
+            f"replaces the folder's {before.kind} calibration (threshold {before.threshold:.3f}, "
+            f"{before.decision})",
+            highlight=False,
+        )
     console.print(
         f"{found.lost_share:.1%} of the player-frames lost HP; chosen on each half of the rounds "
         f"alone: {found.halves[0]:.3f}, {found.halves[1]:.3f}; {len(found.failures)} rounds "
@@ -250,6 +254,12 @@ def calibrate(
         )
     console.print(table)
     c = result.calibration
+    if result.replaced is not None:
+        before = result.replaced
+        console.print(
+            f"replaces the folder's {before.kind} calibration (threshold {before.threshold:.3f})",
+            highlight=False,
+        )
     console.print(
         f"p' = sigmoid({c.a:.4f} * logit(p) + {c.b:.4f}); threshold {c.threshold:.3f} on the "
         f"calibrated scale; combat decides by {c.decision}; written to {result.path}",
@@ -279,7 +289,10 @@ def evaluate(
     samples: SampleOptions = SampleOptions(),
     balanced: bool = typer.Option(BALANCED, "--balance/--no-balance", help=BALANCE_HELP),
     threshold: float | None = typer.Option(
-        None, "--threshold", help="DIP decision threshold (default: the model's own)."
+        None,
+        "--threshold",
+        help="DIP decision threshold (default: the one the fight decides by: the folder's "
+        "dip_calibration.json, else the DIP's own).",
     ),
     draws: int = typer.Option(DRAWS, "--draws", help=DRAWS_HELP),
     min_cell: int = typer.Option(MIN_CELL, "--min-cell", help=MIN_CELL_HELP),

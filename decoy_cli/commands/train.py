@@ -136,6 +136,7 @@ def dip(
     options = fitting.options(epochs, samples.seed)
     choice = samples.choice(data)
     _check_outputs(out, report)
+    stale = (out / "dip_calibration.json").is_file()
     bars, on_file, on_step = progress_bars()
     with bars:
         result = train_dip_model(
@@ -157,6 +158,12 @@ def dip(
     )
     console.print(dip_table(run.test.metrics, "DIP on the test part"))
     console.print(f"model written to {result.model_folder}, report to {result.report_folder}")
+    if stale:
+        console.print(
+            "the folder's dip_calibration.json, fitted for the DIP this one replaces, was removed: "
+            "rerun decoy models fight-threshold (or calibrate) for this one",
+            highlight=False,
+        )
 
 
 @app.command("dog")

@@ -115,6 +115,10 @@ def _logit(p: np.ndarray) -> np.ndarray:
     return np.log(q / (1 - q))
 
 
+MIN_RECALL = 0.8
+"""Least share of each map's real damaging steps DIP must call hits at the operating point
+`decoy models fight-threshold` chooses for the fight (issue 33's floor)."""
+
 Decision = Literal["threshold", "bernoulli"]
 CalibrationKind = Literal["platt", "temperature", "none"]
 DECISIONS: tuple[Decision, ...] = get_args(Decision)

@@ -4,8 +4,9 @@ Per combat step (decoy_cli/sim/combat.py calls it with every visible ordered pai
 
 1. one batched DIP forward pass over all pairs gives the probability that the attacker damages
    the victim in this 0.5 s step (`DipDecision`, which `RulesDamage` shares); a pair hits when
-   it reaches the threshold (the model folder's, 0.444 for the paper's DIP), or by the rule of
-   the folder's calibration (decoy_cli/damage/calibration.py), and the attacker holds a firearm
+   it reaches the threshold (the model folder's, 0.444 for the paper's DIP; the folder's fight
+   threshold when `decoy models fight-threshold` set one), or by the rule of the folder's
+   calibration (decoy_cli/damage/calibration.py), and the attacker holds a firearm
    of the vocabulary (the models know
    only firearm damage: a knife, grenade, C4, Zeus or empty hand deals none here);
 2. one batched DOG pass over the hitting pairs only: z ~ N(0, I) from a torch generator seeded

@@ -4,11 +4,11 @@ An events-only export that did not record view angles may fill each damage and k
 attacker and victim views with the bearings that make the two face each other exactly
 (`../shared/data/events_ancient` does, and says so). Taken as recorded, every hit of such a file
 has a victim looking straight at his attacker, and a DIP learns that this is what a hit looks
-like; real victims are often hit from the side (on the de_dust2 events with real views, a
-quarter of the firearm hits find the victim more than 8 degrees off his attacker). A DIP trained
-on the filled views then misses real hits whose victim looks elsewhere.
+like; real victims are often hit from the side (README, "Damage models"). A DIP trained on the
+filled views then misses real hits whose victim looks elsewhere.
 
-So a round whose every such row faces exactly (`filled_views`) has each of those views redrawn:
+So a round whose every row between two enemies at different spots faces exactly (`filled_views`;
+self-damage, such as a player in his own fire, has no facing to fill) has its views redrawn:
 the facing bearing plus a deviation drawn from the real firearm hits' deviations
 (`ATTACKER_DEVIATION_DEG`, `VICTIM_DEVIATION_DEG`: their quantiles over `hit_view_deviations`
 of the de_dust2 events with real views, printed by `python benchmarks/aim_study.py`), seeded by
@@ -37,7 +37,7 @@ ATTACKER_DEVIATION_DEG = np.array([
 ])
 # fmt: on
 """Quantiles (`QUANTILES`) of the attacker's view minus his bearing of the victim, degrees,
-over 396 real firearm hits between enemies (de_dust2 events)."""
+over the real firearm hits between enemies of de_dust2's events (`hit_view_deviations`)."""
 # fmt: off
 VICTIM_DEVIATION_DEG = np.array([
     -161.5, -42.4, -13.0, -4.1, -1.8, -1.2, -0.8, -0.5, -0.2, -0.1, 0.1,
@@ -72,23 +72,35 @@ def hit_view_deviations(round_: Round) -> tuple[np.ndarray, np.ndarray]:
     return attacker[known], victim[known]
 
 
+def _between_enemies(table: pd.DataFrame) -> np.ndarray:
+    """(K,) rows whose attacker and victim are enemies at different spots with both views."""
+    attacker, victim = _deviations(table)
+    apart = (table["victimX_m"] != table["attackerX_m"]) | (
+        table["victimY_m"] != table["attackerY_m"]
+    )
+    rows = np.isfinite(attacker) & np.isfinite(victim) & apart.to_numpy(bool)
+    if {"attackerSide", "victimSide"} <= set(table.columns):
+        rows &= (table["attackerSide"] != table["victimSide"]).to_numpy(bool)
+    return rows
+
+
 def _with_views(table: pd.DataFrame) -> bool:
     columns = {f"{who}{part}" for who in ("attacker", "victim") for part in ("X_m", "Y_m", "ViewX")}
     return len(table) > 0 and columns <= set(table.columns)
 
 
 def filled_views(round_: Round) -> bool:
-    """Whether the round has damage or kill rows with both players' positions and views, and
-    every one of them faces exactly (a recorded victim's view almost never does)."""
+    """Whether the round has damage or kill rows between enemies at different spots with both
+    views, and every one of them faces exactly (a recorded victim's view almost never does)."""
     rows = 0
     for name in TABLES:
         table = getattr(round_, name)
         if not _with_views(table):
             continue
-        attacker, victim = _deviations(table)
-        known = np.isfinite(attacker) & np.isfinite(victim)
-        if np.any(np.abs(attacker[known]) > FILLED_WITHIN_DEG) or np.any(
-            np.abs(victim[known]) > FILLED_WITHIN_DEG
+        known = _between_enemies(table)
+        attacker, victim = (d[known] for d in _deviations(table))
+        if np.any(np.abs(attacker) > FILLED_WITHIN_DEG) or np.any(
+            np.abs(victim) > FILLED_WITHIN_DEG
         ):
             return False
         rows += int(known.sum())
@@ -111,7 +123,7 @@ def redraw_filled_views(round_: Round, stats: SampleStats) -> Round:
         draws = rng.random((len(table), 2))
         attacker = np.interp(draws[:, 0], QUANTILES, ATTACKER_DEVIATION_DEG)
         victim = np.interp(draws[:, 1], QUANTILES, VICTIM_DEVIATION_DEG)
-        known = np.isfinite(_deviations(table)).all(axis=0)
+        known = _between_enemies(table)
         table["attackerViewX"] = table["attackerViewX"] + attacker
         table["victimViewX"] = table["victimViewX"] + victim
         stats.partial[FILLED_NOTE] += int(known.sum())

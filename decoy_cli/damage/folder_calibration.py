@@ -33,6 +33,9 @@ class CalibrationResult:
     """The fitted map, where it was written, and Brier / ECE before and after by part."""
 
     calibration: Calibration
+    replaced: Calibration | None
+    """The folder's calibration before (this one replaces it; its fight threshold, if it set
+    one, carries over onto the new scale)."""
     path: Path
     scores: dict[str, dict[str, float]]
     """part -> brier, ece, brier_calibrated, ece_calibrated, samples, positives."""
@@ -66,7 +69,7 @@ def calibrate_dip_folder(
         parts[part] = (labels, dip_probabilities(dip, samples.take(index)))
     try:
         calibration = fit_calibration(
-            *parts["val"], kind=kind, threshold=dip.threshold, decision=decision
+            *parts["val"], kind=kind, threshold=dip.decision_threshold, decision=decision
         )
     except ValueError as error:
         raise ModelError(str(error)) from None
@@ -78,4 +81,4 @@ def calibrate_dip_folder(
             **calibration_scores(labels, probabilities, calibration),
         }
     path = save_calibration(folder, calibration)
-    return CalibrationResult(calibration, path, scores, stats)
+    return CalibrationResult(calibration, dip.calibration, path, scores, stats)

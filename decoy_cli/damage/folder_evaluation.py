@@ -192,7 +192,8 @@ def evaluate_model_folder(
 def evaluate_dip_by_map(
     dip: LoadedDip, samples: Samples, chosen: np.ndarray, threshold: float | None
 ) -> tuple[DipEvaluation, dict[str, dict[str, float]]]:
-    """The `chosen` samples scored by `dip` at its threshold (or `threshold`): the evaluation
+    """The `chosen` samples scored by `dip` at the threshold the fight decides by (or
+    `threshold`): the evaluation
     of them all, and each map's metrics."""
     from decoy_cli.damage.evaluation import evaluate_dip
 

@@ -81,11 +81,14 @@ def save_dip(
     threshold: float,
     metadata: JsonObject | None = None,
 ) -> Path:
-    """Write `dip.pt` and `dip.json` into `folder` (created if needed); returns the folder."""
+    """Write `dip.pt` and `dip.json` into `folder` (created if needed); returns the folder. A
+    `dip_calibration.json` there was fitted for the DIP this one replaces: it is removed."""
     threshold = float(threshold)
     if not 0.0 <= threshold <= 1.0:
         raise ValueError(f"a DIP threshold is a probability, got {threshold}")
-    return _save(Path(folder), "dip", net, spec, {"threshold": threshold}, metadata or {})
+    saved = _save(Path(folder), "dip", net, spec, {"threshold": threshold}, metadata or {})
+    (saved / CALIBRATION_FILE).unlink(missing_ok=True)
+    return saved
 
 
 def save_dog(

@@ -10,7 +10,9 @@ on what the fight meets:
 * **objective**: in real rounds of both teams, every frame at which a player alive has exactly
   one enemy in sight (the nav world, eye to eye, real positions) gives a pair as the fight sees
   it, each aimed at the other, labelled by whether the player lost HP within `HORIZON_S`; the
-  threshold with the best F1 of DIP's "hit" against those labels;
+  threshold with the best F1 of DIP's "hit" against those labels (the combat step decides every
+  0.5 s, so a pair at or above it is hit about twice in such a second: the label asks whether
+  the second saw damage at all, as the fight's first hit does);
 * **constraint**: DIP still says "hit" on at least `MIN_RECALL` of the real damaging steps of
   every map of the events data, so that it stays a classifier of real hits (issue 33).
 
@@ -28,10 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.csgo import EYE_HEIGHT_M
+from decoy_cli.damage.calibration import MIN_RECALL
 from decoy_cli.damage.combat import DipDecision
 from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.model_folder import LoadedDip
 from decoy_cli.damage.samples import build_samples
+from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, RoundFailure, collect_match_files, iter_rounds
 from decoy_cli.replay.missing import fill_missing
 from decoy_cli.sim.combat import CombatBatch
@@ -42,8 +46,6 @@ from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.physics import PhysicsWorld
 
-MIN_RECALL = 0.8
-"""Least share of real damaging steps DIP must call hits at the fight's threshold, per map."""
 GRID = tuple(round(0.05 * k, 2) for k in range(1, 20))
 """Candidate thresholds besides DIP's own."""
 HORIZON_S = 1.0
@@ -59,7 +61,7 @@ class FightPairs:
     batch: CombatBatch
     lost_hp: np.ndarray  # (K,) bool
     round_index: np.ndarray  # (K,) int64: which of the rounds used, in their order
-    rounds: int  # rounds used (with both teams)
+    rounds: int  # rounds that gave at least one pair
 
 
 def fight_pairs(rounds: Iterable[Round], graph: WaypointGraph) -> FightPairs:
@@ -138,7 +140,10 @@ def _pairs(parts: list[tuple[Round, np.ndarray]], map_name: str) -> FightPairs:
         lost.append(rows[:, 3].astype(bool))
         numbers.append(np.full(len(rows), len(numbers), dtype=np.int64))
     if not batches:
-        raise ValueError("no frame of these rounds has a player with exactly one enemy in sight")
+        raise DecoyError(
+            f"no round of {map_name or 'the map'} whose frames hold both teams has a frame with a "
+            "player and exactly one enemy in sight: nothing to choose the fight's threshold on"
+        )
     fields = {
         name: np.concatenate([getattr(b, name) for b in batches])
         for name in CombatBatch.__dataclass_fields__
@@ -210,7 +215,7 @@ def choose_for_files(
 ) -> FightChoice:
     """The fight's threshold from ESTA files or folders: the rounds of `graph`'s map whose frames
     hold both teams give the objective, the damage events of every file the constraint (module
-    docstring). ValueError when either gives nothing to choose on."""
+    docstring). A DecoyError when either gives nothing to choose on."""
     files, _ = collect_match_files(paths)
     failures: list[RoundFailure] = []
     rounds = []
@@ -226,7 +231,7 @@ def choose_for_files(
         m: hits.take(np.flatnonzero(hits.map_name == m)) for m in sorted(set(hits.map_name))
     }
     if not damaging:
-        raise ValueError("the events hold no damaging step: nothing to hold DIP's recall on")
+        raise DecoyError("the data holds no damaging step: nothing to hold DIP's recall on")
     probability = pair_probabilities(dip, pairs)
     on_map = {name: dip_probabilities(dip, samples) for name, samples in damaging.items()}
 
