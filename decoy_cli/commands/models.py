@@ -152,7 +152,8 @@ def fight_threshold_command(
     data: list[Path] = typer.Argument(
         ...,
         help="ESTA files or folders: real rounds whose frames hold both teams, and real damage "
-        "events (e.g. ../shared/data/cs2_dust2_both ../shared/data/esta_dust2_events).",
+        "events (e.g. ../shared/data/cs2_dust2_both/spirit-vs-falcons-m2-dust2-r01-12.json.xz "
+        "../shared/data/esta_dust2_events); a round given twice (at two frame rates) counts twice.",
     ),
     min_recall: float = typer.Option(
         MIN_RECALL,
