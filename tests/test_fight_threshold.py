@@ -28,6 +28,15 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"
 
 
+def dip_alone(tmp_path: Path) -> Path:
+    """A model folder holding a copy of the shipped DIP and nothing else."""
+    folder = tmp_path / "models"
+    folder.mkdir()
+    for name in ("dip.pt", "dip.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    return folder
+
+
 def facing_off() -> BothTeams:
     """A T and a CT in bomb site A, in sight of each other; the T kills the CT at 9.5 s."""
     a = builtin_graph().region_of("bombsite_a")
@@ -79,10 +88,7 @@ def test_the_choice_is_the_best_f1_the_recall_allows() -> None:
 
 
 def test_the_command_writes_the_fights_threshold(tmp_path: Path) -> None:
-    folder = tmp_path / "models"
-    folder.mkdir()
-    for name in ("dip.pt", "dip.json"):
-        shutil.copy(ROOT / "models" / name, folder / name)
+    folder = dip_alone(tmp_path)
     rounds = facing_off().write(tmp_path / "both.json")
     events = write_match(tmp_path / "events.json.xz", make_match())
     result = runner.invoke(
@@ -105,10 +111,7 @@ def _one_error_line(args: list[str]) -> str:
 
 
 def test_what_the_command_cannot_choose_on_is_one_error_line(tmp_path: Path) -> None:
-    folder = tmp_path / "models"
-    folder.mkdir()
-    for name in ("dip.pt", "dip.json"):
-        shutil.copy(ROOT / "models" / name, folder / name)
+    folder = dip_alone(tmp_path)
     rounds = facing_off().write(tmp_path / "both.json")
     events_only = make_match()
     for round_ in events_only["gameRounds"]:
@@ -138,10 +141,7 @@ def test_a_new_dip_drops_the_calibration_fitted_for_the_one_it_replaces(tmp_path
 def test_the_shipped_threshold_is_what_the_command_chooses_on_the_real_rounds(
     tmp_path: Path,
 ) -> None:
-    folder = tmp_path / "models"
-    folder.mkdir()
-    for name in ("dip.pt", "dip.json"):
-        shutil.copy(ROOT / "models" / name, folder / name)
+    folder = dip_alone(tmp_path)
     both = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-r01-12.json.xz"
     data = [both, DATA / "esta_dust2_events", DATA / "events_ancient"]
     result = runner.invoke(
