@@ -38,9 +38,10 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M, TICK_RATE
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.damage import load_damage_model
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.evaluate.fight_threshold import EYE
 from decoy_cli.metrics.kills import DEATH_WINDOW_S
 from decoy_cli.replay.deaths import replay_deaths
 from decoy_cli.replay.missing import fill_missing
@@ -53,8 +54,6 @@ from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.meshfile import read_mesh
 from decoy_cli.world.occlusion import read_sight_scene
 from decoy_cli.world.physics import PhysicsWorld
-
-EYE = np.array([0.0, 0.0, EYE_HEIGHT_M])
 
 
 def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:

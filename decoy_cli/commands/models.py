@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
+from rich.console import Console
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
@@ -24,7 +25,7 @@ from decoy_cli.commands._damage_output import (
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
-from decoy_cli.damage.calibration import MIN_RECALL, CalibrationKind, Decision
+from decoy_cli.damage.calibration import MIN_RECALL, Calibration, CalibrationKind, Decision
 from decoy_cli.damage.choice import MODELS_METAVAR
 from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.damage.evaluation import DRAWS
@@ -169,7 +170,6 @@ def fight_threshold_command(
     DIP still calls --min-recall of every map's real damaging steps hits. Written as the
     folder's dip_calibration.json (kind none); prints every candidate and the choice on each
     half of the rounds (decoy_cli/evaluate/fight_threshold.py)."""
-    from decoy_cli.damage.calibration import Calibration
     from decoy_cli.damage.model_folder import load_dip, save_calibration
     from decoy_cli.evaluate.fight_threshold import choose_for_files
     from decoy_cli.waypoints.build import builtin_graph
@@ -194,19 +194,23 @@ def fight_threshold_command(
     console = make_console()
     console.print(table)
     path = save_calibration(model_folder, Calibration("none", 1.0, 0.0, chosen.threshold))
-    if dip.calibration is not None:
-        before = dip.calibration
-        console.print(
-            f"replaces the folder's {before.kind} calibration (threshold {before.threshold:.3f}, "
-            f"{before.decision})",
-            highlight=False,
-        )
+    _say_replaced(console, dip.calibration)
     console.print(
         f"{found.lost_share:.1%} of the player-frames lost HP; chosen on each half of the rounds "
         f"alone: {found.halves[0]:.3f}, {found.halves[1]:.3f}; {len(found.failures)} rounds "
         f"unreadable; the fight decides at {chosen.threshold:.3f}; written to {path}",
         highlight=False,
     )
+
+
+def _say_replaced(console: Console, before: Calibration | None) -> None:
+    """One line naming the calibration a command wrote over, if any."""
+    if before is not None:
+        console.print(
+            f"replaces the folder's {before.kind} calibration (threshold {before.threshold:.3f}), "
+            f"which decided by {before.decision}",
+            highlight=False,
+        )
 
 
 @app.command("calibrate")
@@ -255,12 +259,7 @@ def calibrate(
         )
     console.print(table)
     c = result.calibration
-    if result.replaced is not None:
-        before = result.replaced
-        console.print(
-            f"replaces the folder's {before.kind} calibration (threshold {before.threshold:.3f})",
-            highlight=False,
-        )
+    _say_replaced(console, result.replaced)
     console.print(
         f"p' = sigmoid({c.a:.4f} * logit(p) + {c.b:.4f}); threshold {c.threshold:.3f} on the "
         f"calibrated scale; combat decides by {c.decision}; written to {result.path}",

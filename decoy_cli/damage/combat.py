@@ -172,10 +172,15 @@ class DipDecision:
     ) -> np.ndarray:
         """(K,) bool: the pairs that hit (class doc); `seed` drives Bernoulli decisions."""
         probability = self.hit_probability(batch, features)
-        armed = weapon_index(batch.attacker_weapon) >= 0
+        able = armed(batch)
         if self.calibration is not None:
-            return armed & self.calibration.decide(probability, np.random.default_rng(seed))
-        return armed & (probability >= self.threshold)
+            return able & self.calibration.decide(probability, np.random.default_rng(seed))
+        return able & (probability >= self.threshold)
+
+
+def armed(batch: CombatBatch) -> np.ndarray:
+    """(K,) bool: attackers that can hit at all, holding a firearm of the models' vocabulary."""
+    return weapon_index(batch.attacker_weapon) >= 0
 
 
 class LearnedDamage:

@@ -66,14 +66,13 @@ def hit_view_deviations(round_: Round) -> tuple[np.ndarray, np.ndarray]:
     table = round_.damages
     if not _with_views(table) or not {"weapon", "attackerSide", "victimSide"} <= set(table):
         return np.zeros(0), np.zeros(0)
-    table = table[table["weapon"].isin(FIREARMS) & (table["attackerSide"] != table["victimSide"])]
-    attacker, victim = _deviations(table)
-    known = np.isfinite(attacker) & np.isfinite(victim)
-    return attacker[known], victim[known]
+    rows, attacker, victim = _between_enemies(table[table["weapon"].isin(FIREARMS)])
+    return attacker[rows], victim[rows]
 
 
-def _between_enemies(table: pd.DataFrame) -> np.ndarray:
-    """(K,) rows whose attacker and victim are enemies at different spots with both views."""
+def _between_enemies(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(K,) rows whose attacker and victim are enemies at different spots with both views, and
+    every row's (attacker, victim) view deviations (`_deviations`)."""
     attacker, victim = _deviations(table)
     apart = (table["victimX_m"] != table["attackerX_m"]) | (
         table["victimY_m"] != table["attackerY_m"]
@@ -81,7 +80,7 @@ def _between_enemies(table: pd.DataFrame) -> np.ndarray:
     rows = np.isfinite(attacker) & np.isfinite(victim) & apart.to_numpy(bool)
     if {"attackerSide", "victimSide"} <= set(table.columns):
         rows &= (table["attackerSide"] != table["victimSide"]).to_numpy(bool)
-    return rows
+    return rows, attacker, victim
 
 
 def _with_views(table: pd.DataFrame) -> bool:
@@ -97,10 +96,9 @@ def filled_views(round_: Round) -> bool:
         table = getattr(round_, name)
         if not _with_views(table):
             continue
-        known = _between_enemies(table)
-        attacker, victim = (d[known] for d in _deviations(table))
-        if np.any(np.abs(attacker) > FILLED_WITHIN_DEG) or np.any(
-            np.abs(victim) > FILLED_WITHIN_DEG
+        known, attacker, victim = _between_enemies(table)
+        if np.abs(np.concatenate([attacker[known], victim[known]])).max(initial=0.0) > (
+            FILLED_WITHIN_DEG
         ):
             return False
         rows += int(known.sum())
@@ -123,7 +121,7 @@ def redraw_filled_views(round_: Round, stats: SampleStats) -> Round:
         draws = rng.random((len(table), 2))
         attacker = np.interp(draws[:, 0], QUANTILES, ATTACKER_DEVIATION_DEG)
         victim = np.interp(draws[:, 1], QUANTILES, VICTIM_DEVIATION_DEG)
-        known = _between_enemies(table)
+        known = _between_enemies(table)[0]
         table["attackerViewX"] = table["attackerViewX"] + attacker
         table["victimViewX"] = table["victimViewX"] + victim
         stats.partial[FILLED_NOTE] += int(known.sum())

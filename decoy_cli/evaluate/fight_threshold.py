@@ -31,19 +31,24 @@ import numpy as np
 
 from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.damage.calibration import MIN_RECALL
-from decoy_cli.damage.combat import DipDecision
+from decoy_cli.damage.combat import DipDecision, armed
 from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.model_folder import LoadedDip
-from decoy_cli.damage.samples import build_samples
+from decoy_cli.damage.sample_set import Samples, SampleStats
+from decoy_cli.damage.samples import (
+    DEFAULT_MODE,
+    DEFAULT_WINDOW_S,
+    SAMPLE_ERROR,
+    round_samples,
+)
 from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Round, RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
 from decoy_cli.replay.missing import fill_missing
 from decoy_cli.sim.combat import CombatBatch
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.sites import SiteZones
 from decoy_cli.waypoints.build import graph_world
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.physics import PhysicsWorld
 
 GRID = tuple(round(0.05 * k, 2) for k in range(1, 20))
@@ -168,9 +173,9 @@ class FightThreshold:
 
 
 def pair_probabilities(dip: LoadedDip, pairs: FightPairs) -> np.ndarray:
-    """DIP's probability for each pair; 0 where the attacker holds no firearm (he cannot hit)."""
+    """DIP's probability for each pair; 0 where the attacker cannot hit (`combat.armed`)."""
     probability = DipDecision(dip).hit_probability(pairs.batch)
-    return np.where(np.isin(pairs.batch.attacker_weapon, list(FIREARMS)), probability, 0.0)
+    return np.where(armed(pairs.batch), probability, 0.0)
 
 
 def choose_fight_threshold(
@@ -217,21 +222,36 @@ def choose_for_files(
     hold both teams give the objective, the damage events of every file the constraint (module
     docstring). A DecoyError when either gives nothing to choose on."""
     files, _ = collect_match_files(paths)
+    if not files:
+        raise DecoyError("no data given: pass ESTA match files or folders")
     failures: list[RoundFailure] = []
-    rounds = []
-    for round_ in iter_rounds(files):
-        if isinstance(round_, RoundFailure):
-            failures.append(round_)
-        elif round_.map_name == graph.meta.get("map"):
+    rounds: list[Round] = []
+    parts: list[Samples] = []
+
+    def damaging_steps(round_: Round) -> Samples | None:  # the samples `models evaluate` scores
+        if not len(round_.damages):
+            return None
+        part = round_samples(round_, DEFAULT_MODE, DEFAULT_WINDOW_S, SampleStats())
+        return None if part is None else part.take(np.flatnonzero(part.hit))
+
+    for item in each_round(iter_rounds(files), damaging_steps, SAMPLE_ERROR):
+        if isinstance(item, RoundFailure):
+            failures.append(item)
+            continue
+        round_, part = item
+        if round_.map_name == graph.meta.get("map"):
             rounds.append(round_)
+        if part is not None and len(part):
+            parts.append(part)
     pairs = fight_pairs(rounds, graph)
-    samples, _ = build_samples(files)
-    hits = samples.take(np.flatnonzero(samples.hit))
+    if not parts:
+        raise DecoyError(
+            "no usable samples: the data holds no damaging step to hold DIP's recall on"
+        )
+    hits = Samples.concat(parts)
     damaging = {
         m: hits.take(np.flatnonzero(hits.map_name == m)) for m in sorted(set(hits.map_name))
     }
-    if not damaging:
-        raise DecoyError("the data holds no damaging step: nothing to hold DIP's recall on")
     probability = pair_probabilities(dip, pairs)
     on_map = {name: dip_probabilities(dip, samples) for name, samples in damaging.items()}
 
