@@ -19,8 +19,16 @@ import numpy as np
 from decoy_cli.damage import SHIPPED_MODELS
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.fold_comparison import rules_out_of_fold
-from decoy_cli.damage.hp_lost import HpLostScores, draw_outcomes, score_by_map
+from decoy_cli.damage.hp_lost import (
+    HpLostScores,
+    band_labels,
+    distance_u,
+    draw_outcomes,
+    drawn_hp_lost,
+    score_by_map,
+)
 from decoy_cli.damage.rules_model import RulesFile
+from decoy_cli.damage.sample_set import Samples
 from decoy_cli.damage.samples import build_samples
 from decoy_cli.damage.split import leave_matches_out
 from decoy_cli.esta import collect_match_files, read_match
@@ -61,6 +69,26 @@ def main() -> None:
             print(_line(name, where, scores))
     print("HP lost per step; W: Wasserstein per (weapon, distance band) cell; floor: what the")
     print("model would score were the real steps drawn from it")
+    _largest_cells(positives, fitted)
+
+
+def _largest_cells(positives: Samples, drawn: np.ndarray, count: int = 3) -> None:
+    """Each map's `count` largest cells of the leave-matches-out draws, with the mean HP lost
+    real and drawn."""
+    lost = drawn_hp_lost(drawn, positives.victim_hp)
+    bands = band_labels(distance_u(positives))
+    for where, scores in score_by_map(positives, drawn).items():
+        if where == "all":
+            continue
+        for cell in sorted(scores.cells, key=lambda c: -c["wasserstein_hp"])[:count]:
+            rows = (positives.map_name == where) & (positives.attacker_weapon == cell["weapon"])
+            rows &= bands == cell["part"]
+            print(
+                f"largest cell {where} {cell['weapon']} {cell['part']}: {cell['real']} steps, "
+                f"mean HP lost real {positives.hp_lost[rows].mean():.1f}, drawn "
+                f"{lost[:, rows].mean():.1f}, W {cell['wasserstein_hp']:.2f} "
+                f"(floor {cell['floor_hp']:.2f})"
+            )
 
 
 if __name__ == "__main__":

@@ -120,6 +120,20 @@ def test_censored_bullet_counts_by_hand() -> None:
     assert p_one < 1.0 and counts.probabilities("AK-47", 300.0)[1] > 0
 
 
+def test_a_kill_hides_only_whether_one_more_bullet_would_land() -> None:
+    """A Desert Eagle step killed by one bullet and one step of one bullet that left its victim
+    alive: the kill says at least one bullet lands, not that a second would; the one step that
+    ended says one is all. So one bullet, at every level; counting the kill at risk of a second
+    bullet (its own count) would have drawn two in half the steps."""
+    counts = BulletCounts(censored=True)
+    counts.add("Desert Eagle", 300.0, 1, killed=True)
+    counts.add("Desert Eagle", 300.0, 1, killed=False)
+    np.testing.assert_allclose(counts.probabilities("Desert Eagle", 300.0), [1.0] + [0.0] * 9)
+    counts.add("Desert Eagle", 300.0, 2, killed=False)  # now one of two alive steps went on
+    p = counts.probabilities("Desert Eagle", 300.0)
+    assert 0.0 < p[1] < 0.5 and p[0] + p[1] == pytest.approx(1.0)
+
+
 def test_leave_matches_out_folds() -> None:
     """Map A has two matches: one fold each. Map B has one match of 5 rounds: its rounds are
     dealt into folds of their own, every round in one fold."""

@@ -5,12 +5,15 @@ Steps are counted by the bullets that landed, at four levels, each pulled toward
 with `PRIOR_STEPS` pseudo-steps: all steps, the weapon's class, the weapon, and the weapon at
 the step's distance band (`hit_groups.DISTANCE_BANDS_U`; fewer bullets land at long range).
 
-A step that killed its victim says only that at least that many bullets would have landed: the
+A step that killed its victim after k bullets says only that at least k would have landed: the
 victim's death ended it. With `censored`, those steps are right-censored and the distribution is
 the Kaplan-Meier estimate of the bullets that would land on a victim that stays alive (the
 hazard of "no further bullet" at each count, pulled level by level as the counts are), which the
 simulator then cuts at the victim's death; the weapon's most bullets seen in one step (measured
-on the real steps) bounds it. Without `censored`, the plain shares of the counts.
+on the real steps) bounds it. A step killed at k is at risk of ending at the counts below k
+only: whether a k+1-th bullet would have landed is what its kill hides (counting it at risk at
+k, as if it had, drew too many bullets: a kill by one head shot said "a second bullet lands").
+Without `censored`, the plain shares of the counts.
 """
 
 from __future__ import annotations
@@ -69,7 +72,7 @@ class BulletCounts:
             return p
         hazard = np.ones(MAX_BULLETS)
         for counts, killed in tables:
-            at_risk = np.cumsum(counts[::-1])[::-1]
+            at_risk = np.cumsum(counts[::-1])[::-1] - killed
             hazard = (counts - killed + PRIOR_STEPS * hazard) / (at_risk + PRIOR_STEPS)
         most = int(np.flatnonzero(tables[min(len(tables), 3) - 1][0])[-1])
         hazard[most:] = 1.0  # never more bullets than the weapon was seen to land

@@ -162,7 +162,7 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
     distances: list[float] = []
     groups: list[str] = []
     health: list[float] = []
-    bullets, bullets_hurt = BulletCounts(censored=True), BulletCounts()
+    bullets, bullets_hurt = BulletCounts(censored=True), BulletCounts(censored=True)
     unknown: list[tuple[str, float, float, float, bool]] = []
     used_rounds = 0
     maps: set[str] = set()
