@@ -87,6 +87,32 @@ def test_the_choice_is_the_best_f1_the_recall_allows() -> None:
     assert own.threshold == 0.12  # only DIP's own and 0.05, 0.1 remain: it scores best
 
 
+def test_recall_is_held_on_the_steps_dip_did_not_train_on() -> None:
+    """Map A has a match DIP trained on and one it did not: its recall is held on the latter
+    alone. Map B's only match was trained on: held on it, and named so. A DIP whose metadata
+    names no split (imported, older) is held on every step."""
+    import dataclasses
+
+    from test_damage_samples import synthetic
+
+    from decoy_cli.evaluate.fight_threshold import _damaging_by_map, _trained_on
+
+    base = synthetic(groups=6, per_group=2, matches=1)
+    maps = np.array(["de_a"] * 8 + ["de_b"] * 4, dtype=object)
+    match = np.array(["m1"] * 4 + ["m2"] * 4 + ["m3"] * 4, dtype=object)
+    steps = dataclasses.replace(base, map_name=maps, match=match)
+    dip = load_dip(ROOT / "models")
+    split = {"by": "match", "units": {"train": ["m1", "m3"], "val": ["m2"], "test": []}}
+    trained = _trained_on(dataclasses.replace(dip, metadata={"split": split}), steps)
+    assert trained.tolist() == [True] * 4 + [False] * 4 + [True] * 4
+    parts = _damaging_by_map(steps, trained)
+    assert sorted(parts) == ["de_a held out", "de_b trained on"]
+    assert (
+        parts["de_a held out"].match.tolist() == ["m2"] * 4 and len(parts["de_b trained on"]) == 4
+    )
+    assert not _trained_on(dataclasses.replace(dip, metadata={}), steps).any()
+
+
 def test_the_command_writes_the_fights_threshold(tmp_path: Path) -> None:
     folder = dip_alone(tmp_path)
     rounds = facing_off().write(tmp_path / "both.json")

@@ -161,13 +161,15 @@ def fight_threshold_command(
         "--min-recall",
         min=0.0,
         max=1.0,
-        help="Least share of each map's real damaging steps DIP must still call hits.",
+        help="Least share of each map's real damaging steps DIP must still call hits (those "
+        "it did not train on, where the map has any).",
     ),
 ) -> None:
     """Choose the DIP threshold the simulator's fight decides by, where the fight works: the
     best F1 on real rounds of both teams (a player with one enemy in sight at a frame, both
     aimed as the fight aims; did he lose HP within 1 s?), among the thresholds at which
-    DIP still calls --min-recall of every map's real damaging steps hits. Written as the
+    DIP still calls --min-recall of every map's real damaging steps hits (those it did not
+    train on, where the map has any). Written as the
     folder's dip_calibration.json (kind none); prints every candidate and the choice on each
     half of the rounds (decoy_cli/evaluate/fight_threshold.py)."""
     from decoy_cli.damage.model_folder import load_dip, save_calibration

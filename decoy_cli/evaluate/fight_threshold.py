@@ -14,7 +14,10 @@ on what the fight meets:
   0.5 s, so a pair at or above it is hit about twice in such a second: the label asks whether
   the second saw damage at all, as the fight's first hit does);
 * **constraint**: DIP still says "hit" on at least `MIN_RECALL` of the real damaging steps of
-  every map of the events data, so that it stays a classifier of real hits (issue 33).
+  every map of the events data, so that it stays a classifier of real hits (issue 33): of the
+  steps it did not train on (outside the training part its metadata names: its validation and
+  test matches or rounds), where a map has any, since recall on its own training steps flatters
+  it; a map it trained on whole is held on those, and says so.
 
 Candidates: DIP's own threshold and `GRID`. `choose_fight_threshold` returns the table behind
 the choice; `decoy models fight-threshold` writes the choice as the folder's calibration (kind
@@ -201,6 +204,30 @@ def choose_fight_threshold(
     return FightThreshold(float(best["threshold"]), float(own_threshold), rows)
 
 
+def _trained_on(dip: LoadedDip, steps: Samples) -> np.ndarray:
+    """(K,) True for the steps of the matches or rounds DIP trained on (its metadata's
+    `split.units.train`); all False when it names none (an imported or older DIP)."""
+    split = dip.metadata.get("split")
+    parts = split.get("units") if isinstance(split, dict) else None
+    train = parts.get("train") if isinstance(parts, dict) else None
+    if not isinstance(split, dict) or not isinstance(train, list):
+        return np.zeros(len(steps), bool)
+    unit_of = steps.match if split.get("by") == "match" else steps.group
+    return np.isin(unit_of.astype(str), [str(unit) for unit in train])
+
+
+def _damaging_by_map(steps: Samples, trained: np.ndarray) -> dict[str, Samples]:
+    """Each map's damaging steps DIP did not train on, named "<map> held out"; a map whose
+    every step it trained on keeps them all, named "<map> trained on"."""
+    out = {}
+    for name in sorted(set(steps.map_name)):
+        on_map = steps.map_name == name
+        held = on_map & ~trained
+        rows, label = (held, "held out") if held.any() else (on_map, "trained on")
+        out[f"{name} {label}"] = steps.take(np.flatnonzero(rows))
+    return out
+
+
 @dataclass(frozen=True)
 class FightChoice:
     """`choose_for_files`'s result: the choice on all rounds, on each half of them alone, and
@@ -249,9 +276,7 @@ def choose_for_files(
             "no usable samples: the data holds no damaging step to hold DIP's recall on"
         )
     hits = Samples.concat(parts)
-    damaging = {
-        m: hits.take(np.flatnonzero(hits.map_name == m)) for m in sorted(set(hits.map_name))
-    }
+    damaging = _damaging_by_map(hits, _trained_on(dip, hits))
     probability = pair_probabilities(dip, pairs)
     on_map = {name: dip_probabilities(dip, samples) for name, samples in damaging.items()}
 
