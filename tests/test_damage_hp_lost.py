@@ -104,13 +104,14 @@ def test_bullets_per_step_by_weapon_pulled_toward_the_class() -> None:
 def test_censored_bullet_counts_by_hand() -> None:
     """Two AK-47 steps at 300 u: one bullet that left the victim alive, two that killed it. All
     levels hold the same counts, so each pulls the hazard of "no further bullet" toward the one
-    above with 5 pseudo-steps. At one bullet: 1 ended of 2 at risk; at two: 0 ended (the kill
-    is censored) of 1; the AK-47 was seen landing at most 2, so the rest ends there."""
+    above with 5 pseudo-steps. At one bullet: 1 ended of 2 at risk; at two: none at risk (the
+    kill says only "at least two"); the AK-47 was seen landing at most 2, so the rest ends
+    there."""
     counts = BulletCounts(censored=True)
     counts.add("AK-47", 300.0, 1, killed=False)
     counts.add("AK-47", 300.0, 2, killed=True)
     hazard = np.ones(10)
-    at_risk = np.array([2.0, 1.0] + [0.0] * 8)
+    at_risk = np.array([2.0] + [0.0] * 9)
     ended = np.array([1.0] + [0.0] * 9)
     for _ in range(4):  # all steps, the Rifle class, the AK-47, the AK-47 at 0-500 u
         hazard = (ended + 5 * hazard) / (at_risk + 5)
@@ -121,17 +122,21 @@ def test_censored_bullet_counts_by_hand() -> None:
 
 
 def test_a_kill_hides_only_whether_one_more_bullet_would_land() -> None:
-    """A Desert Eagle step killed by one bullet and one step of one bullet that left its victim
-    alive: the kill says at least one bullet lands, not that a second would; the one step that
-    ended says one is all. So one bullet, at every level; counting the kill at risk of a second
-    bullet (its own count) would have drawn two in half the steps."""
+    """Desert Eagle steps at 300 u: one killed by its first bullet, one of one bullet and one of
+    two that left their victims alive. The kill says only that at least one bullet lands, not
+    whether a second would: at one bullet 1 step ended of the 2 whose fate there is known, at two
+    the other (the most this weapon was seen to land). Each level pulls the hazard toward the
+    one above with 5 pseudo-steps. Counting the kill at risk at one bullet (as if a second had
+    landed) would give 1 of 3, and two bullets in more of the draws."""
     counts = BulletCounts(censored=True)
     counts.add("Desert Eagle", 300.0, 1, killed=True)
     counts.add("Desert Eagle", 300.0, 1, killed=False)
-    np.testing.assert_allclose(counts.probabilities("Desert Eagle", 300.0), [1.0] + [0.0] * 9)
-    counts.add("Desert Eagle", 300.0, 2, killed=False)  # now one of two alive steps went on
-    p = counts.probabilities("Desert Eagle", 300.0)
-    assert 0.0 < p[1] < 0.5 and p[0] + p[1] == pytest.approx(1.0)
+    counts.add("Desert Eagle", 300.0, 2, killed=False)
+    hazard = 1.0
+    for _ in range(4):  # all steps, the Pistols class, the Desert Eagle, at 0-500 u
+        hazard = (1 + 5 * hazard) / (2 + 5)
+    expected = [hazard, 1 - hazard] + [0.0] * 8
+    np.testing.assert_allclose(counts.probabilities("Desert Eagle", 300.0), expected)
 
 
 def test_leave_matches_out_folds() -> None:
@@ -202,7 +207,10 @@ def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
     assert report["dip_by_map"]["de_ancient"]["positives"] == step["steps"]
     assert report["dip_of_map"] == {"de_ancient": "the DIP of the shipped models"}
     assert "DIP on de_ancient (the DIP of the shipped models" in result.output
-    assert 0 < step["mean_floor_hp"] < step["mean_wasserstein_hp"]
+    # fitted on these very steps: as close to them as chance lets a model be, within 1 HP
+    assert (
+        step["mean_floor_hp"] > 0 and abs(step["mean_wasserstein_hp"] - step["mean_floor_hp"]) < 1
+    )
 
 
 def test_fold_comparison_labels_what_the_model_saw() -> None:

@@ -89,8 +89,9 @@ def test_the_choice_is_the_best_f1_the_recall_allows() -> None:
 
 def test_recall_is_held_on_the_steps_dip_did_not_train_on() -> None:
     """Map A has a match DIP trained on and one it did not: its recall is held on the latter
-    alone. Map B's only match was trained on: held on it, and named so. A DIP whose metadata
-    names no split (imported, older) is held on every step."""
+    alone. Map B's only match was trained on: held on it, and named so. Split by round, the
+    rounds name the steps. A DIP whose metadata names no split (imported, older) is held on
+    every step, and says so."""
     import dataclasses
 
     from test_damage_samples import synthetic
@@ -102,15 +103,22 @@ def test_recall_is_held_on_the_steps_dip_did_not_train_on() -> None:
     match = np.array(["m1"] * 4 + ["m2"] * 4 + ["m3"] * 4, dtype=object)
     steps = dataclasses.replace(base, map_name=maps, match=match)
     dip = load_dip(ROOT / "models")
-    split = {"by": "match", "units": {"train": ["m1", "m3"], "val": ["m2"], "test": []}}
-    trained = _trained_on(dataclasses.replace(dip, metadata={"split": split}), steps)
-    assert trained.tolist() == [True] * 4 + [False] * 4 + [True] * 4
-    parts = _damaging_by_map(steps, trained)
-    assert sorted(parts) == ["de_a held out", "de_b trained on"]
-    assert (
-        parts["de_a held out"].match.tolist() == ["m2"] * 4 and len(parts["de_b trained on"]) == 4
-    )
-    assert not _trained_on(dataclasses.replace(dip, metadata={}), steps).any()
+
+    def trained(split: object) -> np.ndarray | None:
+        return _trained_on(dataclasses.replace(dip, metadata={"split": split}), steps)
+
+    by_match = trained({"by": "match", "units": {"train": ["m1", "m3"], "val": ["m2"]}})
+    assert by_match is not None
+    assert by_match.tolist() == [True] * 4 + [False] * 4 + [True] * 4
+    parts = _damaging_by_map(steps, by_match)
+    assert sorted(parts) == ["de_a held out (4)", "de_b trained on (4)"]
+    assert parts["de_a held out (4)"].match.tolist() == ["m2"] * 4
+    rounds = sorted(set(steps.group.tolist()))
+    by_round = trained({"by": "round", "units": {"train": rounds[:1]}})
+    assert by_round is not None and by_round.tolist() == [True] * 2 + [False] * 10
+    for odd in (None, {"by": "matches", "units": {"train": ["m1"]}}, {"by": "match"}):
+        assert trained(odd) is None
+    assert sorted(_damaging_by_map(steps, None)) == ["de_a all steps (8)", "de_b all steps (4)"]
 
 
 def test_the_command_writes_the_fights_threshold(tmp_path: Path) -> None:

@@ -52,6 +52,31 @@ def test_fit_rules_beside_a_dip_makes_a_rules_model(tmp_path: Path) -> None:
     assert isinstance(load_damage_model(str(folder)), RulesDamage)  # a DIP and rules, no DOG
 
 
+def test_a_step_another_attacker_ends_counts_as_cut_short(tmp_path: Path) -> None:
+    """Round 2 of the fixture (128 ticks: 64 ticks a step), its damages replaced: ct1 lands
+    one bullet (27 HP) on unhurt t1 and, in the same 0.5 s step, ct2 finishes him (73 HP, on a
+    victim then hurt): ct1's step was cut short by the death as much as ct2's, so both are
+    censored (killed). ct1 hurts t2 (30 HP, unhurt before, alive after) and two steps later
+    lands the rest (70 HP, on a hurt victim: censored too)."""
+    from esta_fixtures import _damage, make_match, write_match
+
+    from decoy_cli.damage.rules_model import fit_rules
+    from decoy_cli.esta import read_match
+
+    match = make_match()
+    match["gameRounds"][1]["damages"] = [
+        _damage(5070, "ct1", "t1", "M4A4", 27),
+        _damage(5075, "ct2", "t1", "M4A4", 73),
+        _damage(5100, "ct1", "t2", "M4A4", 30),
+        _damage(5200, "ct1", "t2", "M4A4", 70),
+    ]
+    path = write_match(tmp_path / "m.json.xz", match)
+    rules = fit_rules([r for r in read_match(path).rounds if r.round_num == 2])
+    assert rules.bullets.counts[ALL][0] == 2 and rules.bullets.killed[ALL][0] == 1
+    assert rules.bullets_hurt is not None and rules.bullets_hurt.censored
+    assert rules.bullets_hurt.counts[ALL][0] == 2 and rules.bullets_hurt.killed[ALL][0] == 2
+
+
 def test_bad_folders_are_one_error_line(tmp_path: Path) -> None:
     result = runner.invoke(app, ["models", "fit-rules", str(tmp_path), str(tmp_path)])
     assert result.exit_code == 1 and "error: " in result.output

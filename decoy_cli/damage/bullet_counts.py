@@ -9,10 +9,11 @@ A step that killed its victim after k bullets says only that at least k would ha
 victim's death ended it. With `censored`, those steps are right-censored and the distribution is
 the Kaplan-Meier estimate of the bullets that would land on a victim that stays alive (the
 hazard of "no further bullet" at each count, pulled level by level as the counts are), which the
-simulator then cuts at the victim's death; the weapon's most bullets seen in one step (measured
-on the real steps) bounds it. A step killed at k is at risk of ending at the counts below k
-only: whether a k+1-th bullet would have landed is what its kill hides (counting it at risk at
-k, as if it had, drew too many bullets: a kill by one head shot said "a second bullet lands").
+simulator then cuts at the victim's death; the most bullets the weapon was seen to land in one
+step (measured on the real steps; a weapon never seen, its class's) bounds it. A step killed at
+k goes on past every count below k and leaves the risk set at k: whether it would have ended
+there is what its kill hides (counted at risk at k, as if a k+1-th bullet had landed, it drew
+too many bullets: a kill by one head shot said "a second bullet lands").
 Without `censored`, the plain shares of the counts.
 """
 

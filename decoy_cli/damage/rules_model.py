@@ -184,10 +184,11 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         origin, step_ticks = step_clock(round_)
         step = np.rint((np.nan_to_num(rows.tick) - origin) / step_ticks)
         steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
-        for hit in steps.values():
-            earlier = (rows.victim == rows.victim[hit.first]) & (rows.tick < rows.tick[hit.first])
-            lost = float(rows.hp_taken[earlier].sum())
-            killed = lost + hit.hp_lost >= FULL_HP - 0.5
+        for (at, _, _), hit in steps.items():
+            victim = rows.victim == rows.victim[hit.first]
+            lost = float(rows.hp_taken[victim & (rows.tick < rows.tick[hit.first])].sum())
+            # died in the step, by this attacker's bullets or another's: its count was cut short
+            killed = float(rows.hp_taken[victim & (step <= at)].sum()) >= FULL_HP - 0.5
             counts = bullets_hurt if lost > 0 else bullets
             counts.add(str(rows.weapon[hit.first]), float(distance[hit.first]), hit.hits, killed)
     total = sum(sum(c.counts.get(ALL, [])) for c in (bullets, bullets_hurt))

@@ -204,27 +204,34 @@ def choose_fight_threshold(
     return FightThreshold(float(best["threshold"]), float(own_threshold), rows)
 
 
-def _trained_on(dip: LoadedDip, steps: Samples) -> np.ndarray:
+def _trained_on(dip: LoadedDip, steps: Samples) -> np.ndarray | None:
     """(K,) True for the steps of the matches or rounds DIP trained on (its metadata's
-    `split.units.train`); all False when it names none (an imported or older DIP)."""
+    `split`: by "match" or "round", and `units.train`); None when it names none (an imported
+    or older DIP): which steps it saw is not known."""
     split = dip.metadata.get("split")
     parts = split.get("units") if isinstance(split, dict) else None
     train = parts.get("train") if isinstance(parts, dict) else None
-    if not isinstance(split, dict) or not isinstance(train, list):
-        return np.zeros(len(steps), bool)
-    unit_of = steps.match if split.get("by") == "match" else steps.group
+    if not isinstance(split, dict) or split.get("by") not in ("match", "round"):
+        return None
+    if not isinstance(train, list):
+        return None
+    unit_of = steps.match if split["by"] == "match" else steps.group
     return np.isin(unit_of.astype(str), [str(unit) for unit in train])
 
 
-def _damaging_by_map(steps: Samples, trained: np.ndarray) -> dict[str, Samples]:
-    """Each map's damaging steps DIP did not train on, named "<map> held out"; a map whose
-    every step it trained on keeps them all, named "<map> trained on"."""
+def _damaging_by_map(steps: Samples, trained: np.ndarray | None) -> dict[str, Samples]:
+    """Each map's damaging steps DIP did not train on, named "<map> held out (N)"; a map whose
+    every step it trained on keeps them all, "<map> trained on (N)"; every step, "<map> all
+    steps (N)", when which it trained on is not known. (Held-out steps include its validation
+    part, which chose its epoch and its own threshold, never its weights.)"""
     out = {}
     for name in sorted(set(steps.map_name)):
         on_map = steps.map_name == name
-        held = on_map & ~trained
-        rows, label = (held, "held out") if held.any() else (on_map, "trained on")
-        out[f"{name} {label}"] = steps.take(np.flatnonzero(rows))
+        held = on_map if trained is None else on_map & ~trained
+        label = "all steps" if trained is None else "held out"
+        if not held.any():
+            held, label = on_map, "trained on"
+        out[f"{name} {label} ({int(held.sum())})"] = steps.take(np.flatnonzero(held))
     return out
 
 
