@@ -5,7 +5,12 @@
 1. On the round of both teams with the real view (`cs2_dust2_both/...-8hz-r02.json.xz`): how far
    the view is from the direction of motion (moving frames, over 0.5 s), and for every real
    kill how far the killer's view was from the victim, and the victim's from the killer, 2, 1,
-   0.5 and 0 s before it. The replay's agents look along their motion until they aim.
+   0.5 and 0 s before it. The replay's agents look along their motion until they aim. And
+   for every kill whose pair is in sight (nav world, eye to eye) at the frame of the victim's
+   first HP loss in the 3 s before it, or the frame before: when that run of frames in sight
+   began, how long until the HP loss, and how far the killer's view was off the victim then:
+   the time reality takes from sight to damage, against the replay's reaction time
+   (`sim/combat.REACTION_S`, at a 0.5 s combat cadence).
 2. On the real damage events (`esta_dust2_events`, `events_ancient`, as `decoy models evaluate`
    reads them): the share of damaging and other steps DIP says "hit" for, as recorded and with
    every victim's view turned 45, 90 and 180 degrees away (de_dust2's views are real;
@@ -23,12 +28,15 @@ from pathlib import Path
 
 import numpy as np
 
+from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.damage import resolve_models
 from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.filled_views import QUANTILES, hit_view_deviations
 from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.damage.samples import build_samples
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.waypoints.build import builtin_graph, graph_world
+from decoy_cli.world.physics import PhysicsWorld
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 ROUND_8HZ = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-8hz-r02.json.xz"
@@ -65,6 +73,37 @@ def real_views() -> None:
             f"the victim {[round(float(x)) for x in killer]}, victim's off the killer "
             f"{[round(float(x)) for x in victim]} deg at {BEFORE_S} s before"
         )
+
+
+def sight_to_damage() -> None:
+    (round_,) = list(iter_rounds([ROUND_8HZ]))
+    seconds, position, yaw, hp = round_.frame_seconds, round_.position, round_.yaw, round_.hp
+    names = [p.name for p in round_.players]
+    eye = np.array([0.0, 0.0, EYE_HEIGHT_M])
+    with PhysicsWorld(graph_world(builtin_graph())) as world:
+        for kill in round_.kills.itertuples():
+            a, v = names.index(kill.attackerName), names.index(kill.victimName)
+            sight = world.line_of_sight(position[a] + eye, position[v] + eye)
+            window = range(max(1, int(np.searchsorted(seconds, kill.seconds - 3.0))), len(seconds))
+            lost = [f for f in window if seconds[f] <= kill.seconds and hp[v, f] < hp[v, f - 1]]
+            first = (
+                lost[0]
+                if lost
+                else min(int(np.searchsorted(seconds, kill.seconds)), len(seconds) - 1)
+            )
+            end = first if sight[first] else first - 1
+            if end < 0 or not sight[end]:
+                print(f"  {kill.seconds:6.1f} s {kill.attackerName} -> {kill.victimName}: hidden")
+                continue
+            start = end
+            while start > 0 and sight[start - 1]:
+                start -= 1
+            off = abs(float(_off(yaw[a, start], position[a, start], position[v, start])))
+            print(
+                f"  {kill.seconds:6.1f} s {kill.attackerName} -> {kill.victimName}: in sight "
+                f"{seconds[first] - seconds[start]:.3f} s before the first HP lost, the killer's "
+                f"view {off:.0f} deg off the victim at first sight"
+            )
 
 
 def dip_on_facing(models: str) -> None:
@@ -112,6 +151,7 @@ def main() -> None:
     parser.add_argument("--models", default="rules", help="a --models choice or a DIP folder")
     args = parser.parse_args()
     real_views()
+    sight_to_damage()
     dip_on_facing(args.models)
     filled_views(args.models)
 
