@@ -96,16 +96,16 @@ def test_recall_is_held_on_the_steps_dip_did_not_train_on() -> None:
 
     from test_damage_samples import synthetic
 
-    from decoy_cli.evaluate.fight_threshold import _damaging_by_map, _trained_on
+    from decoy_cli.damage.provenance import seen_in
+    from decoy_cli.evaluate.fight_threshold import _damaging_by_map
 
     base = synthetic(groups=6, per_group=2, matches=1)
     maps = np.array(["de_a"] * 8 + ["de_b"] * 4, dtype=object)
     match = np.array(["m1"] * 4 + ["m2"] * 4 + ["m3"] * 4, dtype=object)
     steps = dataclasses.replace(base, map_name=maps, match=match)
-    dip = load_dip(ROOT / "models")
 
-    def trained(split: object) -> np.ndarray | None:
-        return _trained_on(dataclasses.replace(dip, metadata={"split": split}), steps)
+    def trained(split: object) -> np.ndarray | None:  # as DIP's metadata records its split
+        return seen_in({"split": split}, steps, ("train",))
 
     by_match = trained({"by": "match", "units": {"train": ["m1", "m3"], "val": ["m2"]}})
     assert by_match is not None

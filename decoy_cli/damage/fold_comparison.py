@@ -29,13 +29,14 @@ import numpy as np
 
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.features import FeatureSpec
+from decoy_cli.damage.provenance import seen_in
 from decoy_cli.damage.rules_model import fit_rules
 from decoy_cli.damage.sample_set import Samples
 from decoy_cli.damage.scores import hit_group_tv, sampling_floor, wasserstein_cells
 from decoy_cli.damage.split import FOLDS, deal_folds
 from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
-from decoy_cli.files import JsonObject, JsonValue, object_at
+from decoy_cli.files import JsonObject
 
 MIN_CELL = 5
 """Fewest real samples of a cell in the Wasserstein mean (issue 13's protocol)."""
@@ -166,22 +167,16 @@ def rules_out_of_fold(
 def training_overlap(metadata: JsonObject, samples: Samples) -> str:
     """What share of the samples' rounds a model saw while it was trained (its training or
     validation part, as its metadata's split records them), in words for a label."""
-    split = object_at(metadata, "split")
-    units = object_at(split, "units")
-    seen = set(_list(units.get("train"))) | set(_list(units.get("val")))
-    key = samples.match if split.get("by") == "match" else samples.group
-    rounds = {str(g): str(k) for g, k in zip(samples.group, key, strict=True)}
-    overlap = sum(1 for unit in rounds.values() if unit in seen)
-    if not split:
+    seen = seen_in(metadata, samples, ("train", "val"))
+    if seen is None:
         return "its training data unrecorded"
+    rounds = {str(g): bool(s) for g, s in zip(samples.group, seen, strict=True)}
+    overlap = sum(rounds.values())
     if overlap == 0:
-        maps = [str(m) for m in _list(metadata.get("maps"))]
-        return "trained on none of these rounds" + (f" ({', '.join(maps)})" if maps else "")
+        maps = metadata.get("maps")
+        names = [str(m) for m in maps] if isinstance(maps, list) else []
+        return "trained on none of these rounds" + (f" ({', '.join(names)})" if names else "")
     return f"trained or validated on {overlap} of these {len(rounds)} rounds"
-
-
-def _list(value: JsonValue) -> list[JsonValue]:
-    return value if isinstance(value, list) else []
 
 
 def compare_on_folds(

@@ -11,6 +11,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from decoy_cli import __version__, files
 from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode, build_samples
@@ -24,6 +26,7 @@ from decoy_cli.damage.split import (
     split_samples,
 )
 from decoy_cli.damage.train_options import TrainOptions
+from decoy_cli.files import JsonObject, object_at
 
 FileCallback = Callable[[Path, int, int], None]
 """Called after each data file is read: (path, files done, files in all)."""
@@ -81,6 +84,23 @@ def provenance(
         "sample_stats": stats.to_json(),
         "options": options.to_json(),
     }
+
+
+def seen_in(metadata: JsonObject, samples: Samples, parts: Sequence[str]) -> np.ndarray | None:
+    """(K,) True for the samples of the matches or rounds a model's metadata (`provenance`)
+    records in `parts` of its split ("train", "val", "test"); None when it records no split by
+    match or round (an imported or older model): what it saw is not known."""
+    split = object_at(metadata, "split")
+    units = split.get("units")
+    if split.get("by") not in ("match", "round") or not isinstance(units, dict):
+        return None
+    seen = [str(u) for part in parts for u in _listed(units.get(part))]
+    unit_of = samples.match if split["by"] == "match" else samples.group
+    return np.isin(unit_of.astype(str), seen)
+
+
+def _listed(value: object) -> list[object]:
+    return value if isinstance(value, list) else []
 
 
 def write_json(path: Path, data: dict[str, object]) -> None:

@@ -37,6 +37,7 @@ from decoy_cli.damage.calibration import MIN_RECALL
 from decoy_cli.damage.combat import DipDecision, armed
 from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.model_folder import LoadedDip
+from decoy_cli.damage.provenance import seen_in
 from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.damage.samples import (
     DEFAULT_MODE,
@@ -204,21 +205,6 @@ def choose_fight_threshold(
     return FightThreshold(float(best["threshold"]), float(own_threshold), rows)
 
 
-def _trained_on(dip: LoadedDip, steps: Samples) -> np.ndarray | None:
-    """(K,) True for the steps of the matches or rounds DIP trained on (its metadata's
-    `split`: by "match" or "round", and `units.train`); None when it names none (an imported
-    or older DIP): which steps it saw is not known."""
-    split = dip.metadata.get("split")
-    parts = split.get("units") if isinstance(split, dict) else None
-    train = parts.get("train") if isinstance(parts, dict) else None
-    if not isinstance(split, dict) or split.get("by") not in ("match", "round"):
-        return None
-    if not isinstance(train, list):
-        return None
-    unit_of = steps.match if split["by"] == "match" else steps.group
-    return np.isin(unit_of.astype(str), [str(unit) for unit in train])
-
-
 def _damaging_by_map(steps: Samples, trained: np.ndarray | None) -> dict[str, Samples]:
     """Each map's damaging steps DIP did not train on, named "<map> held out (N)"; a map whose
     every step it trained on keeps them all, "<map> trained on (N)"; every step, "<map> all
@@ -283,7 +269,7 @@ def choose_for_files(
             "no usable samples: the data holds no damaging step to hold DIP's recall on"
         )
     hits = Samples.concat(parts)
-    damaging = _damaging_by_map(hits, _trained_on(dip, hits))
+    damaging = _damaging_by_map(hits, seen_in(dip.metadata, hits, ("train",)))
     probability = pair_probabilities(dip, pairs)
     on_map = {name: dip_probabilities(dip, samples) for name, samples in damaging.items()}
 
