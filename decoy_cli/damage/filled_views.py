@@ -88,9 +88,10 @@ def _with_views(table: pd.DataFrame) -> bool:
     return len(table) > 0 and columns <= set(table.columns)
 
 
-def filled_views(round_: Round) -> bool:
-    """Whether the round has damage or kill rows between enemies at different spots with both
-    views, and every one of them faces exactly (a recorded victim's view almost never does)."""
+def filled_views(round_: Round) -> int:
+    """The round's damage and kill rows between enemies at different spots with both views when
+    every one of them faces exactly (a recorded victim's view almost never does); 0 when one
+    does not, or there is none."""
     rows = 0
     for name in TABLES:
         table = getattr(round_, name)
@@ -100,15 +101,16 @@ def filled_views(round_: Round) -> bool:
         if np.abs(np.concatenate([attacker[known], victim[known]])).max(initial=0.0) > (
             FILLED_WITHIN_DEG
         ):
-            return False
+            return 0
         rows += int(known.sum())
-    return rows > 0
+    return rows
 
 
 def redraw_filled_views(round_: Round, stats: SampleStats) -> Round:
     """The round with filled views redrawn (module docstring), counted in `stats.partial`;
     unchanged when its views were recorded."""
-    if not filled_views(round_):
+    filled = filled_views(round_)
+    if not filled:
         return round_
     seed = [zlib.crc32(str(round_.match_id).encode()), int(round_.round_num)]
     rng = np.random.default_rng(seed)
@@ -119,11 +121,8 @@ def redraw_filled_views(round_: Round, stats: SampleStats) -> Round:
             continue
         table = table.copy()
         draws = rng.random((len(table), 2))
-        attacker = np.interp(draws[:, 0], QUANTILES, ATTACKER_DEVIATION_DEG)
-        victim = np.interp(draws[:, 1], QUANTILES, VICTIM_DEVIATION_DEG)
-        known = _between_enemies(table)[0]
-        table["attackerViewX"] = table["attackerViewX"] + attacker
-        table["victimViewX"] = table["victimViewX"] + victim
-        stats.partial[FILLED_NOTE] += int(known.sum())
+        table["attackerViewX"] += np.interp(draws[:, 0], QUANTILES, ATTACKER_DEVIATION_DEG)
+        table["victimViewX"] += np.interp(draws[:, 1], QUANTILES, VICTIM_DEVIATION_DEG)
         tables[name] = table
+    stats.partial[FILLED_NOTE] += filled
     return replace(round_, **tables)
