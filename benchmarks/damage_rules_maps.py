@@ -64,20 +64,24 @@ def main() -> None:
         f"{'model':<28} {'map':<11} {'steps':>6} {'real':>6} {'drawn':>6} {'bias':>7} "
         f"{'mean W':>7} {'max W':>7} {'floor':>6} {'cells':>5}"
     )
+    by_map = {}
     for name, drawn in (("rules, leave-matches-out", fitted), ("shipped rules.json", shipped)):
-        for where, scores in score_by_map(positives, drawn).items():
+        by_map[name] = score_by_map(positives, drawn)
+        for where, scores in by_map[name].items():
             print(_line(name, where, scores))
     print("HP lost per step; W: Wasserstein per (weapon, distance band) cell; floor: what the")
     print("model would score were the real steps drawn from it")
-    _largest_cells(positives, fitted)
+    _largest_cells(positives, fitted, by_map["rules, leave-matches-out"])
 
 
-def _largest_cells(positives: Samples, drawn: np.ndarray, count: int = 3) -> None:
-    """Each map's `count` largest cells of the leave-matches-out draws, with the mean HP lost
-    real and drawn."""
+def _largest_cells(
+    positives: Samples, drawn: np.ndarray, by_map: dict[str, HpLostScores], count: int = 3
+) -> None:
+    """Each map's `count` largest cells of `by_map` (the scores of `drawn`), with the mean HP
+    lost real and drawn."""
     lost = drawn_hp_lost(drawn, positives.victim_hp)
     bands = band_labels(distance_u(positives))
-    for where, scores in score_by_map(positives, drawn).items():
+    for where, scores in by_map.items():
         if where == "all":
             continue
         for cell in sorted(scores.cells, key=lambda c: -c["wasserstein_hp"])[:count]:
