@@ -84,13 +84,13 @@ def sight_to_damage() -> None:
         for kill in round_.kills.itertuples():
             a, v = names.index(kill.attackerName), names.index(kill.victimName)
             sight = world.line_of_sight(position[a] + eye, position[v] + eye)
-            window = range(max(1, int(np.searchsorted(seconds, kill.seconds - 3.0))), len(seconds))
-            lost = [f for f in window if seconds[f] <= kill.seconds and hp[v, f] < hp[v, f - 1]]
-            first = (
-                lost[0]
-                if lost
-                else min(int(np.searchsorted(seconds, kill.seconds)), len(seconds) - 1)
-            )
+            lost = [
+                f
+                for f in range(1, len(seconds))
+                if kill.seconds - 3.0 <= seconds[f] <= kill.seconds and hp[v, f] < hp[v, f - 1]
+            ]
+            at_kill = min(int(np.searchsorted(seconds, kill.seconds)), len(seconds) - 1)
+            first = lost[0] if lost else at_kill
             end = first if sight[first] else first - 1
             if end < 0 or not sight[end]:
                 print(f"  {kill.seconds:6.1f} s {kill.attackerName} -> {kill.victimName}: hidden")
