@@ -77,6 +77,23 @@ def test_a_step_another_attacker_ends_counts_as_cut_short(tmp_path: Path) -> Non
     assert rules.bullets_hurt.counts[ALL][0] == 2 and rules.bullets_hurt.killed[ALL][0] == 2
 
 
+def test_damage_without_a_tick_ends_no_step(tmp_path: Path) -> None:
+    """A row without a tick says nothing of when the victim lost that HP: ct1's one bullet
+    (27 HP) on unhurt t1 stays a step he survived, though a world-damage row without a tick
+    takes t1's other 73 HP."""
+    from esta_fixtures import _damage, make_match, write_match
+
+    from decoy_cli.damage.rules_model import fit_rules
+    from decoy_cli.esta import read_match
+
+    match = make_match()
+    no_tick = _damage(5075, None, "t1", "World", 73) | {"tick": None}
+    match["gameRounds"][1]["damages"] = [_damage(5070, "ct1", "t1", "M4A4", 27), no_tick]
+    path = write_match(tmp_path / "m.json.xz", match)
+    rules = fit_rules([r for r in read_match(path).rounds if r.round_num == 2])
+    assert rules.bullets.counts[ALL][0] == 1 and rules.bullets.killed[ALL][0] == 0
+
+
 def test_bad_folders_are_one_error_line(tmp_path: Path) -> None:
     result = runner.invoke(app, ["models", "fit-rules", str(tmp_path), str(tmp_path)])
     assert result.exit_code == 1 and "error: " in result.output

@@ -182,7 +182,8 @@ def fit_rules(rounds: Sequence[Round]) -> RulesFile:
         groups += [str(g) for g in table["hitGroup"]]
         health += [float(h) for h in table["hpDamage"]]
         origin, step_ticks = step_clock(round_)
-        step = np.rint((np.nan_to_num(rows.tick) - origin) / step_ticks)
+        # a row without a tick (never usable) says nothing of when its HP was lost: no step
+        step = np.where(np.isfinite(rows.tick), np.rint((rows.tick - origin) / step_ticks), np.inf)
         steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
         for (at, _, _), hit in steps.items():
             victim = rows.victim == rows.victim[hit.first]
