@@ -75,10 +75,6 @@ class Agents:
     def count(self) -> int:
         return len(self.names)
 
-    def of_side(self, side: str) -> np.ndarray:
-        """Boolean mask of the agents of one side."""
-        return self.side == side
-
     def alive_of_side(self, side: str) -> int:
         return int(np.sum(self.alive & (self.side == side)))
 
