@@ -182,6 +182,21 @@ def test_what_frames_and_events_contradict_is_named(tmp_path: Path) -> None:
     assert found == ("the round ends BombDefused, but the bomb was never planted",)
 
 
+def test_a_plant_with_no_t_alive_is_named_and_replayed_without_a_planter(tmp_path: Path) -> None:
+    """Every T dead from frame 9 on, yet the data plants at 10 s: named, and the replay runs
+    with nobody inferred as the planter (with the Ts alive, t1 would be) rather than failing."""
+    doc = gunfight()
+    for mate in doc.players:
+        if mate.side == "T":
+            mate.dead_from = 9
+    doc.plant = (10.0, "A")
+    round_ = read(doc, tmp_path)
+    assert "the bomb is planted with no T alive" in contradictions(round_)
+    result = replay_round(round_, builtin_graph(), ReplayOptions(combat=False))
+    assert "the bomb is planted with no T alive" in result.contradictions
+    assert not [item for item in result.inferred if "planter" in item]
+
+
 def test_the_datas_death_time_is_its_kill_and_the_killer_known(tmp_path: Path) -> None:
     round_ = read(gunfight(), tmp_path)
     result = replay_round(round_, builtin_graph(), ReplayOptions(combat=False, bomb=False))
