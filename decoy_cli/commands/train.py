@@ -27,6 +27,7 @@ from decoy_cli.commands._damage_output import (
 )
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
+from decoy_cli.damage.calibration import CALIBRATION_FILE
 from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.provenance import SampleChoice
 from decoy_cli.damage.scores import MIN_CELL
@@ -136,7 +137,7 @@ def dip(
     options = fitting.options(epochs, samples.seed)
     choice = samples.choice(data)
     _check_outputs(out, report)
-    stale = (out / "dip_calibration.json").is_file()
+    stale = (out / CALIBRATION_FILE).is_file()
     bars, on_file, on_step = progress_bars()
     with bars:
         result = train_dip_model(

@@ -115,6 +115,8 @@ def _logit(p: np.ndarray) -> np.ndarray:
     return np.log(q / (1 - q))
 
 
+CALIBRATION_FILE = "dip_calibration.json"
+"""A model folder's DIP calibration (`decoy models calibrate`, `decoy models fight-threshold`)."""
 MIN_RECALL = 0.8
 """Least share of each map's real damaging steps DIP must call hits at the operating point
 `decoy models fight-threshold` chooses for the fight (issue 33's floor)."""

@@ -26,7 +26,7 @@ from pathlib import Path
 import torch
 from torch import nn
 
-from decoy_cli.damage.calibration import Calibration
+from decoy_cli.damage.calibration import CALIBRATION_FILE, Calibration
 from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
@@ -144,9 +144,6 @@ def load_dip(folder: str | Path) -> LoadedDip:
         object_at(description, "metadata"),
         load_calibration(Path(folder)),
     )
-
-
-CALIBRATION_FILE = "dip_calibration.json"
 
 
 def load_calibration(folder: Path) -> Calibration | None:
