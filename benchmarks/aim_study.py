@@ -28,13 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.damage import resolve_models
 from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.filled_views import QUANTILES, hit_view_deviations
 from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.damage.samples import build_samples
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.evaluate.fight_threshold import EYE
 from decoy_cli.waypoints.build import builtin_graph, graph_world
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -79,11 +79,10 @@ def sight_to_damage() -> None:
     (round_,) = list(iter_rounds([ROUND_8HZ]))
     seconds, position, yaw, hp = round_.frame_seconds, round_.position, round_.yaw, round_.hp
     names = [p.name for p in round_.players]
-    eye = np.array([0.0, 0.0, EYE_HEIGHT_M])
     with PhysicsWorld(graph_world(builtin_graph())) as world:
         for kill in round_.kills.itertuples():
             a, v = names.index(kill.attackerName), names.index(kill.victimName)
-            sight = world.line_of_sight(position[a] + eye, position[v] + eye)
+            sight = world.line_of_sight(position[a] + EYE, position[v] + EYE)
             lost = [
                 f
                 for f in range(1, len(seconds))

@@ -41,7 +41,7 @@ import numpy as np
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.damage import load_damage_model
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
-from decoy_cli.evaluate.fight_threshold import EYE
+from decoy_cli.evaluate.fight_threshold import EYE, enemies_in_sight
 from decoy_cli.metrics.kills import DEATH_WINDOW_S
 from decoy_cli.replay.deaths import replay_deaths
 from decoy_cli.replay.missing import fill_missing
@@ -122,35 +122,37 @@ def _damage_by_sight(round_, result, world, by_sight, by_distance) -> None:
     present = np.asarray(round_.present, bool)
     alive = np.asarray(round_.alive, bool) & present
     replay_alive = result.recording.alive.T  # one row per data frame (replay_round)
-    side = np.array([p.side for p in round_.players])
-    eyes = round_.position + EYE
     damaged = np.zeros(alive.shape, bool)
     for event in result.events:
         if event.kind == "damage":  # on the simulator's clock, as the frames' ticks
             frame = int(np.searchsorted(result.frame_ticks, event.tick, side="right")) - 1
             if 0 <= frame < alive.shape[1]:
                 damaged[int(event.other), frame] = True
-    known_next = present[:, 1:] & (hp[:, 1:] >= 0) & (hp[:, :-1] >= 0)
-    for frame in range(alive.shape[1] - 1):
-        seen_at = alive[:, frame] & replay_alive[:, frame] & known_next[:, frame]
-        for victim in np.flatnonzero(seen_at & np.isfinite(eyes[:, frame]).all(axis=1)):
-            enemies = np.flatnonzero(alive[:, frame] & (side != side[victim]))
-            starts = eyes[enemies, frame]
-            starts = starts[np.isfinite(starts).all(axis=1)]
-            ends = np.repeat(eyes[victim, frame][None], len(starts), axis=0)
-            clear = world.line_of_sight(starts, ends)
-            seen_by = int(clear.sum())
-            lost = not alive[victim, frame + 1] or hp[victim, frame + 1] < hp[victim, frame]
-            row = by_sight[min(seen_by, SIGHT_BUCKETS - 1)]
+    known_next = np.zeros(alive.shape, bool)  # no frame after the last
+    known_next[:, :-1] = present[:, 1:] & (hp[:, 1:] >= 0) & (hp[:, :-1] >= 0)
+    watched = alive & replay_alive & known_next
+    for frame, victim, enemies in enemies_in_sight(round_, world, watched):
+        lost = not alive[victim, frame + 1] or hp[victim, frame + 1] < hp[victim, frame]
+        counts = [by_sight[min(len(enemies), SIGHT_BUCKETS - 1)]]
+        if len(enemies):
+            delta = round_.position[enemies, frame] - round_.position[victim, frame]
+            nearest = float(np.linalg.norm(delta, axis=1).min())
+            band = int(np.searchsorted(DISTANCE_BANDS_M, nearest, side="right"))
+            counts.append(by_distance[band])
+        for row in counts:
             row[0] += 1
             row[1] += lost
             row[2] += bool(damaged[victim, frame])
-            if seen_by:
-                nearest = float(np.linalg.norm(starts[clear] - ends[clear], axis=1).min())
-                band = by_distance[int(np.searchsorted(DISTANCE_BANDS_M, nearest, side="right"))]
-                band[0] += 1
-                band[1] += lost
-                band[2] += bool(damaged[victim, frame])
+
+
+def _shares(label: str, row: list[int]) -> str:
+    """A line of `_damage_by_sight`'s table: player-frames, and the shares (counts) damaged in
+    the data and by the replay's fight."""
+    frames, real, replay = row
+    return (
+        f"  {label}: {frames} player-frames, data {real / frames:.3f} ({real}), "
+        f"replay's fight {replay / frames:.3f} ({replay})"
+    )
 
 
 def main() -> None:
@@ -279,21 +281,15 @@ def main() -> None:
     frames, real, replay = np.sum(list(by_sight.values()), axis=0)
     print(f"damaged player-frames of {frames} alive in both: data {real}, replay's fight {replay}")
     print("damaged within the next frame, by enemies in sight at the frame (nav world):")
-    for seen_by, (seconds, real, replay) in sorted(by_sight.items()):
-        label = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
-        print(
-            f"  {label} in sight: {seconds} player-frames, data {real / seconds:.3f}, "
-            f"replay's fight {replay / seconds:.3f}"
-        )
+    for seen_by, row in sorted(by_sight.items()):
+        count = f"{seen_by}+" if seen_by == SIGHT_BUCKETS - 1 else str(seen_by)
+        print(_shares(f"{count} in sight", row))
     print("with an enemy in sight, by the nearest one's distance:")
     edges = (0.0, *DISTANCE_BANDS_M)
-    for band, (seconds, real, replay) in sorted(by_distance.items()):
+    for band, row in sorted(by_distance.items()):
         last = band == len(DISTANCE_BANDS_M)
         label = f"{edges[band]:g}+ m" if last else f"{edges[band]:g}-{DISTANCE_BANDS_M[band]:g} m"
-        print(
-            f"  {label}: {seconds} player-frames, data {real / seconds:.3f}, "
-            f"replay's fight {replay / seconds:.3f}"
-        )
+        print(_shares(label, row))
     full = np.asarray(hp_before_death) >= 100
     print(f"real deaths from full HP within one frame: {full.sum()} of {len(full)}")
 

@@ -26,7 +26,7 @@ the choice; `decoy models fight-threshold` writes the choice as the folder's cal
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -90,30 +90,43 @@ def fight_pairs(rounds: Iterable[Round], graph: WaypointGraph) -> FightPairs:
     return _pairs(parts, str(graph.meta.get("map", "")))
 
 
+def enemies_in_sight(
+    round_: Round, world: PhysicsWorld, watched: np.ndarray
+) -> Iterator[tuple[int, int, np.ndarray]]:
+    """(frame, player, the enemies in sight of him) for every frame and player `watched` (P, F)
+    marks whose eye position is known: the enemies alive at the frame with a known position,
+    eye to eye in `world` at the real positions, in index order (none when none is)."""
+    alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
+    eyes = np.asarray(round_.position, dtype=np.float64) + EYE
+    side = np.array([p.side for p in round_.players])
+    known = alive & np.isfinite(eyes).all(axis=2)
+    for frame in range(known.shape[1]):
+        for player in np.flatnonzero(watched[:, frame] & np.isfinite(eyes[:, frame]).all(axis=1)):
+            enemies = np.flatnonzero(known[:, frame] & (side != side[player]))
+            if not len(enemies):
+                yield frame, int(player), enemies
+                continue
+            ends = np.repeat(eyes[player, frame][None], len(enemies), axis=0)
+            yield frame, int(player), enemies[world.line_of_sight(eyes[enemies, frame], ends)]
+
+
 def _in_sight_alone(round_: Round, world: PhysicsWorld) -> np.ndarray:
     """(K, 4) attacker, victim, frame, lost HP within `HORIZON_S`: the round's players with
     exactly one enemy in sight at a frame (frames without a frame `HORIZON_S` later left out)."""
     hp = np.asarray(round_.hp, dtype=np.float64)
     alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
-    eyes = np.asarray(round_.position, dtype=np.float64) + EYE
-    side = np.array([p.side for p in round_.players])
-    known = alive & np.isfinite(eyes).all(axis=2)
     seconds = np.asarray(round_.frame_seconds, dtype=np.float64)
     later = np.searchsorted(seconds, seconds + HORIZON_S - 1e-6)
+    has_later = later < len(seconds)
+    then = np.where(has_later, later, 0)
+    watched = alive & has_later & (hp >= 0) & (hp[:, then] >= 0)
     rows = []
-    for frame in np.flatnonzero(later < len(seconds)):
-        then = int(later[frame])
-        for victim in np.flatnonzero(known[:, frame] & (hp[:, frame] >= 0) & (hp[:, then] >= 0)):
-            enemies = np.flatnonzero(known[:, frame] & (side != side[victim]))
-            if not len(enemies):
-                continue
-            starts = eyes[enemies, frame]
-            ends = np.repeat(eyes[victim, frame][None], len(starts), axis=0)
-            clear = world.line_of_sight(starts, ends)
-            if int(clear.sum()) != 1:
-                continue
-            lost = not alive[victim, then] or hp[victim, then] < hp[victim, frame]
-            rows.append((int(enemies[clear][0]), int(victim), int(frame), int(lost)))
+    for frame, victim, seen_by in enemies_in_sight(round_, world, watched):
+        if len(seen_by) != 1:
+            continue
+        after = int(then[frame])
+        lost = not alive[victim, after] or hp[victim, after] < hp[victim, frame]
+        rows.append((int(seen_by[0]), victim, frame, int(lost)))
     return np.array(rows, dtype=np.int64).reshape(-1, 4)
 
 
