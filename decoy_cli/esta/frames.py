@@ -22,6 +22,7 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
+import pandas as pd
 
 from decoy_cli.csgo import HAMMER_TO_M, MAX_VELOCITY_M_S
 from decoy_cli.esta.schema import FrameState, Invalid, PlayerState, TeamState
@@ -249,10 +250,44 @@ def _steam_id(value: int | float, ticks: np.ndarray, frame: int) -> int | None:
     return value or None
 
 
+@dataclass(frozen=True, eq=False)
+class PlayerRows:
+    """A round's player entries in long form, one row per player per frame (E rows), as any
+    source gives them: what `player_arrays` validates and scatters into (P, F) arrays.
+
+    `key` is the steamID as a string, else the name; `position` (E, 3) Hammer units, `located`
+    where x, y and z are all given (not null: a NaN is an error); the other numbers float64, NaN
+    where null; `alive` 1.0, 0.0 or NaN (unknown: hp > 0 decides);
+    `weapon` "" where none; `vertical_speed` Hammer units per second.
+    """
+
+    frame: np.ndarray
+    key: np.ndarray
+    name: np.ndarray
+    steam_id: np.ndarray
+    side: np.ndarray
+    position: np.ndarray
+    located: np.ndarray
+    yaw: np.ndarray
+    hp: np.ndarray
+    armor: np.ndarray
+    helmet: np.ndarray
+    has_defuser: np.ndarray
+    has_bomb: np.ndarray
+    alive: np.ndarray
+    weapon: np.ndarray
+    vertical_speed: np.ndarray
+
+
 def _players(
     frames: list[FrameState], ticks: np.ndarray
 ) -> tuple[list[PlayerInfo], dict[str, np.ndarray]]:
-    """Gather every player entry, key it, validate it and scatter it into (P, F) arrays."""
+    """Gather every player entry of the frames and build the (P, F) arrays."""
+    return player_arrays(_entries(frames, ticks), ticks)
+
+
+def _entries(frames: list[FrameState], ticks: np.ndarray) -> PlayerRows:
+    """Every player entry of ESTA frames as long-form rows; a bad steamID raises."""
     entries: list[PlayerState] = []
     frame_of: list[int] = []
     side_of: list[Side] = []
@@ -263,22 +298,73 @@ def _players(
                 entries.extend(team.players)
                 frame_of.extend([j] * len(team.players))
                 side_of.extend([side] * len(team.players))
-
-    index: dict[tuple[str, Side], int] = {}
-    infos: list[PlayerInfo] = []
-    player_of = np.empty(len(entries), dtype=np.int64)
+    steam_ids: list[int | None] = []
+    keys: list[str] = []
     for e, player in enumerate(entries):
         raw_id = player.steamID
         steam_id = None if raw_id is None else _steam_id(raw_id, ticks, frame_of[e])
-        key = str(steam_id) if steam_id is not None else player.name
-        if not key:
-            raise Invalid(f"{_where(ticks, frame_of[e])}: a player has neither steamID nor name")
-        i = index.get((key, side_of[e]))
-        if i is None:  # a player seen on both sides gets a row per side (plausibility.py)
-            i = index[key, side_of[e]] = len(infos)
-            infos.append(PlayerInfo(key, player.name or key, steam_id, side_of[e]))
-        player_of[e] = i
+        steam_ids.append(steam_id)
+        keys.append(str(steam_id) if steam_id is not None else (player.name or ""))
 
+    def numbers(field: str) -> np.ndarray:
+        return np.array([getattr(p, field) for p in entries], dtype=np.float64)
+
+    def flags(field: str) -> np.ndarray:
+        return np.array([getattr(p, field) is True for p in entries], dtype=bool)
+
+    return PlayerRows(
+        frame=np.array(frame_of, dtype=np.int64),
+        key=np.array(keys, dtype=object),
+        name=np.array([p.name or "" for p in entries], dtype=object),
+        steam_id=np.array(steam_ids, dtype=object),
+        side=np.array(side_of, dtype=object),
+        position=np.array([(p.x, p.y, p.z) for p in entries], dtype=np.float64).reshape(
+            len(entries), 3
+        ),
+        located=np.array(
+            [p.x is not None and p.y is not None and p.z is not None for p in entries], bool
+        ),
+        yaw=numbers("viewX"),
+        hp=numbers("hp"),
+        armor=numbers("armor"),
+        helmet=flags("hasHelmet"),
+        has_defuser=flags("hasDefuse"),
+        has_bomb=flags("hasBomb"),
+        alive=np.array(
+            [np.nan if p.isAlive is None else float(p.isAlive) for p in entries], np.float64
+        ),
+        weapon=np.array([p.activeWeapon or "" for p in entries], dtype=object),
+        vertical_speed=numbers("velocityZ"),
+    )
+
+
+def player_arrays(
+    rows: PlayerRows, ticks: np.ndarray
+) -> tuple[list[PlayerInfo], dict[str, np.ndarray]]:
+    """Key, validate and scatter long-form player rows into (P, F) arrays over the frames at
+    `ticks`: the players (T first, then CT, each by key) and the arrays of `FrameArrays`."""
+    num_frames = len(ticks)
+    frame_idx = rows.frame
+    empty = np.flatnonzero(rows.key == "")
+    if empty.size:
+        raise Invalid(
+            f"{_where(ticks, int(frame_idx[empty[0]]))}: a player has neither steamID nor name"
+        )
+    # a player seen on both sides gets a row per side (plausibility.py)
+    pairs = pd.MultiIndex.from_arrays([rows.key, rows.side]) if len(rows.key) else None
+    codes, uniques = pd.factorize(pairs) if pairs is not None else (np.zeros(0, np.int64), [])
+    first = np.zeros(len(uniques), dtype=np.int64)
+    if len(codes):
+        first[codes[::-1]] = np.arange(len(codes))[::-1]
+    infos = [
+        PlayerInfo(
+            str(rows.key[e]),
+            str(rows.name[e] or rows.key[e]),
+            rows.steam_id[e],
+            rows.side[e],
+        )
+        for e in first
+    ]
     if len(infos) > MAX_PLAYERS:
         raise Invalid(
             f"{len(infos):,} distinct players in the frames (a server has at most {MAX_PLAYERS})"
@@ -288,19 +374,16 @@ def _players(
     rank = np.empty(len(infos), dtype=np.int64)
     rank[order] = np.arange(len(infos))
     players = [infos[i] for i in order]
-    player_of = rank[player_of]
-    frame_idx = np.array(frame_of, dtype=np.int64)
-    _check_unique(player_of, frame_idx, players, ticks, len(frames))
+    player_of = rank[codes].astype(np.int64)
+    _check_unique(player_of, frame_idx, players, ticks, num_frames)
 
-    position, placed = _positions(entries, player_of, frame_idx, players, ticks)
-    hp = _counts(entries, "hp", player_of, frame_idx, players, ticks)
-    armor = _counts(entries, "armor", player_of, frame_idx, players, ticks)
-    weapons = _weapons(entries, player_of, frame_idx, players, ticks)
-    alive_flag = np.array([p.isAlive is True for p in entries], dtype=bool)
-    alive_known = np.array([p.isAlive is not None for p in entries], dtype=bool)
-    alive = np.where(alive_known, alive_flag, hp > 0)
+    placed = _placed(rows.position, rows.located, player_of, frame_idx, players, ticks)
+    hp = _counts(rows.hp, "hp", player_of, frame_idx, players, ticks)
+    armor = _counts(rows.armor, "armor", player_of, frame_idx, players, ticks)
+    _check_weapons(rows.weapon, player_of, frame_idx, players, ticks)
+    alive = np.where(np.isnan(rows.alive), hp > 0, rows.alive == 1.0)
 
-    shape = (len(players), len(frames))
+    shape = (len(players), num_frames)
     p, f = player_of[placed], frame_idx[placed]
 
     def scatter(values: np.ndarray, fill: float | str, dtype: npt.DTypeLike) -> np.ndarray:
@@ -309,29 +392,28 @@ def _players(
         out[p, f] = values[placed]
         return out
 
-    width = max((len(w) for w in weapons), default=1) or 1
-    yaw = np.array([pl.viewX for pl in entries], dtype=np.float64)
+    weapons = rows.weapon.astype(str) if len(rows.weapon) else np.zeros(0, dtype="<U1")
+    width = max(weapons.dtype.itemsize // 4, 1)
     return players, dict(
-        position=scatter(position * HAMMER_TO_M, np.nan, np.float64),
-        yaw=scatter(yaw, np.nan, np.float64),
+        position=scatter(rows.position * HAMMER_TO_M, np.nan, np.float64),
+        yaw=scatter(rows.yaw, np.nan, np.float64),
         hp=scatter(hp, MISSING, np.int16),
         armor=scatter(armor, MISSING, np.int16),
-        helmet=scatter(np.array([pl.hasHelmet is True for pl in entries], bool), False, bool),
-        has_defuser=scatter(np.array([pl.hasDefuse is True for pl in entries], bool), False, bool),
-        weapon=scatter(np.array(weapons, dtype=f"<U{width}"), "", f"<U{width}"),
+        helmet=scatter(rows.helmet, False, bool),
+        has_defuser=scatter(rows.has_defuser, False, bool),
+        weapon=scatter(weapons, "", f"<U{width}"),
         alive=scatter(alive, False, bool),
-        present=scatter(np.ones(len(entries), dtype=bool), False, bool),
-        has_bomb=scatter(np.array([pl.hasBomb is True for pl in entries], bool), False, bool),
-        vertical_speed=scatter(_vertical_speed(entries, ticks, frame_idx), np.nan, np.float64),
+        present=scatter(np.ones(len(player_of), dtype=bool), False, bool),
+        has_bomb=scatter(rows.has_bomb, False, bool),
+        vertical_speed=scatter(
+            _vertical_speed(rows.vertical_speed, ticks, frame_idx), np.nan, np.float64
+        ),
     )
 
 
-def _vertical_speed(
-    entries: list[PlayerState], ticks: np.ndarray, frame_idx: np.ndarray
-) -> np.ndarray:
+def _vertical_speed(values: np.ndarray, ticks: np.ndarray, frame_idx: np.ndarray) -> np.ndarray:
     """awpy's `velocityZ` in m/s (NaN where null: not every export has it); 0 on the ground,
     where the Source engine keeps no vertical velocity."""
-    values = np.array([pl.velocityZ for pl in entries], dtype=np.float64)  # None -> NaN
     bad = np.abs(values) * HAMMER_TO_M > MAX_VELOCITY_M_S  # infinities too, not NaN
     if bad.any():
         e = int(np.flatnonzero(bad)[0])
@@ -355,18 +437,17 @@ def _check_unique(
         raise Invalid(f"{_where(ticks, j)}: player {players[i].key} appears twice")
 
 
-def _positions(
-    entries: list[PlayerState],
+def _placed(
+    position: np.ndarray,
+    located: np.ndarray,
     player_of: np.ndarray,
     frame_idx: np.ndarray,
     players: list[PlayerInfo],
     ticks: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
-    """(E, 3) Hammer positions and which entries have one; NaN or off-map raises."""
-    position = np.array([(p.x, p.y, p.z) for p in entries], dtype=np.float64).reshape(
-        len(entries), 3
-    )
-    null = np.array([p.x is None or p.y is None or p.z is None for p in entries], dtype=bool)
+) -> np.ndarray:
+    """Which entries have a position (the others are absent from the frame); NaN or off-map
+    raises."""
+    null = ~located
     with np.errstate(invalid="ignore"):
         bad = ~null & ~(np.abs(position) <= MAX_COORD_U).all(axis=1)
     if bad.any():
@@ -376,11 +457,11 @@ def _positions(
             f"{_where(ticks, int(frame_idx[e]))}: player {players[player_of[e]].key} position "
             f"({x:.1f}, {y:.1f}, {z:.1f}) u is NaN or off the map (beyond ±{MAX_COORD_U:,.0f} u)"
         )
-    return position, ~null
+    return ~null
 
 
 def _counts(
-    entries: list[PlayerState],
+    values: np.ndarray,
     field: str,
     player_of: np.ndarray,
     frame_idx: np.ndarray,
@@ -388,7 +469,6 @@ def _counts(
     ticks: np.ndarray,
 ) -> np.ndarray:
     """hp or armor as int16 per entry: MISSING where null or NaN; out of 0..32767 raises."""
-    values = np.array([getattr(p, field) for p in entries], dtype=np.float64)
     known = np.isfinite(values)
     with np.errstate(invalid="ignore"):
         out_of_range = (values < 0) | (values > np.iinfo(np.int16).max)
@@ -402,20 +482,18 @@ def _counts(
     return np.where(known, np.rint(np.where(known, values, 0)), MISSING).astype(np.int16)
 
 
-def _weapons(
-    entries: list[PlayerState],
+def _check_weapons(
+    names: np.ndarray,
     player_of: np.ndarray,
     frame_idx: np.ndarray,
     players: list[PlayerInfo],
     ticks: np.ndarray,
-) -> list[str]:
-    """`activeWeapon` per entry ("" where null); a name not in the weapon table raises."""
-    names = [p.activeWeapon or "" for p in entries]
-    for name in set(names):
+) -> None:
+    """Every weapon in hand ("" where none) is in the weapon table; another name raises."""
+    for name in pd.unique(names):
         if not is_known(name):
-            e = names.index(name)
+            e = int(np.flatnonzero(names == name)[0])
             raise Invalid(
                 f"{_where(ticks, int(frame_idx[e]))}: player {players[player_of[e]].key} holds "
                 f"unknown weapon {name!r}"
             )
-    return names
