@@ -422,7 +422,7 @@ def test_a_full_disk_stops_with_one_line_and_keeps_what_was_cached(
 def test_missing_inputs_and_bad_options_are_one_line(clean: Path, tmp_path: Path) -> None:
     for args, expected in (
         ([str(tmp_path / "nowhere")], "no such file or folder"),
-        ([str(tmp_path), "--combat"], "no .json.xz or .json match files"),
+        ([str(tmp_path), "--combat"], "no match files in this folder"),
         ([str(clean), "--map", "cache"], "unknown map 'cache'"),
         ([str(clean), "--combat", "--models", str(tmp_path / "no-models")], "no such model"),
     ):

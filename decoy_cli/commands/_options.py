@@ -75,6 +75,12 @@ def models_option(default: ModelName) -> str:
     return typer.Option(default.value, "--models", metavar=MODELS_METAVAR, help=MODELS_HELP)
 
 
+RATE_HELP = (
+    "Frames a second read from awpy's full-rate ticks (default 8, docs/cs2.md); data sampled "
+    "at or below it, and ESTA files, are read as they are."
+)
+
+
 @dataclass(frozen=True, kw_only=True)
 class RunOptions(ReplaySpec):
     """How `decoy replay` and `decoy evaluate` run a round: the replay's spec (`ReplaySpec`:
@@ -105,6 +111,7 @@ class RunOptions(ReplaySpec):
         "fail"
     )
     sight_mesh: Annotated[Path | None, typer.Option("--sight-mesh", help=SIGHT_MESH_HELP)] = None
+    rate: Annotated[float | None, typer.Option("--rate", help=RATE_HELP, min=0.1, max=128)] = None
     seed: Annotated[
         int,
         typer.Option(

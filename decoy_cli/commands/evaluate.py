@@ -148,6 +148,7 @@ def evaluate(
         mover=given.mover,
         seed=given.seed,
         implausible=given.implausible,
+        rate=given.rate,
         deaths=given.deaths,
         missing=given.missing,
         fastdtw=fastdtw,

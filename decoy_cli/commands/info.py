@@ -1,4 +1,5 @@
-"""`decoy info PATH[:ROUND]`: what an ESTA match file, one of its rounds, or a folder holds."""
+"""`decoy info PATH[:ROUND]`: what a match (an ESTA file, awpy's tables), one of its rounds, or a
+folder holds, and what it does not record."""
 
 from __future__ import annotations
 
@@ -12,8 +13,10 @@ from rich.table import Table
 from rich.text import Text
 
 from decoy_cli.commands._console import make_console
+from decoy_cli.commands._options import RATE_HELP
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, iter_match_files, parse_round_address, read_match
+from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.replay.missing import lacking
 
 
@@ -21,25 +24,27 @@ def info(
     target: str = typer.Argument(
         ...,
         metavar="PATH[:ROUND]",
-        help="A match file (.json.xz or .json), FILE:ROUND for one round, or a folder of matches.",
+        help="A match (an ESTA .json.xz or .json, an awpy 2 .zip, a folder of awpy 3 tables, "
+        "a .dem with awpy 3 installed), PATH:ROUND for one round, or a folder of matches.",
     ),
+    rate: float | None = typer.Option(None, "--rate", help=RATE_HELP, min=0.1, max=128),
 ) -> None:
-    """Show the rounds of a match file, the players of one round, or the matches in a folder."""
+    """Show the rounds of a match, the players of one round, or the matches in a folder."""
     console = make_console()
     path = Path(target)
-    if path.is_dir():
-        _show_folder(console, path)
-    elif path.is_file():
-        _show_match(console, read_match(path))
+    if path.is_file() or is_awpy_source(path):
+        _show_match(console, read_match(path, rate=rate))
+    elif path.is_dir():
+        _show_folder(console, path, rate)
     else:
         try:
             file, num = parse_round_address(target)
         except EstaError:
             raise EstaError(f"{target}: no such file or folder") from None
-        _show_round(console, read_match(file).round(num))
+        _show_round(console, read_match(file, rate=rate).round(num))
 
 
-def _show_folder(console: Console, folder: Path) -> None:
+def _show_folder(console: Console, folder: Path, rate: float | None) -> None:
     """One row per match file: map, rounds read and failed; unreadable files and failed rounds
     fail the command, as they do for one file."""
     files = iter_match_files(folder)
@@ -58,7 +63,7 @@ def _show_folder(console: Console, folder: Path) -> None:
     with progress:
         for file in progress.track(files):
             try:
-                match = read_match(file)
+                match = read_match(file, rate=rate)
             except EstaError as error:
                 unreadable.append(str(error))
                 table.add_row(file.name, Text("unreadable", style="red"), "", "")
@@ -84,7 +89,7 @@ def _show_match(console: Console, match: Match) -> None:
     """One row per round; rounds that failed are listed after the table and fail the command."""
     table = Table(
         title=f"{match.match_id}: {match.map_name or 'unknown map'}, {match.tick_rate} tick, "
-        f"{len(match.round_numbers)} rounds"
+        f"{len(match.round_numbers)} rounds ({match.meta.get('source', 'ESTA')})"
     )
     for column in ("round", "frames", "T", "CT", "plant tick", "winner", "reason", "lacks"):
         table.add_column(column, justify="left" if column in ("reason", "lacks") else "right")
@@ -101,6 +106,7 @@ def _show_match(console: Console, match: Match) -> None:
             ", ".join(lacking(played)) or "-",
         )
     console.print(table)
+    _show_recorded(console, match)
     if any(lacking(played) for played in match.rounds):
         console.print(
             "lacks: fields the game needs that the file does not record; a replay fills them "
@@ -116,6 +122,22 @@ def _show_match(console: Console, match: Match) -> None:
         )
 
 
+def _show_recorded(console: Console, match: Match) -> None:
+    """For awpy's tables: the tick rate's source and what the ticks do not record."""
+    rule = match.meta.get("tick_rate_rule")
+    if rule:
+        console.print(f"tick rate {match.tick_rate}: {rule}", highlight=False)
+    missing = sorted({name for played in match.rounds for name in played.not_recorded})
+    if match.meta.get("source") in (None, "ESTA"):
+        return
+    console.print(
+        "not recorded: " + (", ".join(missing) or "nothing the replay uses"), highlight=False
+    )
+    warned = [(r.round_num, w) for r in match.rounds for w in r.warnings]
+    for num, warning in warned:
+        console.print(f"round {num}: {warning}", style="yellow", highlight=False)
+
+
 def _show_round(console: Console, played: Round) -> None:
     """The round's facts and one row per player with frame counts."""
     seconds = played.frame_seconds
@@ -126,7 +148,8 @@ def _show_round(console: Console, played: Round) -> None:
         f"{_or_dash(played.end_tick)}, winner {_or_dash(played.winning_side)} "
         f"({_or_dash(played.end_reason)}), plant tick {_or_dash(played.bomb_plant_tick)}; "
         f"{len(played.damages)} damages, {len(played.kills)} kills, "
-        f"{len(played.bomb_events)} bomb events",
+        f"{len(played.bomb_events)} bomb events; read from {played.source}"
+        + (f"; not recorded: {', '.join(played.not_recorded)}" if played.not_recorded else ""),
         highlight=False,
     )
     if not played.players:

@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError
+from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import PlayerInfo, RoundClock, Side, build_frames
 from decoy_cli.esta.plausibility import Implausible, check_frames, round_order_problems
@@ -56,8 +57,9 @@ times the most in a real file in ../shared/data (28,365, T side only; twice that
 teams). With the per-round limits of decoy_cli/esta/frames.py it bounds the memory a hostile
 file can take."""
 
-MATCH_SUFFIXES = (".json.xz", ".json")
-"""File names `iter_match_files` picks up in a folder."""
+MATCH_SUFFIXES = (".json.xz", ".json", ".zip", ".dem")
+"""File names `iter_match_files` picks up in a folder: ESTA files, awpy 2 zips and demos (a
+folder of awpy 3 tables is picked up by its `header.json`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +117,11 @@ class Round:
     buy_types: dict[str, str] = field(default_factory=dict)
     """awpy's buy type of each side that has one ("Full Eco", "Semi Eco", "Semi Buy",
     "Full Buy"), from `tBuyType` and `ctBuyType`; what armour a side could afford."""
+    source: str = "ESTA"
+    """The data the round was read from: "ESTA" (awpy 1.x JSON), "awpy 2" or "awpy 3"."""
+    not_recorded: tuple[str, ...] = ()
+    """What awpy's tables do not record for this round (decoy_cli/esta/awpy/rounds.py): held
+    as absent, and filled by the replay's rules where the game needs it."""
 
     @property
     def num_frames(self) -> int:
@@ -164,11 +171,22 @@ class Match:
         raise EstaError(f"{self.path}: no round {num} ({_describe_numbers(self.round_numbers)})")
 
 
-def read_match(path: str | Path, *, implausible: Implausible = "fail") -> Match:
-    """Read and validate one match file; file-level problems raise EstaError (module doc).
+def read_match(
+    path: str | Path, *, implausible: Implausible = "fail", rate: float | None = None
+) -> Match:
+    """Read and validate one match: an ESTA file, or awpy's tables (an awpy 2 zip, a folder of
+    awpy 3 tables, a demo: decoy_cli/esta/awpy/reader.py, `rate` frames a second from full-rate
+    ticks, its default when None); file-level problems raise EstaError (module doc).
     `implausible` says whether a round with implausible data fails or keeps warnings
     (decoy_cli/esta/plausibility.py)."""
     path = Path(path)
+    if is_awpy_source(path):
+        from decoy_cli.esta.awpy.reader import read_awpy_match
+        from decoy_cli.esta.awpy.rounds import DEFAULT_RATE
+
+        return read_awpy_match(
+            path, rate=DEFAULT_RATE if rate is None else rate, implausible=implausible
+        )
     document = parse(path, read_bytes(path))
     top = document.top
     tick_rate = _tick_rate(path, top.get("tickRate"))
@@ -239,20 +257,29 @@ def iter_match_files(path: str | Path) -> list[Path]:
     with a match-file name that is not a readable file (a dangling or looping link) is listed
     too, so that reading it fails with its reason instead of vanishing."""
     path = Path(path)
-    if path.is_file():
+    if path.is_file() or is_awpy_source(path):
         return [path]
     if not path.is_dir():
         raise EstaError(f"{path}: no such file or folder")
-    files = sorted(p for p in path.iterdir() if p.name.endswith(MATCH_SUFFIXES) and not p.is_dir())
+    files = sorted(
+        p
+        for p in path.iterdir()
+        if (p.name.endswith(MATCH_SUFFIXES) and not p.is_dir()) or is_awpy_source(p)
+    )
     if not files:
-        raise EstaError(f"{path}: no .json.xz or .json match files in this folder")
+        raise EstaError(
+            f"{path}: no match files in this folder (.json.xz, .json, awpy's .zip or .dem, or "
+            "folders of awpy 3 tables)"
+        )
     return files
 
 
-def load_round(address: str, *, implausible: Implausible = "fail") -> Round:
+def load_round(
+    address: str, *, implausible: Implausible = "fail", rate: float | None = None
+) -> Round:
     """The round at "FILE:ROUND" (reads the whole file: for many rounds, read_match once)."""
     file, num = parse_round_address(address)
-    return read_match(file, implausible=implausible).round(num)
+    return read_match(file, implausible=implausible, rate=rate).round(num)
 
 
 def _build_round(

@@ -12,7 +12,6 @@ A round's result is a `RoundRecord` (decoy_cli/evaluate/record.py).
 
 from __future__ import annotations
 
-import hashlib
 import json
 import signal
 import threading
@@ -101,7 +100,7 @@ class _WorkerState:
         self.physics = PhysicsWorld(graph_world(self.graph))
         self.sight = run_sight(settings, self.graph)
         self.models: dict[ModelChoice, DamageModel | None] = {}
-        self.matches: OrderedDict[tuple[str, str, str], Match] = OrderedDict()
+        self.matches: OrderedDict[tuple[str, str, str, float | None], Match] = OrderedDict()
 
     def damage_model(self, choice: ModelChoice) -> DamageModel | None:
         """The damage model of a `--models` choice, loaded once (torch on one thread)."""
@@ -116,21 +115,19 @@ class _WorkerState:
             self.models[choice] = model
         return self.models[choice]
 
-    def match(self, file: str, file_sha: str, implausible: Implausible) -> Match:
-        """The match read from `file` under the run's policy for implausible rounds, checked to
-        be the content the run hashed."""
-        key = (file, file_sha, implausible)
+    def match(
+        self, file: str, file_sha: str, implausible: Implausible, rate: float | None
+    ) -> Match:
+        """The match read from `file` under the run's policy for implausible rounds and at its
+        frame rate, checked to be the content the run hashed."""
+        key = (file, file_sha, implausible, rate)
         if key in self.matches:
             self.matches.move_to_end(key)
             return self.matches[key]
         path = Path(file)
-        try:
-            data = path.read_bytes()
-        except OSError as error:
-            raise DecoyError(f"{file}: cannot read the file ({error.strerror or error})") from None
-        if hashlib.sha256(data).hexdigest() != file_sha:
+        if file_sha256(path) != file_sha:
             raise DecoyError(f"{file}: the file changed while the evaluation ran")
-        match = read_match(path, implausible=implausible)
+        match = read_match(path, implausible=implausible, rate=rate)
         self.matches[key] = match
         while len(self.matches) > _MATCHES_KEPT:
             self.matches.popitem(last=False)
@@ -187,7 +184,7 @@ def index_file(task: IndexTask) -> FileIndex | RoundFailure:
     """Read a match file and list its rounds; the worker keeps the match for its rounds."""
     try:
         match = worker_state(task.settings).match(
-            task.file, task.file_sha, task.settings.implausible
+            task.file, task.file_sha, task.settings.implausible, task.settings.rate
         )
     except Exception as error:
         return failure_from(error, task.file, None, UNREADABLE_FILE)
@@ -242,7 +239,9 @@ def evaluate_round(task: RoundTask) -> RoundRecord | RoundFailure:
 
 def _evaluate(task: RoundTask) -> RoundRecord:
     state = worker_state(task.settings)
-    round_ = state.match(task.file, task.file_sha, task.settings.implausible).round(task.round_num)
+    round_ = state.match(
+        task.file, task.file_sha, task.settings.implausible, task.settings.rate
+    ).round(task.round_num)
     settings = task.settings
     model = state.damage_model(settings.models) if settings.combat else None
     started = time.perf_counter()

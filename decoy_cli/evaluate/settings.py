@@ -89,8 +89,11 @@ def round_key(settings: EvalSettings, file_sha: str, round_num: int) -> str:
 
 def index_key(settings: EvalSettings, file_sha: str) -> str:
     """The cache key of a file's index (its rounds, map and provenance); depends on the code and
-    on the policy for implausible rounds (which decides the rounds that failed)."""
-    text = f"index|{RECORD_VERSION}|{settings.code}|{settings.implausible}|{file_sha}"
+    on the policy for implausible rounds (which decides the rounds that failed) and on the frame
+    rate awpy's ticks are read at."""
+    text = (
+        f"index|{RECORD_VERSION}|{settings.code}|{settings.implausible}|{settings.rate}|{file_sha}"
+    )
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -101,12 +104,17 @@ def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
 
 
 def file_sha256(path: Path) -> str:
-    """SHA-256 of a file's bytes; an unreadable file raises EstaError."""
+    """SHA-256 of a file's bytes, or of a folder of awpy 3 tables (each regular file's name and
+    bytes, in name order); an unreadable one raises EstaError."""
     digest = hashlib.sha256()
+    files = sorted(p for p in path.iterdir() if p.is_file()) if path.is_dir() else [path]
     try:
-        with path.open("rb") as handle:
-            for block in iter(lambda: handle.read(1 << 20), b""):
-                digest.update(block)
+        for file in files:
+            if path.is_dir():
+                digest.update(file.name.encode() + b"\0")
+            with file.open("rb") as handle:
+                for block in iter(lambda: handle.read(1 << 20), b""):
+                    digest.update(block)
     except OSError as error:
         raise EstaError(f"{path}: cannot read the file ({error.strerror or error})") from None
     return digest.hexdigest()

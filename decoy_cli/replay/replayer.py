@@ -149,6 +149,10 @@ class ReplaySpec(RunSpec):
     implausible: Implausible = "fail"
     """Whether a player far off the map fails the round or is a warning (as the reader's
     policy for the round's other implausible data, decoy_cli/esta/plausibility.py)."""
+    rate: float | None = None
+    """Frames a second read from awpy's full-rate ticks (None: the reader's default,
+    decoy_cli/esta/awpy/rounds.py); ESTA files and data sampled at or below it are read as
+    they are."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -186,6 +190,7 @@ class ReplayOptions(ReplaySpec):
             deaths=spec.deaths,
             missing=spec.missing,
             implausible=spec.implausible,
+            rate=spec.rate,
             damage_model=damage_model,
             sight=sight,
         )

@@ -66,7 +66,7 @@ def replay_address(
     """
     if map_name is not None:
         map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
-    round_ = load_round(address, implausible=options.implausible)
+    round_ = load_round(address, implausible=options.implausible, rate=options.rate)
     map_id = round_map(address, round_.map_name, map_name)
     graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id)
     graph_map = str(graph.meta.get("map", ""))

@@ -1,0 +1,196 @@
+"""Read an awpy 2 zip, a folder of awpy 3 tables or a demo (through awpy 3) into a `Match`.
+
+The tick table is read twice, and only the second time whole: first its `tick` column alone,
+which decides the frames of every round (decoy_cli/esta/awpy/rounds.py), then the rows of those
+frames, in batches: a match's memory is the frames it keeps, not the millions of ticks of a
+full-rate table. The tick rate is the header's (awpy 3's `playback_ticks / playback_time`, or a
+`tick_rate` key); where the header does not give it (awpy 2 writes none), it is CS2's 64 ticks a
+second, and the match says so (`Match.meta["tick_rate_rule"]`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from decoy_cli.errors import EstaError
+from decoy_cli.esta.awpy.layouts import LAYOUTS, Layout, TableLayout
+from decoy_cli.esta.awpy.names import bomb_site
+from decoy_cli.esta.awpy.rounds import (
+    AwpyTables,
+    assign_rounds,
+    frame_ticks,
+    read_tables_match,
+    round_windows,
+)
+from decoy_cli.esta.awpy.tables import TableSource, open_source, read_table, stream_table
+from decoy_cli.esta.plausibility import Implausible
+from decoy_cli.esta.reader import Match
+
+CS2_TICK_RATE = 64
+"""Ticks a second of a CS2 server (sub-tick, 64 ticks/s): the rate where the header gives none."""
+
+MAX_TICK_ROWS = 50_000_000
+"""Most rows a tick table may hold: a full-rate 64-tick match of 30 rounds holds about 2 million
+(10 players × 64 ticks × ~3,000 s); 25 times that bounds the memory of a hostile table."""
+
+
+def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail") -> Match:
+    """The match in awpy's tables at `path`; `rate` frames a second from full-rate ticks."""
+    if not (math.isfinite(rate) and rate > 0):
+        raise EstaError(f"the frame rate must be a positive number of frames a second, not {rate}")
+    source = open_source(path, rate)
+    layout = LAYOUTS[source.layout]
+    tick_rate, rule = _tick_rate(source)
+    map_name = source.header.get("map_name")
+    if not isinstance(map_name, str):
+        raise EstaError(f"{path}: header.json names no map (map_name {map_name!r})")
+    bomb = _frame(source, layout.bomb)
+    rounds = _rounds(source, layout, bomb)
+    windows = round_windows(path, rounds)
+    ticks_only = read_table(source, layout.ticks.name, {"tick": "int"}, ("tick",))
+    tick_values = ticks_only["tick"].to_numpy(zero_copy_only=False)
+    if len(tick_values) > MAX_TICK_ROWS:
+        raise EstaError(f"{path}: {len(tick_values):,} tick rows, more than {MAX_TICK_ROWS:,}")
+    if pd.isna(tick_values).any():
+        raise EstaError(f"{path}: {layout.ticks.name}: a row has no tick")
+    tick_values = tick_values.astype(np.int64)
+    owner = assign_rounds(tick_values, windows)
+    if owner.size and (owner < 0).all():
+        raise EstaError(
+            f"{path}: none of the {owner.size:,} rows of {layout.ticks.name} falls in a round of "
+            "its rounds table (tables of two demos?)"
+        )
+    step = max(1, round(tick_rate / rate))
+    kept = [
+        frame_ticks(np.unique(tick_values[owner == i]), w.freeze_end, step)
+        for i, w in enumerate(windows)
+    ]
+    wanted = pa.array(np.unique(np.concatenate(kept)) if kept else np.zeros(0, np.int64))
+    del ticks_only, tick_values, owner
+    rows = stream_table(
+        source,
+        layout.ticks.name,
+        layout.ticks.kinds,
+        layout.ticks.required,
+        lambda batch: pc.is_in(pc.cast(batch.column("tick"), pa.int64()), value_set=wanted),
+    )
+    ticks = _to_pandas(rows.rename_columns([layout.ticks.renames[c] for c in rows.column_names]))
+    _check_parts(path, ticks, layout.ticks.name)
+    kills = _frame(source, layout.kills)
+    if len(kills) and (assign_rounds(kills["tick"].to_numpy(np.int64), windows) < 0).all():
+        raise EstaError(
+            f"{path}: none of the {len(kills)} kills falls in a round of its rounds table "
+            "(tables of two demos?)"
+        )
+    tables = AwpyTables(
+        path=path,
+        match_id=path.name.removesuffix(path.suffix) if path.is_file() else path.name,
+        layout=source.layout,
+        header=source.header,
+        map_name=map_name,
+        tick_rate=tick_rate,
+        tick_weapons=layout.tick_weapons,
+        windows=windows,
+        frames=kept,
+        ticks=ticks,
+        kills=kills,
+        damages=_damages(source, layout),
+        bomb=bomb,
+    )
+    match = read_tables_match(tables, implausible=implausible)
+    match.meta["tick_rate_rule"] = rule
+    return match
+
+
+def _tick_rate(source: TableSource) -> tuple[int, str]:
+    """The demo's tick rate and where it comes from (module docstring)."""
+    header = source.header
+    ticks, seconds = header.get("playback_ticks"), header.get("playback_time")
+    if _number(ticks) and _number(seconds) and float(seconds) > 0:  # type: ignore[arg-type]
+        rate = float(ticks) / float(seconds)  # type: ignore[arg-type]
+        return _checked_rate(source.path, rate), "the header's playback_ticks / playback_time"
+    given = header.get("tick_rate")
+    if given is not None:
+        if not _number(given):
+            raise EstaError(f"{source.path}: header.json tick_rate {given!r} is not a number")
+        return _checked_rate(source.path, float(given)), "the header's tick_rate"  # type: ignore[arg-type]
+    return CS2_TICK_RATE, "the header gives none: CS2 servers run 64 ticks/s"
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _checked_rate(path: Path, rate: float) -> int:
+    """A tick rate a demo can have: 64 or 128 ticks a second, within 2%."""
+    for known in (64, 128):
+        if abs(rate - known) <= 0.02 * known:
+            return known
+    raise EstaError(f"{path}: a tick rate of {rate:g} ticks/s (a demo records 64 or 128)")
+
+
+def _frame(source: TableSource, table: TableLayout) -> pd.DataFrame:
+    """A whole (small) event table under the reader's names."""
+    data = read_table(source, table.name, table.kinds, table.required)
+    frame = _to_pandas(data.rename_columns([table.renames[c] for c in data.column_names]))
+    _check_parts(source.path, frame, table.name)
+    if "tick" in frame and frame["tick"].isna().any():
+        raise EstaError(f"{source.path}: {table.name}: a row has no tick")
+    return frame
+
+
+def _damages(source: TableSource, layout: Layout) -> pd.DataFrame:
+    """The damages table; awpy 3's HP and armour taken come from the values before and after."""
+    frame = _frame(source, layout.damages)
+    if "health_pre" in frame and "health_post" in frame:
+        frame["dmg_health_taken"] = frame["health_pre"] - frame["health_post"]
+    if "armor_pre" in frame and "armor_post" in frame:
+        frame["dmg_armor_taken"] = frame["armor_pre"] - frame["armor_post"]
+    return frame
+
+
+def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataFrame:
+    """The rounds table under the reader's names; awpy 3's plants come from its bomb table."""
+    rounds = _frame(source, layout.rounds)
+    if "official_end" not in rounds:
+        rounds["official_end"] = pd.NA
+    if "bomb_plant" in rounds:
+        rounds["bomb_site"] = rounds.get("bomb_site", pd.Series("", index=rounds.index)).map(
+            bomb_site
+        )
+        return rounds
+    plants = bomb[bomb["event"] == "finish_plant"].sort_values("tick", kind="stable")
+    starts = rounds["start"].to_numpy(np.int64)
+    ends = rounds["end"].to_numpy(np.int64)
+    plant_tick: list[object] = []
+    plant_site: list[str] = []
+    for start, end in zip(starts, ends, strict=True):
+        inside = plants[(plants["tick"] >= start) & (plants["tick"] <= end)]
+        plant_tick.append(int(inside["tick"].iloc[0]) if len(inside) else pd.NA)
+        plant_site.append(bomb_site(inside["site"].iloc[0]) if len(inside) else "")
+    rounds["bomb_plant"] = pd.array(plant_tick, dtype="Int64")
+    rounds["bomb_site"] = plant_site
+    return rounds
+
+
+def _check_parts(path: Path, frame: pd.DataFrame, table: str) -> None:
+    """A multipart demo's tables restart their ticks in each part: refused, named."""
+    if "part" in frame:
+        parts = sorted(int(p) for p in frame["part"].dropna().unique())
+        if len(parts) > 1:
+            raise EstaError(
+                f"{path}: {table} holds parts {', '.join(map(str, parts))} of a multipart demo "
+                "(ticks restart in each part): write each part's tables to its own folder"
+            )
+
+
+def _to_pandas(table: pa.Table) -> pd.DataFrame:
+    """Arrow to pandas with nullable integers kept exact (steamids exceed float64's 2**53)."""
+    exact = {pa.uint64(): pd.UInt64Dtype(), pa.int64(): pd.Int64Dtype()}
+    return table.to_pandas(types_mapper=exact.get)

@@ -1,0 +1,527 @@
+"""awpy's tables, opened as one shape (decoy_cli/esta/awpy/tables.py), as a `Match` of `Round`s.
+
+The same `Round` an ESTA file gives: frames run from freeze-time end on the game's clock, players
+keyed by steamID where the data has one, else by name, T before CT; positions in metres; events
+as ESTA's tables with its names (decoy_cli/esta/awpy/names.py).
+
+* **Rounds and time.** Start, freeze end and end from the rounds table; a tick table row or an
+  event belongs to the round whose start is the latest at or before its tick, up to that round's
+  end (awpy 2's own rule; a tick equal to one round's end and the next one's start is the next
+  round's). The tick rate is the demo's (the header, never assumed).
+* **Frames at a rate.** Full-rate ticks are sampled at `rate` frames a second on the grid from
+  freeze-time end (the first tick at or after each grid point, so a missing tick moves a frame
+  and never drops it); ticks already sampled at or below that rate are kept as they are.
+* **What the data lacks.** A tick column that is absent, all null or one constant over the whole
+  table (awpy 3's stand-ins: armour 0, yaw 0.0) is not recorded: the round holds it as absent
+  (-1, NaN, "", False) and names it in `Round.not_recorded`, so the replay fills it by the rules
+  of decoy_cli/replay/missing.py and says so.
+* **Coordinates** are awpy's float32, widened exactly to float64.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from decoy_cli.errors import EstaError
+from decoy_cli.esta.awpy.names import (
+    Spelling,
+    bomb_action,
+    bomb_site,
+    end_reason,
+    hit_group,
+    side_name,
+    weapon_name,
+)
+from decoy_cli.esta.events import build_table
+from decoy_cli.esta.frames import (
+    MAX_FRAMES,
+    FrameArrays,
+    PlayerRows,
+    RoundClock,
+    player_arrays,
+)
+from decoy_cli.esta.plausibility import Implausible, check_frames
+from decoy_cli.esta.reader import Match, Round
+from decoy_cli.esta.schema import (
+    BOMB_EVENT_COLUMNS,
+    DAMAGE_COLUMNS,
+    FLASH_COLUMNS,
+    KILL_COLUMNS,
+    BombEvent,
+    DamageEvent,
+    Invalid,
+    KillEvent,
+)
+from decoy_cli.files import JsonObject
+
+DEFAULT_RATE = 8.0
+"""Frames a second taken from full-rate ticks unless `--rate` says otherwise (docs/cs2.md says
+what it trades)."""
+
+NOT_RECORDED = {
+    "yaw": "view angles",
+    "armor": "armour, helmet and kit",
+    "weapon": "weapon in hand",
+    "velocity_z": "vertical speed",
+    "steamid": "steamids",
+}
+"""Tick columns a source may lack, by the name a round's `not_recorded` gives them."""
+CARRIER = "bomb carrier"
+EQUIPMENT = ("armor", "has_helmet", "has_defuser")
+
+
+@dataclass(frozen=True)
+class RoundWindow:
+    """One row of the rounds table: ticks and outcome (`winner`, `reason` as awpy has them)."""
+
+    num: int
+    start: int
+    freeze_end: int
+    end: int
+    official_end: int
+    winner: object
+    reason: object
+    plant_tick: int | None
+    plant_site: str
+
+
+@dataclass(frozen=True, eq=False)
+class AwpyTables:
+    """A match's awpy tables under the reader's names (decoy_cli/esta/awpy/layouts.py): the
+    rounds as windows, each round's frame ticks, the kept tick rows and the event tables."""
+
+    path: Path
+    match_id: str
+    layout: str
+    header: JsonObject
+    map_name: str
+    tick_rate: int
+    tick_weapons: Spelling
+    windows: list[RoundWindow]
+    frames: list[np.ndarray]
+    ticks: pd.DataFrame
+    kills: pd.DataFrame
+    damages: pd.DataFrame
+    bomb: pd.DataFrame
+
+
+def read_tables_match(tables: AwpyTables, *, implausible: Implausible) -> Match:
+    """Every round of the tables, built, or its error kept by round number (as `read_match`)."""
+    not_recorded = _not_recorded(tables.ticks)
+    ticks = tables.ticks.drop(columns=[c for c in tables.ticks if c in _dropped(not_recorded)])
+    owner = assign_rounds(ticks["tick"].to_numpy(np.int64), tables.windows)
+    rounds: list[Round] = []
+    errors: dict[int, EstaError] = {}
+    for index, window in enumerate(tables.windows):
+        try:
+            rows = ticks[owner == index]
+            built = _build_round(tables, window, tables.frames[index], rows, implausible)
+            lacking = (*not_recorded, *_carrier(rows, window))
+            rounds.append(_with(built, not_recorded=lacking))
+        except Invalid as problem:
+            errors[window.num] = EstaError(f"{tables.path}: round {window.num}: {problem}")
+    return Match(
+        match_id=tables.match_id,
+        path=tables.path,
+        map_name=tables.map_name,
+        tick_rate=tables.tick_rate,
+        meta={"source": tables.layout, "header": tables.header},
+        rounds=rounds,
+        round_errors=dict(sorted(errors.items())),
+    )
+
+
+def _with(round_: Round, **changes: object) -> Round:
+    from dataclasses import replace
+
+    return replace(round_, **changes)  # type: ignore[arg-type]
+
+
+def _not_recorded(ticks: pd.DataFrame) -> tuple[str, ...]:
+    """The optional tick columns that hold no information: absent, all null, or one value in
+    every row (awpy 3's stand-ins), by the names of `NOT_RECORDED`."""
+    lacking = []
+    for column, name in NOT_RECORDED.items():
+        if column not in ticks or ticks[column].nunique(dropna=True) <= 1:
+            lacking.append(name)
+    return tuple(lacking)
+
+
+def _dropped(not_recorded: tuple[str, ...]) -> set[str]:
+    """The tick columns a round holds as absent because the table does not record them."""
+    columns = {column for column, name in NOT_RECORDED.items() if name in not_recorded}
+    if "armor" in columns:
+        columns |= set(EQUIPMENT)
+    return columns
+
+
+def _carrier(rows: pd.DataFrame, window: RoundWindow) -> tuple[str, ...]:
+    """The bomb carrier, named not recorded where nobody holds the bomb in a round's rows."""
+    if "has_bomb" in rows and rows["has_bomb"].fillna(False).astype(bool).any():
+        return ()
+    return (CARRIER,)
+
+
+def round_windows(path: Path, table: pd.DataFrame) -> list[RoundWindow]:
+    """The rounds table as windows, in tick order; repeated or overlapping rounds raise."""
+    windows = []
+    for row in table.to_dict("records"):
+        official = row.get("official_end")
+        plant = row.get("bomb_plant")
+        windows.append(
+            RoundWindow(
+                num=int(row["round_num"]),
+                start=int(row["start"]),
+                freeze_end=int(row["freeze_end"]),
+                end=int(row["end"]),
+                official_end=int(row["end"]) if _is_null(official) else int(official),
+                winner=row["winner"],
+                reason=row["reason"],
+                plant_tick=None if _is_null(plant) else int(plant),
+                plant_site=bomb_site(row.get("bomb_site")),
+            )
+        )
+    windows.sort(key=lambda w: w.start)
+    numbers = [w.num for w in windows]
+    if len(set(numbers)) != len(numbers):
+        repeated = sorted({n for n in numbers if numbers.count(n) > 1})
+        raise EstaError(f"{path}: the rounds table holds round {repeated[0]} twice")
+    for w in windows:
+        if not w.start <= w.freeze_end <= w.end <= w.official_end:
+            raise EstaError(
+                f"{path}: round {w.num}: start {w.start}, freeze end {w.freeze_end}, end {w.end} "
+                f"and official end {w.official_end} are not in order"
+            )
+    for before, after in itertools.pairwise(windows):
+        if after.start < before.end:
+            raise EstaError(
+                f"{path}: round {after.num} starts at tick {after.start}, before round "
+                f"{before.num} ends (tick {before.end})"
+            )
+    return windows
+
+
+def assign_rounds(ticks: np.ndarray, windows: list[RoundWindow]) -> np.ndarray:
+    """The index into `windows` of the round each tick belongs to (module docstring), -1 for a
+    tick in no round."""
+    values = np.asarray(ticks, dtype=np.int64)
+    if not windows:
+        return np.full(values.shape, -1, dtype=np.int64)
+    starts = np.array([w.start for w in windows], dtype=np.int64)
+    ends = np.array([w.official_end for w in windows], dtype=np.int64)
+    index = np.searchsorted(starts, values, side="right") - 1
+    inside = (index >= 0) & (values <= ends[np.clip(index, 0, None)])
+    return np.where(inside, index, -1)
+
+
+def frame_ticks(ticks: np.ndarray, freeze_end: int, step: int) -> np.ndarray:
+    """The ticks kept as frames from a round's sorted unique `ticks` from freeze-time end on:
+    all of them when they are `step` ticks apart or more (sampled already), else the first tick
+    at or after each point of the grid `freeze_end + k * step`."""
+    ticks = ticks[ticks >= freeze_end]
+    if ticks.size < 2 or step <= 1 or np.median(np.diff(ticks)) >= step:
+        return ticks
+    grid = np.arange(freeze_end, int(ticks[-1]) + 1, step, dtype=np.int64)
+    at = np.searchsorted(ticks, grid, side="left")
+    return np.unique(ticks[at[at < ticks.size]])
+
+
+def _build_round(
+    tables: AwpyTables,
+    window: RoundWindow,
+    kept: np.ndarray,
+    rows: pd.DataFrame,
+    implausible: Implausible,
+) -> Round:
+    """One round of the tables (module docstring); a problem raises Invalid."""
+    if kept.size == 0:
+        raise Invalid("no tick rows from its freeze end to its end")
+    if kept.size > MAX_FRAMES:
+        raise Invalid(f"{kept.size:,} frames (a round holds at most {MAX_FRAMES:,})")
+    warnings: list[str] = []
+    winner = side_name(window.winner)
+    reason = end_reason(window.reason)
+    if winner is None:
+        warnings.append(f"winner {window.winner!r} is not a side: no winner")
+    if reason is None:
+        warnings.append(f"unknown round end reason {window.reason!r}: none kept")
+    clock = RoundClock(float(window.freeze_end), tables.tick_rate)
+    rows = rows[rows["tick"].to_numpy(np.int64) >= window.freeze_end]
+    raw = rows["tick"].to_numpy(np.int64)
+    if raw.size and (np.diff(raw) < 0).any():
+        rows = rows.sort_values("tick", kind="stable")
+        raw = rows["tick"].to_numpy(np.int64)
+        warnings.append("the tick table is not in tick order (read sorted)")
+    frame = np.searchsorted(kept, raw)
+    infos, arrays = player_arrays(_player_rows(rows, frame, tables, warnings), kept)
+    seconds = clock.seconds(kept)
+    planted = (
+        (kept >= window.plant_tick) if window.plant_tick is not None else np.zeros(kept.size, bool)
+    )
+    frames = FrameArrays(
+        ticks=kept,
+        seconds=seconds,
+        clock=clock,
+        players=infos,
+        **arrays,
+        bomb_position=np.full((kept.size, 3), np.nan),
+        bomb_planted=planted,
+        bombsite=np.array([window.plant_site if p else "" for p in planted], dtype=str),
+    )
+    warnings.extend(check_frames(frames, implausible))
+    events = _events(tables, window, warnings)
+    return Round(
+        match_id=tables.match_id,
+        path=tables.path,
+        round_num=window.num,
+        map_name=tables.map_name,
+        tick_rate=tables.tick_rate,
+        frame_ticks=kept,
+        frame_seconds=seconds,
+        players=infos,
+        position=frames.position,
+        yaw=frames.yaw,
+        hp=frames.hp,
+        armor=frames.armor,
+        helmet=frames.helmet,
+        has_defuser=frames.has_defuser,
+        weapon=frames.weapon,
+        alive=frames.alive,
+        present=frames.present,
+        has_bomb=frames.has_bomb,
+        vertical_speed=frames.vertical_speed,
+        bomb_position=frames.bomb_position,
+        bomb_planted=frames.bomb_planted,
+        bombsite=frames.bombsite,
+        damages=build_table("damages", events["damages"], DAMAGE_COLUMNS, kept, clock),
+        kills=build_table("kills", events["kills"], KILL_COLUMNS, kept, clock),
+        bomb_events=build_table("bomb_events", events["bomb"], BOMB_EVENT_COLUMNS, kept, clock),
+        flashes=build_table("flashes", [], FLASH_COLUMNS, kept, clock),
+        winning_side=winner,  # type: ignore[arg-type]  # side_name gives "T", "CT" or None
+        end_reason=reason,
+        bomb_plant_tick=window.plant_tick,
+        start_tick=window.start,
+        end_tick=window.end,
+        clock=clock,
+        warnings=tuple(warnings),
+        source=tables.layout,
+    )
+
+
+def _player_rows(
+    rows: pd.DataFrame, frame: np.ndarray, tables: AwpyTables, warnings: list[str]
+) -> PlayerRows:
+    """The round's kept tick rows in the long form `player_arrays` takes."""
+    count = len(rows)
+
+    def numbers(column: str) -> np.ndarray:
+        if column not in rows:
+            return np.full(count, np.nan)
+        return rows[column].to_numpy(dtype=np.float64, na_value=np.nan)
+
+    def flags(column: str) -> np.ndarray:
+        if column not in rows:
+            return np.zeros(count, dtype=bool)
+        return rows[column].to_numpy(dtype=object, na_value=False).astype(bool)
+
+    names = rows["name"].to_numpy(dtype=object, na_value="")
+    steam = (
+        rows["steamid"].to_numpy(dtype=object, na_value=None)
+        if "steamid" in rows
+        else np.full(count, None, dtype=object)
+    )
+    steam = np.array([_steam_id(s) for s in steam], dtype=object)
+    keys = np.array([n if s is None else str(s) for n, s in zip(names, steam, strict=True)], object)
+    sides = rows["side"].to_numpy(dtype=object, na_value=None)
+    side = np.array([side_name(s) or "" for s in sides], dtype=object)
+    if (side == "").any():
+        bad = sides[int(np.flatnonzero(side == "")[0])]
+        raise Invalid(f"a tick row has side {bad!r} (not a team's)")
+    position = np.stack([numbers("x"), numbers("y"), numbers("z")], axis=1).reshape(count, 3)
+    alive = numbers("is_alive")
+    return PlayerRows(
+        frame=frame.astype(np.int64),
+        key=keys,
+        name=names,
+        steam_id=steam,
+        side=side,
+        position=position,
+        located=~np.isnan(position).any(axis=1),
+        yaw=numbers("yaw") % 360.0,
+        hp=numbers("health"),
+        armor=numbers("armor"),
+        helmet=flags("has_helmet"),
+        has_defuser=flags("has_defuser"),
+        has_bomb=flags("has_bomb"),
+        alive=alive,
+        weapon=_weapons(rows, tables.tick_weapons, warnings),
+        vertical_speed=numbers("velocity_z"),
+    )
+
+
+def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.ndarray:
+    """ESTA's name of each row's weapon in hand; an unknown one is "" and a named warning."""
+    if "weapon" not in rows:
+        return np.full(len(rows), "", dtype=object)
+    raw = rows["weapon"].to_numpy(dtype=object, na_value="")
+    names, codes = np.unique(raw.astype(str), return_inverse=True)
+    mapped = []
+    for name in names:
+        esta = weapon_name(name, spelling)
+        if esta is None:
+            warnings.append(f"unknown weapon in hand {name!r}: read as none")
+        mapped.append(esta or "")
+    return np.array(mapped, dtype=object)[codes]
+
+
+def _events(tables: AwpyTables, window: RoundWindow, warnings: list[str]) -> dict[str, list]:
+    """The round's kills, damages and bomb events as ESTA event structs."""
+    kills = [_kill(row, warnings) for row in _records(_in_window(tables.kills, window))]
+    damages = [_damage(row, warnings) for row in _records(_in_window(tables.damages, window))]
+    bomb = [_bomb_event(row, window) for row in _records(_in_window(tables.bomb, window))]
+    return {
+        "kills": [KillEvent(**row) for row in kills],
+        "damages": [DamageEvent(**row) for row in damages],
+        "bomb": [BombEvent(**row) for row in bomb if row is not None],
+    }
+
+
+def _in_window(table: pd.DataFrame, window: RoundWindow) -> pd.DataFrame:
+    """The rows of an event table in the round (module docstring), in tick order."""
+    ticks = table["tick"].to_numpy(dtype=np.int64)
+    inside = (ticks >= window.start) & (ticks <= window.official_end)
+    return table[inside].sort_values("tick", kind="stable")
+
+
+def _records(table: pd.DataFrame) -> list[dict[str, object]]:
+    """Rows as dicts with None for every null."""
+    return [
+        {k: (None if _is_null(v) else v) for k, v in row.items()}
+        for row in table.to_dict("records")
+    ]
+
+
+def _is_null(value: object) -> bool:
+    return value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value))
+
+
+def _player(row: dict[str, object], who: str, esta: str) -> dict[str, object]:
+    """One player's columns of an event as ESTA names them (`esta` is the ESTA prefix)."""
+    side = row.get(f"{who}_side")
+    return {
+        f"{esta}SteamID": _steam_id(row.get(f"{who}_steamid")),
+        f"{esta}Name": row.get(f"{who}_name"),
+        f"{esta}Side": None if side is None else side_name(side),
+        f"{esta}X": row.get(f"{who}_x"),
+        f"{esta}Y": row.get(f"{who}_y"),
+        f"{esta}Z": row.get(f"{who}_z"),
+        f"{esta}ViewX": _yaw(row.get(f"{who}_yaw")),
+        f"{esta}ViewY": row.get(f"{who}_pitch"),
+    }
+
+
+def _steam_id(value: object) -> int | None:
+    """A steamid as an int; null or 0 (a bot) is None."""
+    if _is_null(value) or value == 0:
+        return None
+    return int(value)  # type: ignore[call-overload]
+
+
+def _yaw(value: object) -> float | None:
+    return None if value is None else float(value) % 360.0  # type: ignore[arg-type]
+
+
+def _event_weapon(row: dict[str, object], warnings: list[str]) -> str | None:
+    """ESTA's name of an event's weapon; an unknown one is None and a named warning."""
+    raw = row.get("weapon")
+    name = weapon_name(raw, "item")
+    if name is None:
+        warnings.append(f"unknown weapon {raw!r} at tick {row['tick']}: kept unnamed")
+    return name or None
+
+
+def _event_hit_group(row: dict[str, object], warnings: list[str]) -> str | None:
+    raw = row.get("hitgroup")
+    group = hit_group(raw)
+    if group is None:
+        warnings.append(f"unknown hit group {raw!r} at tick {row['tick']}: kept unnamed")
+    return group or None
+
+
+def _kill(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
+    attacker = _player(row, "attacker", "attacker")
+    victim = _player(row, "victim", "victim")
+    assister = _player(row, "assister", "assister")
+    penetrated = row.get("penetrated")
+    return {
+        "tick": row["tick"],
+        **attacker,
+        **victim,
+        "assisterSteamID": assister["assisterSteamID"],
+        "assisterName": assister["assisterName"],
+        "assisterSide": assister["assisterSide"],
+        "weapon": _event_weapon(row, warnings),
+        "isHeadshot": row.get("headshot"),
+        "isSuicide": attacker["attackerName"] == victim["victimName"],
+        "isTeamkill": attacker["attackerSide"] == victim["victimSide"],
+        "thruSmoke": row.get("thrusmoke"),
+        "noScope": row.get("noscope"),
+        "isWallbang": None if penetrated is None else bool(penetrated),
+        "penetratedObjects": penetrated,
+        "attackerBlinded": row.get("attackerblind"),
+        "distance": row.get("distance"),
+    }
+
+
+def _damage(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
+    attacker = _player(row, "attacker", "attacker")
+    victim = _player(row, "victim", "victim")
+    return {
+        "tick": row["tick"],
+        **attacker,
+        **victim,
+        "weapon": _event_weapon(row, warnings) or "World",
+        "hpDamage": row.get("dmg_health"),
+        "hpDamageTaken": row.get("dmg_health_taken"),
+        "armorDamage": row.get("dmg_armor"),
+        "armorDamageTaken": row.get("dmg_armor_taken"),
+        "hitGroup": _event_hit_group(row, warnings),
+        "isFriendlyFire": attacker["attackerSide"] is not None
+        and attacker["attackerSide"] == victim["victimSide"],
+        "distance": _distance(row),
+    }
+
+
+def _distance(row: dict[str, object]) -> float | None:
+    """awpy's distance where given, else the attacker-victim distance in Hammer units."""
+    if row.get("distance") is not None:
+        return float(row["distance"])  # type: ignore[arg-type]
+    ends = [row.get(f"{who}_{axis}") for who in ("attacker", "victim") for axis in "xyz"]
+    if any(value is None for value in ends):
+        return None
+    a, b = np.array(ends[:3], dtype=np.float64), np.array(ends[3:], dtype=np.float64)
+    return float(np.linalg.norm(a - b))
+
+
+def _bomb_event(row: dict[str, object], window: RoundWindow) -> dict[str, object] | None:
+    """A bomb event as ESTA writes it (the plant's site is the round's where the row names a
+    place, as awpy 2 does); None for the events ESTA has no name for (drop, pick-up)."""
+    action = bomb_action(row.get("event"))
+    if action is None:
+        return None
+    site = bomb_site(row.get("site")) or (window.plant_site if action == "plant" else "")
+    return {
+        "tick": row["tick"],
+        "playerSteamID": _steam_id(row.get("steamid")),
+        "playerName": row.get("name"),
+        "playerX": row.get("x"),
+        "playerY": row.get("y"),
+        "playerZ": row.get("z"),
+        "bombAction": action,
+        "bombSite": site or None,
+    }
