@@ -25,6 +25,9 @@ Rules, the first that applies:
   Without a plant nobody carries it (the replay plants only where the data did).
 * Defuse (the round ended `BombDefused` with no `defuse` event): it began 5 s (kit) or 10 s
   before the round's end (the rules' durations), by the CT alive at the end nearest the bomb.
+* Defuse start (a `defuse` event with no `defuse_start` before it: awpy writes none, and takes
+  it from the ticks only where they record `is_defusing`): the defuser began 5 s (kit) or 10 s
+  before the defuse.
 
 `contradictions` names what the frames and the events say against each other (a victim alive
 after its kill, a killer or victim never in the frames, a plant with no T alive, a defuse of a
@@ -89,6 +92,8 @@ def fill_missing(round_: Round, zones: SiteZones, rules: RulesConfig, missing: M
         filled = _bomb(filled, zones, rules.plant_s, notes)
     if "defuser" in absent:
         filled = _defuse(filled, rules, notes)
+    if "defuse start" in absent:
+        filled = _defuse_start(filled, rules, notes)
     return Filled(filled, tuple(notes))
 
 
@@ -109,7 +114,16 @@ def lacking(round_: Round) -> tuple[str, ...]:
     defused = len(events) and "bombAction" in events and (events["bombAction"] == "defuse").any()
     if round_.end_reason == "BombDefused" and not defused:
         names.append("defuser")
+    if defused and len(_unstarted_defuses(events)):
+        names.append("defuse start")
     return tuple(names)
+
+
+def _unstarted_defuses(events: pd.DataFrame) -> pd.DataFrame:
+    """The `defuse` events with no `defuse_start` at or before them."""
+    starts = events.loc[events["bombAction"] == "defuse_start", "tick"].to_numpy(np.float64)
+    defuses = events[events["bombAction"] == "defuse"]
+    return defuses[[not (starts <= float(t)).any() for t in defuses["tick"]]]
 
 
 def _firearm(name: object) -> bool:
@@ -307,6 +321,38 @@ def _defuse(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
         f"before the round's end ({'with' if kit else 'without'} a kit)"
     )
     return replace(round_, bomb_events=table)
+
+
+def _defuse_start(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
+    """A `defuse_start` before each defuse the data has without one (module docstring)."""
+    if round_.clock is None:
+        return round_
+    events = round_.bomb_events
+    rows = []
+    for defuse in _unstarted_defuses(events).itertuples():
+        name = defuse.playerName if isinstance(defuse.playerName, str) else ""
+        player = next((p for p, pl in enumerate(round_.players) if pl.name == name), -1)
+        kit = player >= 0 and bool(np.asarray(round_.has_defuser, bool)[player].any())
+        seconds = rules.defuse_kit_s if kit else rules.defuse_s
+        start = float(defuse.tick) - seconds * round_.clock.tick_rate
+        rows.append(
+            {
+                "tick": start,
+                "bombAction": "defuse_start",
+                "playerName": defuse.playerName,
+                "playerSteamID": defuse.playerSteamID,
+            }
+        )
+        notes.append(
+            f"defuse start ({name or 'unnamed'}): {seconds:g} s before the data's defuse "
+            f"({'with' if kit else 'without'} a kit)"
+        )
+    if not rows:
+        return round_
+    added = pd.DataFrame(rows)
+    added["seconds"] = round_.clock.seconds(added["tick"].to_numpy(np.float64))
+    table = pd.concat([events, added], ignore_index=True).sort_values("tick", kind="stable")
+    return replace(round_, bomb_events=table.reset_index(drop=True))
 
 
 def contradictions(round_: Round) -> tuple[str, ...]:

@@ -127,6 +127,7 @@ AWPY2 = Layout(
             "is_alive": ("is_alive", "bool"),
             "active_weapon_name": ("weapon", "str"),
             "velocity_Z": ("velocity_z", "float"),
+            "inventory": ("inventory", "list"),
         },
         ("tick", "name", "side", "X", "Y", "Z", "health"),
     ),

@@ -4,8 +4,10 @@ The tick table is read twice, and only the second time whole: first its `tick` c
 which decides the frames of every round (decoy_cli/esta/awpy/rounds.py), then the rows of those
 frames, in batches: a match's memory is the frames it keeps, not the millions of ticks of a
 full-rate table. The tick rate is the header's (awpy 3's `playback_ticks / playback_time`, or a
-`tick_rate` key); where the header does not give it (awpy 2 writes none), it is CS2's 64 ticks a
-second, and the match says so (`Match.meta["tick_rate_rule"]`).
+`tick_rate` key); where the header does not give it (awpy 2 writes none), the spans the game's
+rules fix tell it: plant to detonation (the 40 s bomb timer) and freeze end to a round lost on
+time (the 115 s round time), the median of their ticks per second taken to the nearer of 64 and
+128; with neither, CS2's 64. The match says which (`Match.meta["tick_rate_rule"]`).
 """
 
 from __future__ import annotations
@@ -20,9 +22,10 @@ import pyarrow.compute as pc
 
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.awpy.layouts import LAYOUTS, Layout, TableLayout
-from decoy_cli.esta.awpy.names import bomb_site
+from decoy_cli.esta.awpy.names import bomb_action, bomb_site, end_reason, weapon_name
 from decoy_cli.esta.awpy.rounds import (
     AwpyTables,
+    RoundWindow,
     assign_rounds,
     frame_ticks,
     read_tables_match,
@@ -31,9 +34,13 @@ from decoy_cli.esta.awpy.rounds import (
 from decoy_cli.esta.awpy.tables import TableSource, open_source, read_table, stream_table
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.esta.reader import Match
+from decoy_cli.esta.records import BOMB_TIMER_S, ROUND_TIME_S
 
 CS2_TICK_RATE = 64
 """Ticks a second of a CS2 server (sub-tick, 64 ticks/s): the rate where the header gives none."""
+
+KNOWN_TICK_RATES = (64, 128)
+"""The tick rates of Counter-Strike demos: CS2's 64, CS:GO's 64 and 128."""
 
 MAX_TICK_ROWS = 50_000_000
 """Most rows a tick table may hold: a full-rate 64-tick match of 30 rounds holds about 2 million
@@ -46,13 +53,13 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
         raise EstaError(f"the frame rate must be a positive number of frames a second, not {rate}")
     source = open_source(path, rate)
     layout = LAYOUTS[source.layout]
-    tick_rate, rule = _tick_rate(source)
     map_name = source.header.get("map_name")
     if not isinstance(map_name, str):
         raise EstaError(f"{path}: header.json names no map (map_name {map_name!r})")
     bomb = _frame(source, layout.bomb)
     rounds = _rounds(source, layout, bomb)
     windows = round_windows(path, rounds)
+    tick_rate, rule = _tick_rate(source, windows, bomb)
     ticks_only = read_table(source, layout.ticks.name, {"tick": "int"}, ("tick",))
     tick_values = ticks_only["tick"].to_numpy(zero_copy_only=False)
     if len(tick_values) > MAX_TICK_ROWS:
@@ -81,6 +88,8 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
         lambda batch: pc.is_in(pc.cast(batch.column("tick"), pa.int64()), value_set=wanted),
     )
     ticks = _to_pandas(rows.rename_columns([layout.ticks.renames[c] for c in rows.column_names]))
+    if "inventory" in ticks and "has_bomb" not in ticks:
+        ticks["has_bomb"] = ticks.pop("inventory").map(_holds_bomb)
     _check_parts(path, ticks, layout.ticks.name)
     kills = _frame(source, layout.kills)
     if len(kills) and (assign_rounds(kills["tick"].to_numpy(np.int64), windows) < 0).all():
@@ -108,7 +117,9 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
     return match
 
 
-def _tick_rate(source: TableSource) -> tuple[int, str]:
+def _tick_rate(
+    source: TableSource, windows: list[RoundWindow], bomb: pd.DataFrame
+) -> tuple[int, str]:
     """The demo's tick rate and where it comes from (module docstring)."""
     header = source.header
     ticks, seconds = header.get("playback_ticks"), header.get("playback_time")
@@ -120,7 +131,33 @@ def _tick_rate(source: TableSource) -> tuple[int, str]:
         if not _number(given):
             raise EstaError(f"{source.path}: header.json tick_rate {given!r} is not a number")
         return _checked_rate(source.path, float(given)), "the header's tick_rate"  # type: ignore[arg-type]
-    return CS2_TICK_RATE, "the header gives none: CS2 servers run 64 ticks/s"
+    spans = _rule_spans(windows, bomb)
+    if not spans:
+        return CS2_TICK_RATE, "the header gives none, nor a round timed by the rules: CS2's 64"
+    measured = float(np.median(spans))
+    rate = min(KNOWN_TICK_RATES, key=lambda known: abs(math.log(measured / known)))
+    return rate, (
+        f"the header gives none: {len(spans)} span(s) the rules time (bomb timer "
+        f"{BOMB_TIMER_S:g} s, round time {ROUND_TIME_S:g} s) measure {measured:.1f} ticks/s"
+    )
+
+
+def _rule_spans(windows: list[RoundWindow], bomb: pd.DataFrame) -> list[float]:
+    """Ticks per second of each span the game's rules fix: plant to detonation, freeze end to
+    the end of a round lost on time."""
+    spans = [
+        (w.end - w.freeze_end) / ROUND_TIME_S
+        for w in windows
+        if end_reason(w.reason) == "TargetSaved" and w.end > w.freeze_end
+    ]
+    events = bomb.sort_values("tick", kind="stable")
+    plants = events.loc[events["event"].map(bomb_action) == "plant", "tick"].to_numpy(np.int64)
+    blasts = events.loc[events["event"].map(bomb_action) == "explode", "tick"].to_numpy(np.int64)
+    for blast in blasts:
+        before = plants[plants < blast]
+        if before.size:
+            spans.append((blast - before[-1]) / BOMB_TIMER_S)
+    return spans
 
 
 def _number(value: object) -> bool:
@@ -129,7 +166,7 @@ def _number(value: object) -> bool:
 
 def _checked_rate(path: Path, rate: float) -> int:
     """A tick rate a demo can have: 64 or 128 ticks a second, within 2%."""
-    for known in (64, 128):
+    for known in KNOWN_TICK_RATES:
         if abs(rate - known) <= 0.02 * known:
             return known
     raise EstaError(f"{path}: a tick rate of {rate:g} ticks/s (a demo records 64 or 128)")
@@ -177,6 +214,13 @@ def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataF
     rounds["bomb_plant"] = pd.array(plant_tick, dtype="Int64")
     rounds["bomb_site"] = plant_site
     return rounds
+
+
+def _holds_bomb(items: object) -> bool | None:
+    """Whether awpy 2's `inventory` (demoparser2's names) holds the bomb; None where null."""
+    if items is None or isinstance(items, float):
+        return None
+    return any(weapon_name(item, "display") == "C4" for item in items)  # type: ignore[attr-defined]
 
 
 def _check_parts(path: Path, frame: pd.DataFrame, table: str) -> None:

@@ -41,6 +41,7 @@ from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import (
     MAX_FRAMES,
     FrameArrays,
+    PlayerInfo,
     PlayerRows,
     RoundClock,
     player_arrays,
@@ -275,6 +276,7 @@ def _build_round(
     )
     warnings.extend(check_frames(frames, implausible))
     events = _events(tables, window, warnings)
+    events["bomb"] = _defuse_starts(events["bomb"], rows, infos)
     return Round(
         match_id=tables.match_id,
         path=tables.path,
@@ -330,13 +332,7 @@ def _player_rows(
         return rows[column].to_numpy(dtype=object, na_value=False).astype(bool)
 
     names = rows["name"].to_numpy(dtype=object, na_value="")
-    steam = (
-        rows["steamid"].to_numpy(dtype=object, na_value=None)
-        if "steamid" in rows
-        else np.full(count, None, dtype=object)
-    )
-    steam = np.array([_steam_id(s) for s in steam], dtype=object)
-    keys = np.array([n if s is None else str(s) for n, s in zip(names, steam, strict=True)], object)
+    keys, steam = _row_keys(rows)
     sides = rows["side"].to_numpy(dtype=object, na_value=None)
     side = np.array([side_name(s) or "" for s in sides], dtype=object)
     if (side == "").any():
@@ -364,6 +360,20 @@ def _player_rows(
     )
 
 
+def _row_keys(rows: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Each tick row's player key (the steamid as text, else the name) and steamid (None where
+    null or 0, a bot)."""
+    names = rows["name"].to_numpy(dtype=object, na_value="")
+    raw = (
+        rows["steamid"].to_numpy(dtype=object, na_value=None)
+        if "steamid" in rows
+        else np.full(len(rows), None, dtype=object)
+    )
+    steam = np.array([_steam_id(s) for s in raw], dtype=object)
+    keys = np.array([n if s is None else str(s) for n, s in zip(names, steam, strict=True)], object)
+    return keys, steam
+
+
 def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.ndarray:
     """ESTA's name of each row's weapon in hand; an unknown one is "" and a named warning."""
     if "weapon" not in rows:
@@ -374,7 +384,7 @@ def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.
     for name in names:
         esta = weapon_name(name, spelling)
         if esta is None:
-            warnings.append(f"unknown weapon in hand {name!r}: read as none")
+            warnings.append(f"unknown weapon in hand {str(name)!r}: read as none")
         mapped.append(esta or "")
     return np.array(mapped, dtype=object)[codes]
 
@@ -389,6 +399,39 @@ def _events(tables: AwpyTables, window: RoundWindow, warnings: list[str]) -> dic
         "damages": [DamageEvent(**row) for row in damages],
         "bomb": [BombEvent(**row) for row in bomb if row is not None],
     }
+
+
+def _defuse_starts(bomb: list, rows: pd.DataFrame, players: list[PlayerInfo]) -> list:
+    """The bomb events with a `defuse_start` before each `defuse` that has none, where the
+    defuser's ticks show him defusing (awpy 3's `is_defusing`, awpy 2's with the prop): the
+    first tick of the run of defusing ticks that ends in the defuse. awpy writes no event for
+    the start of a defuse."""
+    if "is_defusing" not in rows or not len(bomb):
+        return bomb
+    out = list(bomb)
+    for event in bomb:
+        if event.bombAction != "defuse" or any(
+            e.bombAction == "defuse_start" and e.tick <= event.tick for e in bomb
+        ):
+            continue
+        key = str(event.playerSteamID) if event.playerSteamID else event.playerName
+        keys, _ = _row_keys(rows)
+        mine = rows[(keys == key) & (rows["tick"].to_numpy(np.int64) <= event.tick)]
+        mine = mine.sort_values("tick", kind="stable")
+        defusing = mine["is_defusing"].to_numpy(dtype=object, na_value=False).astype(bool)
+        if not defusing.size or not defusing[-1]:
+            continue
+        stops = np.flatnonzero(~defusing)
+        first = stops[-1] + 1 if stops.size else 0
+        start = int(mine["tick"].iloc[first])
+        out.append(
+            BombEvent(**{**_struct_fields(event), "tick": start, "bombAction": "defuse_start"})
+        )
+    return sorted(out, key=lambda e: e.tick)
+
+
+def _struct_fields(event: object) -> dict[str, object]:
+    return {name: getattr(event, name) for name in event.__struct_fields__}  # type: ignore[attr-defined]
 
 
 def _in_window(table: pd.DataFrame, window: RoundWindow) -> pd.DataFrame:

@@ -26,7 +26,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta.source import max_match_bytes
 from decoy_cli.files import JsonObject
 
-Kind = Literal["int", "float", "str", "bool"]
+Kind = Literal["int", "float", "str", "bool", "list"]
 """What a column holds; integers may arrive as floats where awpy writes nulls."""
 
 HEADER = "header.json"
@@ -45,6 +45,13 @@ _CHECKS: dict[Kind, Callable[[pa.DataType], bool]] = {
         or (pa.types.is_dictionary(t) and pa.types.is_string(t.value_type))
     ),
     "bool": lambda t: pa.types.is_boolean(t) or pa.types.is_null(t),
+    "list": lambda t: (
+        (
+            (pa.types.is_list(t) or pa.types.is_large_list(t))
+            and (pa.types.is_string(t.value_type) or pa.types.is_large_string(t.value_type))
+        )
+        or pa.types.is_null(t)
+    ),
 }
 
 

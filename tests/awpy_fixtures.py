@@ -1,0 +1,326 @@
+"""awpy 2 zips and awpy 3 table folders written by the tests, in awpy's own column names and
+types (parquet through pyarrow), from rounds the project generated (the synthetic sample) or
+made up here: what the real CS2 rounds in ../shared/data lack (weapons, armour, a carrier,
+steamids, bomb events with players, damages, full-rate ticks).
+
+Names are awpy's (decoy_cli/esta/awpy/names.py lists them): awpy 2 ticks spell weapons as
+demoparser2 shows them ("M4A1-S"), events and awpy 3 snapshots as the game's items
+("m4a1_silencer"). Sides `t`/`ct` (awpy 2), `terrorist`/`counter-terrorist` (awpy 3).
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.esta import Match, Round
+from decoy_cli.esta.awpy.names import WEAPON_SPELLINGS
+
+DISPLAY = {esta: shown[0] for esta, (shown, _) in WEAPON_SPELLINGS.items() if shown}
+ITEM = {esta: items[0] for esta, (_, items) in WEAPON_SPELLINGS.items() if items}
+HIT_GROUPS = {
+    "Generic": "generic",
+    "Head": "head",
+    "Chest": "chest",
+    "Stomach": "stomach",
+    "LeftArm": "left_arm",
+    "RightArm": "right_arm",
+    "LeftLeg": "left_leg",
+    "RightLeg": "right_leg",
+    "Neck": "neck",
+}
+HIT_GROUP_CODES = {name: code for code, name in enumerate(HIT_GROUPS.values())}
+REASONS2 = {
+    "TargetBombed": "bomb_exploded",
+    "BombDefused": "bomb_defused",
+    "CTWin": "t_killed",
+    "TerroristsWin": "ct_killed",
+    "TargetSaved": "time_ran_out",
+}
+REASONS3 = {"TargetBombed": 1, "BombDefused": 7, "CTWin": 8, "TerroristsWin": 9, "TargetSaved": 12}
+REASON_NAMES3 = {1: "target_bombed", 7: "bomb_defused", 8: "ct_win", 9: "terrorists_win"}
+REASON_NAMES3[12] = "target_saved"
+BOMB2 = {"plant": "plant", "defuse": "defuse", "explode": "detonate"}
+BOMB3 = {"plant_begin": "start_plant", "plant": "finish_plant", "defuse": "defuse"}
+SIDE2 = {"T": "t", "CT": "ct"}
+SIDE3 = {"T": "terrorist", "CT": "counter-terrorist"}
+FREEZE_TICKS = 15 * 128
+"""Ticks of freeze time before each round's freeze end in the written round windows."""
+
+
+def _write(table: dict[str, pa.Array]) -> bytes:
+    sink = pa.BufferOutputStream()
+    pq.write_table(pa.table(table), sink, compression="zstd")
+    return sink.getvalue().to_pybytes()
+
+
+def tick_rows(rounds: list[Round], *, every: int = 0) -> dict[str, np.ndarray]:
+    """One row per player present per kept tick (each frame's, or with `every` one every
+    `every` ticks between frames, positions interpolated): the long form both layouts share."""
+    out: dict[str, list[np.ndarray]] = {k: [] for k in ("tick", "player", "round", "frame")}
+    xyz: list[np.ndarray] = []
+    for r_index, round_ in enumerate(rounds):
+        ticks = round_.frame_ticks
+        if every:
+            fine = np.arange(ticks[0], ticks[-1] + 1, every, dtype=np.int64)
+            frame = np.clip(np.searchsorted(ticks, fine, side="right") - 1, 0, len(ticks) - 1)
+        else:
+            fine, frame = ticks, np.arange(len(ticks))
+        for p in range(round_.num_players):
+            present = round_.present[p, frame]
+            where = np.flatnonzero(present)
+            if every:
+                position = np.stack(
+                    [
+                        np.interp(fine, ticks, round_.position[p, :, axis] / HAMMER_TO_M)
+                        for axis in range(3)
+                    ],
+                    axis=1,
+                )
+            else:
+                position = round_.position[p] / HAMMER_TO_M
+            out["tick"].append(fine[where])
+            out["player"].append(np.full(where.size, p))
+            out["round"].append(np.full(where.size, r_index))
+            out["frame"].append(frame[where])
+            xyz.append(position[where])
+    rows = {k: np.concatenate(v) for k, v in out.items()}
+    rows["xyz"] = np.concatenate(xyz)
+    order = np.lexsort((rows["player"], rows["tick"]))
+    return {k: v[order] for k, v in rows.items()}
+
+
+def _players_columns(rounds: list[Round], rows: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Per row: name, steamid, side, health, armour, flags, yaw, weapon (ESTA name)."""
+
+    def take(field: str) -> np.ndarray:
+        return np.array(
+            [
+                getattr(rounds[r], field)[p, f]
+                for r, p, f in zip(rows["round"], rows["player"], rows["frame"], strict=True)
+            ]
+        )
+
+    players = [[(pl.name, pl.steam_id, pl.side) for pl in r.players] for r in rounds]
+    info = [players[r][p] for r, p in zip(rows["round"], rows["player"], strict=True)]
+    defusing = np.zeros(len(rows["tick"]), dtype=bool)
+    for r_index, round_ in enumerate(rounds):
+        events = round_.bomb_events
+        starts = events[events["bombAction"] == "defuse_start"]
+        ends = events[events["bombAction"] == "defuse"]
+        for start, end in zip(starts.itertuples(), ends.itertuples(), strict=False):
+            p = next(i for i, pl in enumerate(round_.players) if pl.name == start.playerName)
+            defusing |= (
+                (rows["round"] == r_index)
+                & (rows["player"] == p)
+                & (rows["tick"] >= start.tick)
+                & (rows["tick"] <= end.tick)
+            )
+    return {
+        "is_defusing": defusing,
+        "name": np.array([i[0] for i in info], dtype=object),
+        "steamid": np.array([i[1] or 0 for i in info], dtype=np.uint64),
+        "side": np.array([i[2] for i in info], dtype=object),
+        "health": take("hp").astype(np.int32),
+        "armor": take("armor").astype(np.int32),
+        "has_helmet": take("helmet").astype(bool),
+        "has_defuser": take("has_defuser").astype(bool),
+        "has_bomb": take("has_bomb").astype(bool),
+        "is_alive": take("alive").astype(bool),
+        "yaw": take("yaw").astype(np.float32),
+        "weapon": take("weapon").astype(object),
+    }
+
+
+def _event_players(
+    round_: Round, table: str, who: str, sides: dict[str, str], upper: bool
+) -> dict[str, list]:
+    """An event table's columns of one player, awpy style (`who` the ESTA prefix, also awpy's)."""
+    frame = getattr(round_, table)
+    steam = frame[f"{who}SteamID"]
+    columns: dict[str, list] = {
+        f"{who}_name": [None if v is None or v != v else v for v in frame[f"{who}Name"]],
+        f"{who}_steamid": [0 if v is None or v != v else int(v) for v in steam.astype(object)],
+        f"{who}_side": [sides.get(v) if isinstance(v, str) else None for v in frame[f"{who}Side"]],
+    }
+    for axis in "XYZ":
+        columns[f"{who}_{axis if upper else axis.lower()}"] = frame[f"{who}{axis}"].tolist()
+    return columns
+
+
+def _rounds_and_events(match: Match, layout: int) -> dict[str, bytes]:
+    """The rounds, kills, damages and bomb tables of one layout (2 or 3)."""
+    rounds = match.rounds
+    upper = layout == 2
+    side = SIDE2 if layout == 2 else SIDE3
+    tables: dict[str, dict[str, list]] = {"kills": {}, "damages": {}, "bomb": {}}
+    round_rows: dict[str, list] = {}
+    for round_ in rounds:
+        freeze_end = int(round_.clock.zero_tick)
+        plant = round_.bomb_plant_tick
+        site = next((s for s in round_.bombsite if s), "")
+        row2 = {
+            "round_num": round_.round_num,
+            "start": freeze_end - FREEZE_TICKS,
+            "freeze_end": freeze_end,
+            "end": int(round_.end_tick),
+            "official_end": int(round_.end_tick),
+            "winner": SIDE2[round_.winning_side],
+            "reason": REASONS2[round_.end_reason],
+            "bomb_plant": plant,
+            "bomb_site": f"bombsite_{site.lower()}" if site else "not_planted",
+        }
+        row3 = {
+            "round_num": round_.round_num,
+            "start_tick": freeze_end - FREEZE_TICKS,
+            "freeze_end_tick": freeze_end,
+            "end_tick": int(round_.end_tick),
+            "official_end_tick": int(round_.end_tick),
+            "winner": 2 if round_.winning_side == "T" else 3,
+            "winner_side": SIDE3[round_.winning_side],
+            "reason": REASONS3[round_.end_reason],
+            "reason_name": REASON_NAMES3[REASONS3[round_.end_reason]],
+        }
+        for key, value in (row2 if layout == 2 else row3).items():
+            round_rows.setdefault(key, []).append(value)
+        kills, damages, bomb = round_.kills, round_.damages, round_.bomb_events
+        for name, frame in (("kills", kills), ("damages", damages)):
+            table = tables[name]
+            for who in ("attacker", "victim"):
+                for key, column in _event_players(round_, name, who, side, upper).items():
+                    table.setdefault(key, []).extend(column)
+            table.setdefault("tick", []).extend(frame["tick"].astype(int).tolist())
+            table.setdefault("weapon", []).extend(ITEM.get(w, w) for w in frame["weapon"])
+            if layout == 2:
+                table.setdefault("round_num", []).extend([round_.round_num] * len(frame))
+        tables["kills"].setdefault("headshot", []).extend(bool(h) for h in kills["isHeadshot"])
+        groups = [HIT_GROUPS[g] for g in damages["hitGroup"]]
+        if layout == 2:
+            tables["damages"].setdefault("hitgroup", []).extend(groups)
+            tables["damages"].setdefault("dmg_health", []).extend(damages["hpDamage"].astype(int))
+            tables["damages"].setdefault("dmg_health_real", []).extend(
+                damages["hpDamageTaken"].astype(int)
+            )
+            tables["damages"].setdefault("dmg_armor", []).extend(damages["armorDamage"].astype(int))
+        else:
+            tables["damages"].setdefault("hitgroup", []).extend(HIT_GROUP_CODES[g] for g in groups)
+            tables["damages"].setdefault("hitgroup_name", []).extend(groups)
+            tables["damages"].setdefault("dmg_health", []).extend(damages["hpDamage"].astype(int))
+            taken = damages["hpDamageTaken"].astype(int).to_numpy()
+            tables["damages"].setdefault("health_pre", []).extend([100] * len(taken))
+            tables["damages"].setdefault("health_post", []).extend((100 - taken).tolist())
+            tables["damages"].setdefault("dmg_armor", []).extend(damages["armorDamage"].astype(int))
+        events = BOMB2 if layout == 2 else BOMB3
+        for event in bomb.itertuples():
+            if event.bombAction not in events:
+                continue
+            table = tables["bomb"]
+            table.setdefault("tick", []).append(int(event.tick))
+            table.setdefault("event", []).append(events[event.bombAction])
+            table.setdefault("name", []).append(event.playerName)
+            table.setdefault("steamid", []).append(int(event.playerSteamID))
+            for axis in "XYZ":
+                key = axis if upper else axis.lower()
+                table.setdefault(key, []).append(float(getattr(event, f"player{axis}")))
+            site = event.bombSite or ""
+            table.setdefault("bombsite", []).append(
+                (f"Bombsite{site}" if layout == 2 else site) if site else None
+            )
+            if layout == 2:
+                table.setdefault("round_num", []).append(round_.round_num)
+    out = {"rounds": _write({k: pa.array(v) for k, v in round_rows.items()})}
+    for name, columns in tables.items():
+        typed = {}
+        for key, values in columns.items():
+            kind = pa.int32() if key in ("tick", "health_pre", "health_post") else None
+            if key.endswith(("_x", "_y", "_z", "_X", "_Y", "_Z")) or key in "XYZxyz":
+                kind = pa.float32()
+            if key.endswith("steamid"):
+                kind = pa.uint64()
+            typed[key] = pa.array([_plain(v) for v in values], kind)
+        out[name] = _write(typed)
+    return out
+
+
+def _plain(value: object) -> object:
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
+    """The match as `awpy parse --player-props` writes it (a zip of parquet tables)."""
+    rows = tick_rows(match.rounds, every=every)
+    cols = _players_columns(match.rounds, rows)
+    xyz = rows["xyz"]
+    ticks = {
+        "tick": pa.array(rows["tick"], pa.int32()),
+        "steamid": pa.array(cols["steamid"], pa.uint64()),
+        "name": pa.array(cols["name"], pa.large_string()),
+        "round_num": pa.array([match.rounds[r].round_num for r in rows["round"]], pa.uint32()),
+        "X": pa.array(xyz[:, 0], pa.float32()),
+        "Y": pa.array(xyz[:, 1], pa.float32()),
+        "Z": pa.array(xyz[:, 2], pa.float32()),
+        "health": pa.array(cols["health"], pa.int32()),
+        "side": pa.array([SIDE2[s] for s in cols["side"]], pa.large_string()),
+        "armor": pa.array(cols["armor"], pa.int32()),
+        "has_helmet": pa.array(cols["has_helmet"]),
+        "has_defuser": pa.array(cols["has_defuser"]),
+        "is_alive": pa.array(cols["is_alive"]),
+        "yaw": pa.array(cols["yaw"], pa.float32()),
+        "active_weapon_name": pa.array(
+            [DISPLAY.get(w) if w else None for w in cols["weapon"]], pa.large_string()
+        ),
+        "inventory": pa.array(
+            [
+                ([DISPLAY[w]] if w else []) + ["C4 Explosive"] * int(bomb)
+                for w, bomb in zip(cols["weapon"], cols["has_bomb"], strict=True)
+            ],
+            pa.list_(pa.large_string()),
+        ),
+    }
+    tables = {"ticks": _write(ticks), **_rounds_and_events(match, 2)}
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in tables.items():
+            archive.writestr(f"{name}.parquet", data)
+        archive.writestr("header.json", json.dumps({"map_name": match.map_name}))
+    return path
+
+
+def write_awpy3_folder(match: Match, folder: Path, *, every: int = 0) -> Path:
+    """The match as awpy 3's datasets in this project's folder of tables."""
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = tick_rows(match.rounds, every=every)
+    cols = _players_columns(match.rounds, rows)
+    xyz = rows["xyz"]
+    snapshots = {
+        "tick": pa.array(rows["tick"], pa.int32()),
+        "steamid": pa.array(cols["steamid"], pa.uint64()),
+        "name": pa.array(cols["name"], pa.large_string()),
+        "side": pa.array([SIDE3[s] for s in cols["side"]], pa.large_string()),
+        "x": pa.array(xyz[:, 0], pa.float32()),
+        "y": pa.array(xyz[:, 1], pa.float32()),
+        "z": pa.array(xyz[:, 2], pa.float32()),
+        "pitch": pa.array(np.zeros(len(xyz)), pa.float32()),
+        "yaw": pa.array(cols["yaw"], pa.float32()),
+        "health": pa.array(cols["health"], pa.int32()),
+        "armor": pa.array(cols["armor"], pa.int32()),
+        "has_helmet": pa.array(cols["has_helmet"]),
+        "has_defuser": pa.array(cols["has_defuser"]),
+        "has_bomb": pa.array(cols["has_bomb"]),
+        "is_defusing": pa.array(cols["is_defusing"]),
+        "active_weapon": pa.array(
+            [ITEM.get(w) if w else None for w in cols["weapon"]], pa.large_string()
+        ),
+    }
+    (folder / "snapshots.parquet").write_bytes(_write(snapshots))
+    for name, data in _rounds_and_events(match, 3).items():
+        (folder / f"{name}.parquet").write_bytes(data)
+    header = {"map_name": match.map_name, "playback_ticks": match.tick_rate * 100}
+    header["playback_time"] = 100.0
+    (folder / "header.json").write_text(json.dumps(header))
+    return folder

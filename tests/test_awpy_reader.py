@@ -1,0 +1,394 @@
+"""CS2 rounds from awpy's tables (decoy_cli/esta/awpy/): the real rounds of ../shared/data in both
+layouts read as their ESTA-shaped file, the project's synthetic sample written in both layouts
+and read back with what the real rounds lack, the names, the rate, and bad input."""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import zipfile
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+from awpy_fixtures import write_awpy2_zip, write_awpy3_folder
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.errors import EstaError
+from decoy_cli.esta import Match, Round, read_match
+from decoy_cli.esta.awpy.names import bomb_action, end_reason, hit_group, side_name, weapon_name
+from decoy_cli.replay.missing import fill_missing, lacking
+from decoy_cli.sim.rules import RulesConfig
+from decoy_cli.sim.sites import SiteZones
+from decoy_cli.waypoints.build import builtin_graph
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared" / "data"
+SAMPLE = ROOT / "examples" / "sample" / "synthetic-dust2-seed0.json.xz"
+STEMS = ("spirit-vs-falcons-m2-dust2-r01-12", "spirit-vs-falcons-m2-dust2-8hz-r02")
+needs_data = pytest.mark.skipif(
+    not (SHARED / "cs2_dust2_awpy").is_dir(),
+    reason="../shared/data/cs2_dust2_awpy is absent (the real CS2 rounds in awpy's layouts)",
+)
+FLOAT32_M = 2e-3 * 0.01905
+"""Most a float32 Hammer coordinate of de_dust2 (|x| < 4,096 u) lies from a decimal, in metres."""
+
+
+def _forms(stem: str) -> tuple[Match, Match, Match]:
+    return (
+        read_match(SHARED / "cs2_dust2_both" / f"{stem}.json.xz"),
+        read_match(SHARED / "cs2_dust2_awpy" / "awpy2" / f"{stem}.zip"),
+        read_match(SHARED / "cs2_dust2_awpy" / "awpy3" / stem),
+    )
+
+
+EXACT_FIELDS = ("frame_ticks", "frame_seconds", "hp", "alive", "present", "bomb_planted")
+EVENT_COLUMNS = {
+    "kills": [
+        "tick", "seconds", "attackerName", "attackerSide", "attackerX", "attackerY", "victimName",
+        "victimSide", "victimX", "victimY", "weapon", "isHeadshot", "isSuicide", "isTeamkill",
+    ],
+    "bomb_events": ["tick", "seconds", "bombAction", "bombSite", "playerName"],
+}  # fmt: skip
+
+
+def _assert_same_round(esta: Round, other: Round) -> None:
+    for name in EXACT_FIELDS:
+        np.testing.assert_array_equal(getattr(esta, name), getattr(other, name), err_msg=name)
+    np.testing.assert_allclose(other.position, esta.position, atol=FLOAT32_M, rtol=0)
+    np.testing.assert_array_equal(np.isnan(esta.yaw), np.isnan(other.yaw))
+    np.testing.assert_allclose(other.yaw, esta.yaw, atol=1e-3, equal_nan=True)
+    np.testing.assert_array_equal(esta.bombsite, other.bombsite)
+    assert esta.players == other.players
+    for table, columns in EVENT_COLUMNS.items():
+        pd.testing.assert_frame_equal(
+            getattr(esta, table)[columns].reset_index(drop=True),
+            getattr(other, table)[columns].reset_index(drop=True),
+            check_dtype=False,
+        )
+    for name in ("winning_side", "end_reason", "bomb_plant_tick", "start_tick", "end_tick"):
+        assert getattr(esta, name) == getattr(other, name), name
+    assert esta.clock == other.clock
+
+
+@needs_data
+@pytest.mark.parametrize("stem", STEMS)
+def test_real_cs2_rounds_read_from_both_awpy_layouts_as_from_the_esta_shaped_file(
+    stem: str,
+) -> None:
+    esta, awpy2, awpy3 = _forms(stem)
+    assert esta.round_numbers == awpy2.round_numbers == awpy3.round_numbers
+    assert not awpy2.round_errors and not awpy3.round_errors
+    for round_esta, round_2, round_3 in zip(esta.rounds, awpy2.rounds, awpy3.rounds, strict=True):
+        _assert_same_round(round_esta, round_2)
+        _assert_same_round(round_esta, round_3)
+        assert (round_2.source, round_3.source) == ("awpy 2", "awpy 3")
+
+
+@needs_data
+def test_what_the_real_tables_do_not_record_is_named_and_held_absent() -> None:
+    _, awpy2, awpy3 = _forms(STEMS[0])
+    for match in (awpy2, awpy3):
+        first = match.rounds[0]  # round 1 has a plant and nobody holds the bomb
+        assert {"weapon in hand", "armour, helmet and kit", "steamids", "bomb carrier"} <= set(
+            first.not_recorded
+        )
+        assert (first.armor == -1).all() and (first.weapon == "").all()
+        # awpy 3's stand-in yaw 0.0 in every row is no view: the 1 Hz file records none
+        assert np.isnan(first.yaw).all()
+        assert {"weapon", "armour", "bomb carrier"} <= set(lacking(first))
+    assert "tick rate 64" not in awpy2.meta["tick_rate_rule"]  # it says which rule decided
+
+
+@needs_data
+def test_real_8hz_round_keeps_its_yaw_and_own_rate() -> None:
+    esta, awpy2, awpy3 = _forms(STEMS[1])
+    for match in (awpy2, awpy3):
+        round_ = match.round(2)
+        assert "view angles" not in round_.not_recorded
+        assert np.median(np.diff(round_.frame_ticks)) == 8  # sampled at 8 Hz: read as it is
+        assert round_.num_frames == esta.round(2).num_frames
+
+
+def _sample() -> Match:
+    return read_match(SAMPLE)
+
+
+def test_the_sample_round_trips_through_both_layouts_with_what_the_real_rounds_lack(
+    tmp_path: Path,
+) -> None:
+    sample = _sample()
+    for match in (
+        read_match(write_awpy2_zip(sample, tmp_path / "sample.zip")),
+        read_match(write_awpy3_folder(sample, tmp_path / "sample")),
+    ):
+        assert match.tick_rate == 128 and match.map_name == "de_dust2"
+        for esta, other in zip(sample.rounds, match.rounds, strict=True):
+            for name in ("weapon", "armor", "helmet", "has_defuser", "has_bomb", "hp", "alive"):
+                np.testing.assert_array_equal(getattr(esta, name), getattr(other, name), name)
+            np.testing.assert_allclose(other.position, esta.position, atol=FLOAT32_M, rtol=0)
+            turn = (other.yaw - esta.yaw + 180.0) % 360.0 - 180.0
+            assert np.nanmax(np.abs(turn)) < 1e-3
+            assert [p.steam_id for p in other.players] == [p.steam_id for p in esta.players]
+            kills = ["tick", "attackerName", "victimName", "weapon", "isHeadshot"]
+            pd.testing.assert_frame_equal(esta.kills[kills], other.kills[kills], check_dtype=False)
+            damages = ["tick", "weapon", "hpDamage", "hpDamageTaken", "hitGroup", "armorDamage"]
+            pd.testing.assert_frame_equal(
+                esta.damages[damages], other.damages[damages], check_dtype=False
+            )
+            assert other.not_recorded == ("vertical speed",)
+            assert "weapon" not in lacking(other) and "armour" not in lacking(other)
+
+
+def test_awpy2_reads_the_carrier_from_the_inventory_and_the_rate_from_the_bomb_timer(
+    tmp_path: Path,
+) -> None:
+    match = read_match(write_awpy2_zip(_sample(), tmp_path / "sample.zip"))
+    assert match.tick_rate == 128
+    assert "40 s" in match.meta["tick_rate_rule"]
+    assert all(r.has_bomb.any() for r in match.rounds)
+
+
+def test_awpy3_takes_the_defuse_start_from_is_defusing_and_awpy2_infers_it(
+    tmp_path: Path,
+) -> None:
+    sample = _sample()
+    esta = sample.round(1).bomb_events
+    real_start = int(esta.loc[esta["bombAction"] == "defuse_start", "tick"].iloc[0])
+    awpy3 = read_match(write_awpy3_folder(sample, tmp_path / "sample")).round(1)
+    starts = awpy3.bomb_events.loc[awpy3.bomb_events["bombAction"] == "defuse_start", "tick"]
+    assert 0 <= int(starts.iloc[0]) - real_start < 64  # the first frame showing the defuse
+    assert "defuse start" not in lacking(awpy3)
+
+    awpy2 = read_match(write_awpy2_zip(sample, tmp_path / "sample.zip")).round(1)
+    assert "defuse start" in lacking(awpy2)  # awpy 2 writes no begin-defuse row
+    graph = builtin_graph("de_dust2")
+    filled = fill_missing(awpy2, SiteZones.from_graph(graph), RulesConfig(), "infer")
+    events = filled.round.bomb_events
+    start = events.loc[events["bombAction"] == "defuse_start", "tick"].iloc[0]
+    defuse = events.loc[events["bombAction"] == "defuse", "tick"].iloc[0]
+    assert defuse - start == RulesConfig().defuse_s * 128  # CT-2 holds no kit
+    assert start == real_start  # the sample's defuser took the rules' 10 s
+    assert any(note.startswith("defuse start (CT-2)") for note in filled.notes)
+
+
+def test_full_rate_ticks_are_sampled_on_a_grid_from_freeze_end(tmp_path: Path) -> None:
+    sample = _sample()
+    two = replace(sample, rounds=sample.rounds[:2])
+    path = write_awpy3_folder(two, tmp_path / "full", every=1)
+    for rate, step in ((8.0, 16), (2.0, 64)):
+        match = read_match(path, rate=rate)
+        for esta, round_ in zip(two.rounds, match.rounds, strict=True):
+            assert (np.diff(round_.frame_ticks) == step).all()
+            assert round_.frame_ticks[0] == esta.clock.zero_tick
+    # at the sample's own 2 Hz the frames are the sample's, positions as written
+    match = read_match(path, rate=2.0)
+    for esta, round_ in zip(two.rounds, match.rounds, strict=True):
+        np.testing.assert_array_equal(esta.frame_ticks, round_.frame_ticks)
+        np.testing.assert_allclose(round_.position, esta.position, atol=FLOAT32_M, rtol=0)
+
+
+@pytest.mark.parametrize(
+    ("raw", "spelling", "esta"),
+    [
+        ("m4a1", "item", "M4A4"),
+        ("m4a1_silencer", "item", "M4A1"),
+        ("weapon_m4a1_silencer", "item", "M4A1"),
+        ("M4A1-S", "display", "M4A1"),
+        ("M4A4", "display", "M4A4"),
+        ("usp_silencer", "item", "USP-S"),
+        ("hkp2000", "item", "P2000"),
+        ("USP-S", "display", "USP-S"),
+        ("P2000", "display", "P2000"),
+        ("deagle", "item", "Desert Eagle"),
+        ("revolver", "item", "R8 Revolver"),
+        ("R8 Revolver", "display", "R8 Revolver"),
+        ("CZ75-Auto", "display", "CZ75 Auto"),
+        ("cz75a", "item", "CZ75 Auto"),
+        ("knife_karambit", "item", "Knife"),
+        ("Butterfly Knife", "display", "Knife"),
+        ("C4 Explosive", "display", "C4"),
+        ("planted_c4", "item", "C4"),
+        ("inferno", "item", "Incendiary Grenade"),
+        ("taser", "item", "Zeus x27"),
+        ("world", "item", "World"),
+        (None, "item", ""),
+        ("laser_rifle", "item", None),
+        ("m4a1_silencer", "display", None),  # an item name where display names are due
+    ],
+)
+def test_weapon_names_across_the_sources(raw: object, spelling: str, esta: str | None) -> None:
+    assert weapon_name(raw, spelling) == esta  # type: ignore[arg-type]
+
+
+def test_other_names_across_the_sources() -> None:
+    assert [side_name(s) for s in ("t", "ct", "terrorist", "counter-terrorist", 2, 3, "spec")] == [
+        "T", "CT", "T", "CT", "T", "CT", None,
+    ]  # fmt: skip
+    assert [hit_group(h) for h in ("head", "left_arm", 1, 8, "invalid", -1, "elbow")] == [
+        "Head", "LeftArm", "Head", "Neck", "", "", None,
+    ]  # fmt: skip
+    assert [end_reason(r) for r in ("t_killed", "ct_win", 9, "bomb_exploded", 1, "x")] == [
+        "CTWin", "CTWin", "TerroristsWin", "TargetBombed", "TargetBombed", None,
+    ]  # fmt: skip
+    assert [bomb_action(e) for e in ("detonate", "finish_plant", "start_plant", "pickup")] == [
+        "explode", "plant", "plant_begin", None,
+    ]  # fmt: skip
+
+
+# --- bad input: one error line, or the round's named failure or warning -------------------------
+
+
+def _edit_table(folder: Path, name: str, edit) -> None:  # type: ignore[no-untyped-def]
+    path = folder / f"{name}.parquet"
+    pq.write_table(edit(pq.read_table(path)), path)
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    sample = _sample()
+    return write_awpy3_folder(replace(sample, rounds=sample.rounds[:2]), tmp_path / "m")
+
+
+def test_a_missing_table_is_named(folder: Path) -> None:
+    (folder / "kills.parquet").unlink()
+    with pytest.raises(EstaError, match="no kills table"):
+        read_match(folder)
+
+
+def test_a_zip_without_a_table_or_header_is_named(tmp_path: Path) -> None:
+    path = write_awpy2_zip(_sample(), tmp_path / "m.zip")
+    with zipfile.ZipFile(path) as archive:
+        kept = {n: archive.read(n) for n in archive.namelist() if n != "ticks.parquet"}
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, data in kept.items():
+            archive.writestr(name, data)
+    with pytest.raises(EstaError, match="no ticks table"):
+        read_match(path)
+    (tmp_path / "bad.zip").write_bytes(b"PK\x03\x04 not a zip")
+    with pytest.raises(EstaError, match="not a readable zip"):
+        read_match(tmp_path / "bad.zip")
+
+
+def test_a_column_of_the_wrong_type_is_named(folder: Path) -> None:
+    def text_x(table: pa.Table) -> pa.Table:
+        index = table.schema.get_field_index("x")
+        return table.set_column(index, "x", pa.array([str(v) for v in table["x"].to_pylist()]))
+
+    _edit_table(folder, "snapshots", text_x)
+    with pytest.raises(EstaError, match="snapshots: column x holds"):
+        read_match(folder)
+
+
+def test_a_table_that_is_not_parquet_is_named(folder: Path) -> None:
+    (folder / "rounds.parquet").write_bytes(b"PAR1 garbage")
+    with pytest.raises(EstaError, match="rounds: not a readable parquet table"):
+        read_match(folder)
+
+
+def test_ticks_of_another_demo_are_refused(folder: Path) -> None:
+    _edit_table(
+        folder,
+        "snapshots",
+        lambda t: t.set_column(0, "tick", pa.compute.add(t["tick"], pa.scalar(10**7, pa.int32()))),
+    )
+    with pytest.raises(EstaError, match="falls in a round of its rounds table"):
+        read_match(folder)
+
+
+def test_a_player_twice_at_one_tick_fails_the_round_and_unsorted_ticks_warn(
+    folder: Path,
+) -> None:
+    table = pq.read_table(folder / "snapshots.parquet")
+    pq.write_table(pa.concat_tables([table, table.slice(0, 1)]), folder / "snapshots.parquet")
+    match = read_match(folder)
+    assert "appears twice" in str(match.round_errors[1])
+    pq.write_table(table.take(np.arange(table.num_rows)[::-1]), folder / "snapshots.parquet")
+    match = read_match(folder)
+    assert not match.round_errors
+    assert any("not in tick order" in w for w in match.round(1).warnings)
+
+
+def test_a_multipart_demo_is_refused_and_a_128_tick_header_is_taken(folder: Path) -> None:
+    header = json.loads((folder / "header.json").read_text())
+    assert read_match(folder).tick_rate == 128  # playback_ticks / playback_time
+    (folder / "header.json").write_text(json.dumps({**header, "playback_ticks": 3333}))
+    with pytest.raises(EstaError, match=r"a tick rate of 33\.33"):
+        read_match(folder)
+    (folder / "header.json").write_text(json.dumps(header))
+    _edit_table(
+        folder, "snapshots", lambda t: t.append_column("part", pa.array(np.arange(len(t)) % 2))
+    )
+    with pytest.raises(EstaError, match="multipart demo"):
+        read_match(folder)
+
+
+def test_an_unknown_weapon_is_a_named_warning(folder: Path) -> None:
+    def rename(table: pa.Table) -> pa.Table:
+        index = table.schema.get_field_index("active_weapon")
+        weapons = ["laser_rifle" if w == "glock" else w for w in table["active_weapon"].to_pylist()]
+        return table.set_column(index, "active_weapon", pa.array(weapons, pa.large_string()))
+
+    _edit_table(folder, "snapshots", rename)
+    warnings = read_match(folder).round(1).warnings
+    assert any("unknown weapon in hand 'laser_rifle'" in w for w in warnings)
+
+
+def test_a_header_that_is_not_a_json_object_is_named(folder: Path) -> None:
+    (folder / "header.json").write_text("[1, 2]")
+    with pytest.raises(EstaError, match="not a JSON object"):
+        read_match(folder)
+
+
+def test_a_demo_without_awpy3_installed_says_how_to_read_it(tmp_path: Path) -> None:
+    try:
+        import awpy  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        pytest.skip("awpy 3 is installed: the demo path is tested with DECOY_TEST_DEMO")
+    (tmp_path / "match.dem").write_bytes(b"PBDEMS2\x00")
+    with pytest.raises(EstaError, match=r"needs awpy 3 \(pip install 'decoy\[cs2\]'\)"):
+        read_match(tmp_path / "match.dem")
+
+
+@pytest.mark.skipif(
+    not os.environ.get("DECOY_TEST_DEMO"),
+    reason="DECOY_TEST_DEMO names no CS2 demo (.dem) to read through awpy 3",
+)
+def test_a_real_demo_reads_through_awpy3() -> None:
+    match = read_match(os.environ["DECOY_TEST_DEMO"])
+    assert match.rounds and match.map_name
+    assert all(r.num_frames and r.players for r in match.rounds)
+
+
+@needs_data
+def test_info_lists_what_awpy_tables_record_and_not() -> None:
+    result = CliRunner().invoke(
+        app, ["info", str(SHARED / "cs2_dust2_awpy" / "awpy2" / f"{STEMS[0]}.zip")]
+    )
+    assert result.exit_code == 0, result.output
+    assert "(awpy 2)" in result.output and "not recorded:" in result.output
+    assert "weapon in hand" in result.output
+
+
+def test_zip_members_are_read_by_name_whatever_their_column_order(tmp_path: Path) -> None:
+    path = write_awpy2_zip(_sample(), tmp_path / "m.zip")
+    with zipfile.ZipFile(path) as archive:
+        members = {n: archive.read(n) for n in archive.namelist()}
+    ticks = pq.read_table(io.BytesIO(members["ticks.parquet"]))
+    reordered = ticks.select(list(reversed(ticks.column_names)))
+    sink = pa.BufferOutputStream()
+    pq.write_table(reordered, sink)
+    members["ticks.parquet"] = sink.getvalue().to_pybytes()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    again = read_match(path)
+    np.testing.assert_array_equal(again.round(1).hp, _sample().round(1).hp)
