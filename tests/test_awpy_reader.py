@@ -16,13 +16,13 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-from awpy_fixtures import write_awpy2_zip, write_awpy3_folder
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, read_match
 from decoy_cli.esta.awpy.names import bomb_action, end_reason, hit_group, side_name, weapon_name
+from decoy_cli.esta.awpy.writer import write_awpy2_zip, write_awpy3_folder
 from decoy_cli.replay.missing import fill_missing, lacking
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.sites import SiteZones

@@ -21,19 +21,18 @@ as ESTA's tables with its names (decoy_cli/esta/awpy/names.py).
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError
+from decoy_cli.esta.awpy.events import is_null, round_events, row_keys
 from decoy_cli.esta.awpy.names import (
     Spelling,
-    bomb_action,
     bomb_site,
     end_reason,
-    hit_group,
     side_name,
     weapon_name,
 )
@@ -41,7 +40,6 @@ from decoy_cli.esta.events import build_table
 from decoy_cli.esta.frames import (
     MAX_FRAMES,
     FrameArrays,
-    PlayerInfo,
     PlayerRows,
     RoundClock,
     player_arrays,
@@ -53,10 +51,7 @@ from decoy_cli.esta.schema import (
     DAMAGE_COLUMNS,
     FLASH_COLUMNS,
     KILL_COLUMNS,
-    BombEvent,
-    DamageEvent,
     Invalid,
-    KillEvent,
 )
 from decoy_cli.files import JsonObject
 
@@ -123,7 +118,7 @@ def read_tables_match(tables: AwpyTables, *, implausible: Implausible) -> Match:
             rows = ticks[owner == index]
             built = _build_round(tables, window, tables.frames[index], rows, implausible)
             lacking = (*not_recorded, *_carrier(rows, window))
-            rounds.append(_with(built, not_recorded=lacking))
+            rounds.append(replace(built, not_recorded=lacking))
         except Invalid as problem:
             errors[window.num] = EstaError(f"{tables.path}: round {window.num}: {problem}")
     return Match(
@@ -135,12 +130,6 @@ def read_tables_match(tables: AwpyTables, *, implausible: Implausible) -> Match:
         rounds=rounds,
         round_errors=dict(sorted(errors.items())),
     )
-
-
-def _with(round_: Round, **changes: object) -> Round:
-    from dataclasses import replace
-
-    return replace(round_, **changes)  # type: ignore[arg-type]
 
 
 def _not_recorded(ticks: pd.DataFrame) -> tuple[str, ...]:
@@ -180,10 +169,10 @@ def round_windows(path: Path, table: pd.DataFrame) -> list[RoundWindow]:
                 start=int(row["start"]),
                 freeze_end=int(row["freeze_end"]),
                 end=int(row["end"]),
-                official_end=int(row["end"]) if _is_null(official) else int(official),
+                official_end=int(row["end"]) if is_null(official) else int(official),
                 winner=row["winner"],
                 reason=row["reason"],
-                plant_tick=None if _is_null(plant) else int(plant),
+                plant_tick=None if is_null(plant) else int(plant),
                 plant_site=bomb_site(row.get("bomb_site")),
             )
         )
@@ -275,8 +264,14 @@ def _build_round(
         bombsite=np.array([window.plant_site if p else "" for p in planted], dtype=str),
     )
     warnings.extend(check_frames(frames, implausible))
-    events = _events(tables, window, warnings)
-    events["bomb"] = _defuse_starts(events["bomb"], rows, infos)
+    events = round_events(
+        _in_window(tables.kills, window),
+        _in_window(tables.damages, window),
+        _in_window(tables.bomb, window),
+        rows,
+        window.plant_site,
+        warnings,
+    )
     return Round(
         match_id=tables.match_id,
         path=tables.path,
@@ -332,7 +327,7 @@ def _player_rows(
         return rows[column].to_numpy(dtype=object, na_value=False).astype(bool)
 
     names = rows["name"].to_numpy(dtype=object, na_value="")
-    keys, steam = _row_keys(rows)
+    keys, steam = row_keys(rows)
     sides = rows["side"].to_numpy(dtype=object, na_value=None)
     side = np.array([side_name(s) or "" for s in sides], dtype=object)
     if (side == "").any():
@@ -360,20 +355,6 @@ def _player_rows(
     )
 
 
-def _row_keys(rows: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
-    """Each tick row's player key (the steamid as text, else the name) and steamid (None where
-    null or 0, a bot)."""
-    names = rows["name"].to_numpy(dtype=object, na_value="")
-    raw = (
-        rows["steamid"].to_numpy(dtype=object, na_value=None)
-        if "steamid" in rows
-        else np.full(len(rows), None, dtype=object)
-    )
-    steam = np.array([_steam_id(s) for s in raw], dtype=object)
-    keys = np.array([n if s is None else str(s) for n, s in zip(names, steam, strict=True)], object)
-    return keys, steam
-
-
 def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.ndarray:
     """ESTA's name of each row's weapon in hand; an unknown one is "" and a named warning."""
     if "weapon" not in rows:
@@ -389,182 +370,8 @@ def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.
     return np.array(mapped, dtype=object)[codes]
 
 
-def _events(tables: AwpyTables, window: RoundWindow, warnings: list[str]) -> dict[str, list]:
-    """The round's kills, damages and bomb events as ESTA event structs."""
-    kills = [_kill(row, warnings) for row in _records(_in_window(tables.kills, window))]
-    damages = [_damage(row, warnings) for row in _records(_in_window(tables.damages, window))]
-    bomb = [_bomb_event(row, window) for row in _records(_in_window(tables.bomb, window))]
-    return {
-        "kills": [KillEvent(**row) for row in kills],
-        "damages": [DamageEvent(**row) for row in damages],
-        "bomb": [BombEvent(**row) for row in bomb if row is not None],
-    }
-
-
-def _defuse_starts(bomb: list, rows: pd.DataFrame, players: list[PlayerInfo]) -> list:
-    """The bomb events with a `defuse_start` before each `defuse` that has none, where the
-    defuser's ticks show him defusing (awpy 3's `is_defusing`, awpy 2's with the prop): the
-    first tick of the run of defusing ticks that ends in the defuse. awpy writes no event for
-    the start of a defuse."""
-    if "is_defusing" not in rows or not len(bomb):
-        return bomb
-    out = list(bomb)
-    for event in bomb:
-        if event.bombAction != "defuse" or any(
-            e.bombAction == "defuse_start" and e.tick <= event.tick for e in bomb
-        ):
-            continue
-        key = str(event.playerSteamID) if event.playerSteamID else event.playerName
-        keys, _ = _row_keys(rows)
-        mine = rows[(keys == key) & (rows["tick"].to_numpy(np.int64) <= event.tick)]
-        mine = mine.sort_values("tick", kind="stable")
-        defusing = mine["is_defusing"].to_numpy(dtype=object, na_value=False).astype(bool)
-        if not defusing.size or not defusing[-1]:
-            continue
-        stops = np.flatnonzero(~defusing)
-        first = stops[-1] + 1 if stops.size else 0
-        start = int(mine["tick"].iloc[first])
-        out.append(
-            BombEvent(**{**_struct_fields(event), "tick": start, "bombAction": "defuse_start"})
-        )
-    return sorted(out, key=lambda e: e.tick)
-
-
-def _struct_fields(event: object) -> dict[str, object]:
-    return {name: getattr(event, name) for name in event.__struct_fields__}  # type: ignore[attr-defined]
-
-
 def _in_window(table: pd.DataFrame, window: RoundWindow) -> pd.DataFrame:
     """The rows of an event table in the round (module docstring), in tick order."""
     ticks = table["tick"].to_numpy(dtype=np.int64)
     inside = (ticks >= window.start) & (ticks <= window.official_end)
     return table[inside].sort_values("tick", kind="stable")
-
-
-def _records(table: pd.DataFrame) -> list[dict[str, object]]:
-    """Rows as dicts with None for every null."""
-    return [
-        {k: (None if _is_null(v) else v) for k, v in row.items()}
-        for row in table.to_dict("records")
-    ]
-
-
-def _is_null(value: object) -> bool:
-    return value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value))
-
-
-def _player(row: dict[str, object], who: str, esta: str) -> dict[str, object]:
-    """One player's columns of an event as ESTA names them (`esta` is the ESTA prefix)."""
-    side = row.get(f"{who}_side")
-    return {
-        f"{esta}SteamID": _steam_id(row.get(f"{who}_steamid")),
-        f"{esta}Name": row.get(f"{who}_name"),
-        f"{esta}Side": None if side is None else side_name(side),
-        f"{esta}X": row.get(f"{who}_x"),
-        f"{esta}Y": row.get(f"{who}_y"),
-        f"{esta}Z": row.get(f"{who}_z"),
-        f"{esta}ViewX": _yaw(row.get(f"{who}_yaw")),
-        f"{esta}ViewY": row.get(f"{who}_pitch"),
-    }
-
-
-def _steam_id(value: object) -> int | None:
-    """A steamid as an int; null or 0 (a bot) is None."""
-    if _is_null(value) or value == 0:
-        return None
-    return int(value)  # type: ignore[call-overload]
-
-
-def _yaw(value: object) -> float | None:
-    return None if value is None else float(value) % 360.0  # type: ignore[arg-type]
-
-
-def _event_weapon(row: dict[str, object], warnings: list[str]) -> str | None:
-    """ESTA's name of an event's weapon; an unknown one is None and a named warning."""
-    raw = row.get("weapon")
-    name = weapon_name(raw, "item")
-    if name is None:
-        warnings.append(f"unknown weapon {raw!r} at tick {row['tick']}: kept unnamed")
-    return name or None
-
-
-def _event_hit_group(row: dict[str, object], warnings: list[str]) -> str | None:
-    raw = row.get("hitgroup")
-    group = hit_group(raw)
-    if group is None:
-        warnings.append(f"unknown hit group {raw!r} at tick {row['tick']}: kept unnamed")
-    return group or None
-
-
-def _kill(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
-    attacker = _player(row, "attacker", "attacker")
-    victim = _player(row, "victim", "victim")
-    assister = _player(row, "assister", "assister")
-    penetrated = row.get("penetrated")
-    return {
-        "tick": row["tick"],
-        **attacker,
-        **victim,
-        "assisterSteamID": assister["assisterSteamID"],
-        "assisterName": assister["assisterName"],
-        "assisterSide": assister["assisterSide"],
-        "weapon": _event_weapon(row, warnings),
-        "isHeadshot": row.get("headshot"),
-        "isSuicide": attacker["attackerName"] == victim["victimName"],
-        "isTeamkill": attacker["attackerSide"] == victim["victimSide"],
-        "thruSmoke": row.get("thrusmoke"),
-        "noScope": row.get("noscope"),
-        "isWallbang": None if penetrated is None else bool(penetrated),
-        "penetratedObjects": penetrated,
-        "attackerBlinded": row.get("attackerblind"),
-        "distance": row.get("distance"),
-    }
-
-
-def _damage(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
-    attacker = _player(row, "attacker", "attacker")
-    victim = _player(row, "victim", "victim")
-    return {
-        "tick": row["tick"],
-        **attacker,
-        **victim,
-        "weapon": _event_weapon(row, warnings) or "World",
-        "hpDamage": row.get("dmg_health"),
-        "hpDamageTaken": row.get("dmg_health_taken"),
-        "armorDamage": row.get("dmg_armor"),
-        "armorDamageTaken": row.get("dmg_armor_taken"),
-        "hitGroup": _event_hit_group(row, warnings),
-        "isFriendlyFire": attacker["attackerSide"] is not None
-        and attacker["attackerSide"] == victim["victimSide"],
-        "distance": _distance(row),
-    }
-
-
-def _distance(row: dict[str, object]) -> float | None:
-    """awpy's distance where given, else the attacker-victim distance in Hammer units."""
-    if row.get("distance") is not None:
-        return float(row["distance"])  # type: ignore[arg-type]
-    ends = [row.get(f"{who}_{axis}") for who in ("attacker", "victim") for axis in "xyz"]
-    if any(value is None for value in ends):
-        return None
-    a, b = np.array(ends[:3], dtype=np.float64), np.array(ends[3:], dtype=np.float64)
-    return float(np.linalg.norm(a - b))
-
-
-def _bomb_event(row: dict[str, object], window: RoundWindow) -> dict[str, object] | None:
-    """A bomb event as ESTA writes it (the plant's site is the round's where the row names a
-    place, as awpy 2 does); None for the events ESTA has no name for (drop, pick-up)."""
-    action = bomb_action(row.get("event"))
-    if action is None:
-        return None
-    site = bomb_site(row.get("site")) or (window.plant_site if action == "plant" else "")
-    return {
-        "tick": row["tick"],
-        "playerSteamID": _steam_id(row.get("steamid")),
-        "playerName": row.get("name"),
-        "playerX": row.get("x"),
-        "playerY": row.get("y"),
-        "playerZ": row.get("z"),
-        "bombAction": action,
-        "bombSite": site or None,
-    }

@@ -1,11 +1,12 @@
-"""awpy 2 zips and awpy 3 table folders written by the tests, in awpy's own column names and
-types (parquet through pyarrow), from rounds the project generated (the synthetic sample) or
-made up here: what the real CS2 rounds in ../shared/data lack (weapons, armour, a carrier,
-steamids, bomb events with players, damages, full-rate ticks).
+"""Write a match in awpy's layouts, an awpy 2 zip or a folder of awpy 3 tables, with awpy's
+column names and types (parquet through pyarrow): CS2 tables of rounds the project has (the
+synthetic sample) with what the real CS2 rounds lack (weapons, armour, the carrier, steamids,
+bomb events with players, damages, full-rate ticks), for the tests and the reader's benchmark.
 
-Names are awpy's (decoy_cli/esta/awpy/names.py lists them): awpy 2 ticks spell weapons as
-demoparser2 shows them ("M4A1-S"), events and awpy 3 snapshots as the game's items
-("m4a1_silencer"). Sides `t`/`ct` (awpy 2), `terrorist`/`counter-terrorist` (awpy 3).
+Names are awpy's (decoy_cli/esta/awpy/names.py): awpy 2 ticks spell weapons as demoparser2
+shows them ("M4A1-S"), events and awpy 3 snapshots as the game's items ("m4a1_silencer"). Each
+round's start lies 15 s of freeze time before its freeze end. `every` ticks between rows
+interpolates positions between frames (full-rate tables); the other columns hold the frame's.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.esta import Match, Round
 from decoy_cli.esta.awpy.names import WEAPON_SPELLINGS
+from decoy_cli.esta.reader import Match, Round
 
 DISPLAY = {esta: shown[0] for esta, (shown, _) in WEAPON_SPELLINGS.items() if shown}
 ITEM = {esta: items[0] for esta, (_, items) in WEAPON_SPELLINGS.items() if items}
@@ -60,7 +61,7 @@ def _write(table: dict[str, pa.Array]) -> bytes:
     return sink.getvalue().to_pybytes()
 
 
-def tick_rows(rounds: list[Round], *, every: int = 0) -> dict[str, np.ndarray]:
+def _tick_rows(rounds: list[Round], *, every: int = 0) -> dict[str, np.ndarray]:
     """One row per player present per kept tick (each frame's, or with `every` one every
     `every` ticks between frames, positions interpolated): the long form both layouts share."""
     out: dict[str, list[np.ndarray]] = {k: [] for k in ("tick", "player", "round", "frame")}
@@ -154,6 +155,44 @@ def _event_players(
     return columns
 
 
+def _round_row(round_: Round, layout: int) -> dict[str, object]:
+    """The round's row of awpy's rounds table; a round without a clock, an end, a winner or an
+    end reason awpy would know cannot have one (ValueError)."""
+    clock, end, winner, reason = (
+        round_.clock,
+        round_.end_tick,
+        round_.winning_side,
+        round_.end_reason,
+    )
+    if clock is None or end is None or winner is None or reason not in REASONS2:
+        raise ValueError(f"round {round_.round_num}: no clock, end, winner or known end reason")
+    freeze_end = int(clock.zero_tick)
+    if layout == 2:
+        site = next((str(s) for s in round_.bombsite if s), "")
+        return {
+            "round_num": round_.round_num,
+            "start": freeze_end - FREEZE_TICKS,
+            "freeze_end": freeze_end,
+            "end": end,
+            "official_end": end,
+            "winner": SIDE2[winner],
+            "reason": REASONS2[reason],
+            "bomb_plant": round_.bomb_plant_tick,
+            "bomb_site": f"bombsite_{site.lower()}" if site else "not_planted",
+        }
+    return {
+        "round_num": round_.round_num,
+        "start_tick": freeze_end - FREEZE_TICKS,
+        "freeze_end_tick": freeze_end,
+        "end_tick": end,
+        "official_end_tick": end,
+        "winner": 2 if winner == "T" else 3,
+        "winner_side": SIDE3[winner],
+        "reason": REASONS3[reason],
+        "reason_name": REASON_NAMES3[REASONS3[reason]],
+    }
+
+
 def _rounds_and_events(match: Match, layout: int) -> dict[str, bytes]:
     """The rounds, kills, damages and bomb tables of one layout (2 or 3)."""
     rounds = match.rounds
@@ -162,32 +201,8 @@ def _rounds_and_events(match: Match, layout: int) -> dict[str, bytes]:
     tables: dict[str, dict[str, list]] = {"kills": {}, "damages": {}, "bomb": {}}
     round_rows: dict[str, list] = {}
     for round_ in rounds:
-        freeze_end = int(round_.clock.zero_tick)
-        plant = round_.bomb_plant_tick
-        site = next((s for s in round_.bombsite if s), "")
-        row2 = {
-            "round_num": round_.round_num,
-            "start": freeze_end - FREEZE_TICKS,
-            "freeze_end": freeze_end,
-            "end": int(round_.end_tick),
-            "official_end": int(round_.end_tick),
-            "winner": SIDE2[round_.winning_side],
-            "reason": REASONS2[round_.end_reason],
-            "bomb_plant": plant,
-            "bomb_site": f"bombsite_{site.lower()}" if site else "not_planted",
-        }
-        row3 = {
-            "round_num": round_.round_num,
-            "start_tick": freeze_end - FREEZE_TICKS,
-            "freeze_end_tick": freeze_end,
-            "end_tick": int(round_.end_tick),
-            "official_end_tick": int(round_.end_tick),
-            "winner": 2 if round_.winning_side == "T" else 3,
-            "winner_side": SIDE3[round_.winning_side],
-            "reason": REASONS3[round_.end_reason],
-            "reason_name": REASON_NAMES3[REASONS3[round_.end_reason]],
-        }
-        for key, value in (row2 if layout == 2 else row3).items():
+        row = _round_row(round_, layout)
+        for key, value in row.items():
             round_rows.setdefault(key, []).append(value)
         kills, damages, bomb = round_.kills, round_.damages, round_.bomb_events
         for name, frame in (("kills", kills), ("damages", damages)):
@@ -254,7 +269,7 @@ def _plain(value: object) -> object:
 
 def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
     """The match as `awpy parse --player-props` writes it (a zip of parquet tables)."""
-    rows = tick_rows(match.rounds, every=every)
+    rows = _tick_rows(match.rounds, every=every)
     cols = _players_columns(match.rounds, rows)
     xyz = rows["xyz"]
     ticks = {
@@ -294,7 +309,7 @@ def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
 def write_awpy3_folder(match: Match, folder: Path, *, every: int = 0) -> Path:
     """The match as awpy 3's datasets in this project's folder of tables."""
     folder.mkdir(parents=True, exist_ok=True)
-    rows = tick_rows(match.rounds, every=every)
+    rows = _tick_rows(match.rounds, every=every)
     cols = _players_columns(match.rounds, rows)
     xyz = rows["xyz"]
     snapshots = {
