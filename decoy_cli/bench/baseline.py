@@ -216,6 +216,9 @@ def headlines(section: str, result: JsonObject) -> dict[str, float]:
         figures = {"pairs/s": result.get("pairs_per_s")}
     elif section == "reader" and result.get("files"):
         figures = {"MB/s (JSON)": result.get("mb_per_s_decompressed")}
+    elif section == "awpy":
+        readers = object_at(result, "readers")
+        figures = {f"rows/s, {k}": object_at(readers, k).get("rows_per_s") for k in readers}
     elif section == "replay" and result.get("rounds"):
         figures = {"rounds/s": result.get("rounds_per_s")}
     elif section == "kinematic":

@@ -226,6 +226,24 @@ class ReaderResult(_ReaderFigures, Measured):
     repeats: int
 
 
+class AwpyReadRecord(TypedDict):
+    """One awpy reader on the section's match (`awpy.ReadFigures`)."""
+
+    rows: int
+    rounds: int
+    seconds: float
+    rows_per_s: float
+    peak_rss_mb: float
+
+
+@final
+class AwpyResult(Measured):
+    """The `awpy` section (`awpy.awpy_reader_throughput`): each reader by name."""
+
+    rounds: int
+    readers: dict[str, AwpyReadRecord]
+
+
 Measurement = (
     Table1Result
     | KinematicResult
@@ -234,6 +252,7 @@ Measurement = (
     | ReplayResult
     | MetricsResult
     | ReaderResult
+    | AwpyResult
 )
 """What a section that ran gave."""
 

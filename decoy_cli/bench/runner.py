@@ -20,6 +20,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass, replace
 
 from decoy_cli import __version__
+from decoy_cli.bench.awpy import BENCH_ROUNDS, awpy_reader_throughput
 from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
 from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
 from decoy_cli.bench.portable import PORTABLE_SECTIONS
@@ -45,7 +46,7 @@ from decoy_cli.waypoints.build import canonical_map
 
 REPORT_FORMAT = 1
 
-SECTIONS = ("table1", "kinematic", "env", "combat_step", "replay", "metrics", "reader")
+SECTIONS = ("table1", "kinematic", "env", "combat_step", "replay", "metrics", "reader", "awpy")
 """Section keys of the report, in the order they run."""
 
 DATA_SECTIONS = ("replay", "reader")
@@ -75,6 +76,7 @@ class BenchConfig(RunSpec):
     replay_rounds: int | None = None
     metric_pairs: int = 2000
     reader_files: int | None = None
+    awpy_rounds: int = BENCH_ROUNDS
 
     @classmethod
     def create(
@@ -109,6 +111,7 @@ class BenchConfig(RunSpec):
             replay_rounds=3,
             metric_pairs=100,
             reader_files=2,
+            awpy_rounds=4,
         )
 
 
@@ -208,6 +211,11 @@ def run_section(
         read = reader_throughput(files)
         read["data"] = data.describe()
         result = read
+    elif name == "awpy":
+        result = {
+            "rounds": config.awpy_rounds,
+            "readers": awpy_reader_throughput(config.awpy_rounds),
+        }
     else:
         raise ValueError(f"no bench section {name!r}; the sections are {', '.join(SECTIONS)}")
     result["section_wall_s"] = time.perf_counter() - started

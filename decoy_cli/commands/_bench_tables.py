@@ -9,6 +9,7 @@ from rich.table import Table
 from rich.text import Text
 
 from decoy_cli.bench.records import (
+    AwpyResult,
     CombatResult,
     EnvResult,
     KinematicResult,
@@ -30,6 +31,7 @@ TITLES = {
     "replay": "replay throughput",
     "metrics": "metric throughput",
     "reader": "reader throughput",
+    "awpy": "awpy readers, full-rate ticks",
 }
 
 
@@ -95,6 +97,8 @@ def section_table(name: str, result: SectionResult) -> Table | Text:
         return _metrics_table(cast(MetricsResult, result))
     if name == "reader":
         return _reader_table(cast(ReaderResult, result))
+    if name == "awpy":
+        return _awpy_table(cast(AwpyResult, result))
     raise KeyError(name)
 
 
@@ -291,4 +295,22 @@ def _reader_table(result: ReaderResult) -> Table:
         f"{result['mb_per_s_decompressed']:.1f}",
         f"{result['mb_per_s_compressed']:.2f}",
     )
+    return table
+
+
+def _awpy_table(result: AwpyResult) -> Table:
+    table = _table(
+        f"awpy readers: the sample's rounds repeated to {result['rounds']}, 64 tick rows a "
+        "second, read at the default frame rate, each in a fresh process",
+        ["reader", "rounds", "tick rows", "seconds", "rows/s", "peak memory MB"],
+    )
+    for name, read in result["readers"].items():
+        table.add_row(
+            name,
+            str(read["rounds"]),
+            f"{read['rows']:,}",
+            f"{read['seconds']:.2f}",
+            f"{read['rows_per_s']:,.0f}",
+            f"{read['peak_rss_mb']:.0f}",
+        )
     return table
