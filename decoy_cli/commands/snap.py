@@ -9,7 +9,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import MAPS_HELP
+from decoy_cli.commands._options import MAPS_HELP, RATE_HELP
 from decoy_cli.commands._snap_output import (
     show_actions,
     show_places,
@@ -84,6 +84,7 @@ def snap(
     frames: str | None = typer.Option(
         None, "--frames", help="FILE:ROUND only: plot only data frames FIRST:LAST (inclusive)."
     ),
+    rate: float | None = typer.Option(None, "--rate", help=RATE_HELP, min=0.1, max=128),
 ) -> None:
     """Snap rounds to waypoints: snap errors, plan feasibility, the snapped trajectory's fidelity.
 
@@ -102,13 +103,13 @@ def snap(
         ):
             if given:
                 raise typer.BadParameter(f"{option} needs one round (FILE:ROUND)")
-        _snap_batch(console, path, graph, max_snap, metrics, worst, csv)
+        _snap_batch(console, path, graph, max_snap, metrics, worst, csv, rate)
         return
     try:
         file, num = parse_round_address(target)
     except EstaError:
         raise EstaError(f"{target}: no such file or folder") from None
-    match = read_match(file)
+    match = read_match(file, rate=rate)
     check_map(match, graph)
     round_ = match.round(num)
     chosen = _player_rows(round_, players)
@@ -147,6 +148,7 @@ def _snap_batch(
     metrics: bool,
     worst: int,
     csv: Path | None,
+    rate: float | None,
 ) -> None:
     """Every round of a file or folder: aggregate table, worst intervals, metrics, failures."""
     files = iter_match_files(path)
@@ -174,6 +176,7 @@ def _snap_batch(
             max_distance=max_snap,
             on_progress=on_progress,
             physics=physics,  # the replay's in-the-air rule
+            rate=rate,
         )
     if path.is_file() and study.failures and study.failures[0].round_num is None:
         raise EstaError(study.failures[0].message)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from decoy_cli.errors import DecoyError, EstaError, describe_bug
+from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.esta.reader import MATCH_SUFFIXES, Match, Round, iter_match_files, read_match
 
 Result = TypeVar("Result")
@@ -98,7 +99,7 @@ def collect_match_files(inputs: Sequence[str | Path]) -> tuple[list[Path], list[
         path = Path(item)
         if not path.exists():
             raise EstaError(f"{path}: no such file or folder")
-        if path.is_dir():
+        if path.is_dir() and not is_awpy_source(path):  # a folder of matches
             ignored.extend(
                 sorted(
                     p for p in path.iterdir() if p.is_file() and not p.name.endswith(MATCH_SUFFIXES)
@@ -141,12 +142,13 @@ def match_rounds(match: Match) -> Iterator[Round | RoundFailure]:
 
 
 def iter_matches(
-    files: Iterable[str | Path], *, map_name: str | None = None
+    files: Iterable[str | Path], *, map_name: str | None = None, rate: float | None = None
 ) -> Iterator[Match | RoundFailure]:
-    """Each readable match of `files` on `map_name` (None: any), else the file's failure."""
+    """Each readable match of `files` on `map_name` (None: any), else the file's failure;
+    awpy's full-rate ticks read at `rate` frames a second (None: the reader's default)."""
     for file in files:
         try:
-            match = read_match(file)
+            match = read_match(file, rate=rate)
         except DecoyError as error:
             yield failure_from(error, file, None, UNREADABLE_FILE)
             continue
@@ -155,10 +157,10 @@ def iter_matches(
 
 
 def iter_rounds(
-    files: Iterable[str | Path], *, map_name: str | None = None
+    files: Iterable[str | Path], *, map_name: str | None = None, rate: float | None = None
 ) -> Iterator[Round | RoundFailure]:
     """Every round of `files` in file then round order, or the failure that stands for it."""
-    for item in iter_matches(files, map_name=map_name):
+    for item in iter_matches(files, map_name=map_name, rate=rate):
         if isinstance(item, RoundFailure):
             yield item
         else:

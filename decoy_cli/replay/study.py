@@ -243,9 +243,10 @@ def study_files(
     max_distance: float = DEFAULT_MAX_SNAP_M,
     on_progress: Callable[[float, int], None] | None = None,
     physics: PhysicsWorld | None = None,
+    rate: float | None = None,
 ) -> SnapStudy:
     """Study every round of every match file; failures are recorded, the batch goes on.
-    `physics` as in `study_round`.
+    `physics` as in `study_round`; `rate` the frames a second read from awpy's ticks.
 
     `on_progress(files_done, rounds_studied)` is called after each round and after each file;
     `files_done` counts a file's rounds as fractions of it (1.5 = half of the second file).
@@ -253,7 +254,7 @@ def study_files(
     studies: list[RoundStudy] = []
     failures: list[RoundFailure] = []
     graph_map = str(graph.meta.get("map", "")) or None
-    for i, item in enumerate(iter_matches(files, map_name=graph_map)):
+    for i, item in enumerate(iter_matches(files, map_name=graph_map, rate=rate)):
         if isinstance(item, RoundFailure):
             failures.append(item)
         else:
