@@ -392,3 +392,43 @@ def test_zip_members_are_read_by_name_whatever_their_column_order(tmp_path: Path
             archive.writestr(name, data)
     again = read_match(path)
     np.testing.assert_array_equal(again.round(1).hp, _sample().round(1).hp)
+
+
+def test_a_rounds_table_with_a_null_tick_is_named(folder: Path) -> None:
+    def null_end(table: pa.Table) -> pa.Table:
+        index = table.schema.get_field_index("end_tick")
+        return table.set_column(index, "end_tick", pa.array([None] * len(table), pa.int32()))
+
+    _edit_table(folder, "rounds", null_end)
+    with pytest.raises(EstaError, match="rounds: end null is not a tick"):
+        read_match(folder)
+
+
+def test_a_round_of_an_unknown_map_reads_and_fails_to_replay_by_name(
+    folder: Path, tmp_path: Path
+) -> None:
+    header = json.loads((folder / "header.json").read_text())
+    (folder / "header.json").write_text(json.dumps({**header, "map_name": "de_nowhere"}))
+    assert read_match(folder).map_name == "de_nowhere"
+    result = CliRunner().invoke(
+        app, ["replay", f"{folder}:1", "--no-combat", "--out", str(tmp_path / "out")]
+    )
+    assert result.exit_code == 1
+    assert "de_nowhere" in result.output and "Traceback" not in result.output
+
+
+@needs_data
+def test_replay_of_a_zip_round_matches_the_esta_shaped_file(tmp_path: Path) -> None:
+    """The 8 Hz round is identical in every form (its positions are float32 in the source)."""
+    outputs = []
+    for path in (
+        SHARED / "cs2_dust2_both" / f"{STEMS[1]}.json.xz",
+        SHARED / "cs2_dust2_awpy" / "awpy2" / f"{STEMS[1]}.zip",
+    ):
+        out = tmp_path / path.name
+        result = CliRunner().invoke(app, ["replay", f"{path}:2", "--seed", "3", "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        summary = json.loads(next(out.rglob("summary.json")).read_text())
+        outputs.append((summary["outcome_replay"], pd.read_csv(next(out.rglob("players.csv")))))
+    assert outputs[0][0] == outputs[1][0]
+    pd.testing.assert_frame_equal(outputs[0][1], outputs[1][1])

@@ -195,6 +195,19 @@ def _damages(source: TableSource, layout: Layout) -> pd.DataFrame:
 def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataFrame:
     """The rounds table under the reader's names; awpy 3's plants come from its bomb table."""
     rounds = _frame(source, layout.rounds)
+    for column in ("round_num", "start", "freeze_end", "end", "official_end", "bomb_plant"):
+        if column not in rounds:
+            continue
+        values = pd.to_numeric(rounds[column], errors="coerce").to_numpy(np.float64)
+        required = column in ("round_num", "start", "freeze_end", "end")
+        given = np.ones(len(values), bool) if required else rounds[column].notna().to_numpy()
+        with np.errstate(invalid="ignore"):
+            wrong = ~np.isfinite(values) | (values != np.round(values)) | (np.abs(values) > 2**31)
+        bad = wrong & given
+        if bad.any():
+            raw = rounds[column].iloc[int(np.flatnonzero(bad)[0])]
+            shown = "null" if pd.isna(raw) else str(raw)
+            raise EstaError(f"{source.path}: rounds: {column} {shown} is not a tick or number")
     if "official_end" not in rounds:
         rounds["official_end"] = pd.NA
     if "bomb_plant" in rounds:
@@ -202,7 +215,7 @@ def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataF
             bomb_site
         )
         return rounds
-    plants = bomb[bomb["event"] == "finish_plant"].sort_values("tick", kind="stable")
+    plants = bomb[bomb["event"].map(bomb_action) == "plant"].sort_values("tick", kind="stable")
     starts = rounds["start"].to_numpy(np.int64)
     ends = rounds["end"].to_numpy(np.int64)
     plant_tick: list[object] = []
