@@ -432,3 +432,18 @@ def test_replay_of_a_zip_round_matches_the_esta_shaped_file(tmp_path: Path) -> N
         outputs.append((summary["outcome_replay"], pd.read_csv(next(out.rglob("players.csv")))))
     assert outputs[0][0] == outputs[1][0]
     pd.testing.assert_frame_equal(outputs[0][1], outputs[1][1])
+
+
+def test_sides_swap_at_halftime_by_round_and_players_keep_their_steamids(tmp_path: Path) -> None:
+    sample = _sample()
+    first, second = sample.rounds[:2]
+    swapped_players = [
+        replace(p, side="CT" if p.side == "T" else "T") for p in second.players
+    ]  # the second half: the same people on the other side
+    swapped = replace(second, players=swapped_players, winning_side="T", end_reason="TargetBombed")
+    match = read_match(write_awpy3_folder(replace(sample, rounds=[first, swapped]), tmp_path / "m"))
+    before, after = match.round(1), match.round(2)
+    side_before = {p.steam_id: p.side for p in before.players}
+    side_after = {p.steam_id: p.side for p in after.players}
+    assert side_before.keys() == side_after.keys()
+    assert all(side_before[k] != side_after[k] for k in side_before)
