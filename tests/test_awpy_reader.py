@@ -23,6 +23,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, read_match
 from decoy_cli.esta.awpy.names import bomb_action, end_reason, hit_group, side_name, weapon_name
 from decoy_cli.esta.awpy.writer import write_awpy2_zip, write_awpy3_folder
+from decoy_cli.esta.reader import UTILITY_COLUMNS
 from decoy_cli.replay.missing import fill_missing, lacking
 from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.sites import SiteZones
@@ -142,7 +143,7 @@ def test_the_sample_round_trips_through_both_layouts_with_what_the_real_rounds_l
             pd.testing.assert_frame_equal(
                 esta.damages[damages], other.damages[damages], check_dtype=False
             )
-            assert other.not_recorded == ("vertical speed",)
+            assert other.not_recorded == ("vertical speed", "utility (smokes, fires, blinds)")
             assert "weapon" not in lacking(other) and "armour" not in lacking(other)
 
 
@@ -447,3 +448,82 @@ def test_sides_swap_at_halftime_by_round_and_players_keep_their_steamids(tmp_pat
     side_after = {p.steam_id: p.side for p in after.players}
     assert side_before.keys() == side_after.keys()
     assert all(side_before[k] != side_after[k] for k in side_before)
+
+
+def _with_utility(match: Match) -> Match:
+    """The sample's first round with a smoke, a fire and a blind (made up here)."""
+    round_ = match.rounds[0]
+    zero = round_.clock.zero_tick
+    smoke = pd.DataFrame(
+        {
+            "start_tick": [zero + 1280.0],
+            "end_tick": [zero + 1280.0 + 20 * 128],
+            "x_m": [10.0],
+            "y_m": [20.0],
+            "z_m": [1.0],
+            "thrower_name": ["T-1"],
+            "thrower_side": ["T"],
+            "thrower_steamid": pd.array([11], dtype="Int64"),
+        }
+    )
+    smoke["start_s"] = round_.clock.seconds(smoke["start_tick"])
+    smoke["end_s"] = round_.clock.seconds(smoke["end_tick"])
+    fire = smoke.assign(end_tick=smoke["start_tick"] + 7 * 128, x_m=-5.0)
+    fire["end_s"] = round_.clock.seconds(fire["end_tick"])
+    flash = round_.flashes.iloc[0:0].copy()
+    flash.loc[0, ["tick", "attackerName", "attackerSide", "playerName", "playerSide"]] = [
+        int(zero + 640),
+        "T-1",
+        "T",
+        "CT-1",
+        "CT",
+    ]
+    flash.loc[0, ["attackerX", "attackerY", "attackerZ", "playerX", "playerY", "playerZ"]] = 0.0
+    flash.loc[0, "flashDuration"] = 2.5
+    first = replace(round_, smokes=smoke[list(UTILITY_COLUMNS)], fires=fire[list(UTILITY_COLUMNS)],
+                    flashes=flash)  # fmt: skip
+    return replace(match, rounds=[first, *match.rounds[1:2]])
+
+
+def test_smokes_fires_and_blinds_are_read_with_their_windows(tmp_path: Path) -> None:
+    match = _with_utility(_sample())
+    expected = match.rounds[0]
+    for source in (
+        write_awpy3_folder(match, tmp_path / "m"),
+        write_awpy2_zip(match, tmp_path / "m.zip"),
+    ):
+        round_ = read_match(source).round(1)
+        for name in ("smokes", "fires"):
+            got, want = getattr(round_, name), getattr(expected, name)
+            np.testing.assert_allclose(got["start_s"], want["start_s"])
+            np.testing.assert_allclose(got["end_s"], want["end_s"])
+            np.testing.assert_allclose(got[["x_m", "y_m", "z_m"]], want[["x_m", "y_m", "z_m"]])
+            assert got["thrower_side"].tolist() == ["T"]
+        assert "utility (smokes, fires, blinds)" not in round_.not_recorded
+        if source.suffix == ".zip":  # awpy 2 writes no blinds
+            assert len(round_.flashes) == 0
+        else:
+            assert round_.flashes["playerName"].tolist() == ["CT-1"]
+            assert round_.flashes["flashDuration"].tolist() == [2.5]
+
+
+def test_a_smoke_without_an_end_and_a_blind_of_negative_duration_are_named(
+    tmp_path: Path,
+) -> None:
+    folder = write_awpy3_folder(_with_utility(_sample()), tmp_path / "m")
+    _edit_table(
+        folder,
+        "smokes",
+        lambda t: t.set_column(1, "end_tick", pa.array([None] * len(t), pa.int64())),
+    )
+    _edit_table(
+        folder,
+        "blinds",
+        lambda t: t.set_column(
+            t.schema.get_field_index("duration"), "duration", pa.array([-1.0], pa.float32())
+        ),
+    )
+    round_ = read_match(folder).round(1)
+    assert any("a smoke bursting at tick" in w and "no end" in w for w in round_.warnings)
+    assert any("lasts -1.0 s: left out" in w for w in round_.warnings)
+    assert np.isnan(round_.smokes["end_s"]).all() and len(round_.flashes) == 0

@@ -57,6 +57,31 @@ times the most in a real file in ../shared/data (28,365, T side only; twice that
 teams). With the per-round limits of decoy_cli/esta/frames.py it bounds the memory a hostile
 file can take."""
 
+UTILITY_COLUMNS = (
+    "start_tick",
+    "end_tick",
+    "start_s",
+    "end_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "thrower_name",
+    "thrower_side",
+    "thrower_steamid",
+)
+"""A smoke's or fire's row: ticks (`end_tick` NaN where the data shows no end), seconds on the
+round's clock, where it burst in metres, and who threw it."""
+
+
+def empty_utility() -> pd.DataFrame:
+    """A smokes or fires table without rows."""
+    return pd.DataFrame({column: pd.Series(dtype=_UTILITY_DTYPES.get(column, "float64"))
+                         for column in UTILITY_COLUMNS})  # fmt: skip
+
+
+_UTILITY_DTYPES = {"thrower_name": "object", "thrower_side": "object", "thrower_steamid": "Int64"}
+
+
 MATCH_SUFFIXES = (".json.xz", ".json", ".zip", ".dem")
 """File names `iter_match_files` picks up in a folder: ESTA files, awpy 2 zips and demos (a
 folder of awpy 3 tables is picked up by its `header.json`)."""
@@ -122,6 +147,10 @@ class Round:
     not_recorded: tuple[str, ...] = ()
     """What awpy's tables do not record for this round (decoy_cli/esta/awpy/rounds.py): held
     as absent, and filled by the replay's rules where the game needs it."""
+    smokes: pd.DataFrame = field(default_factory=lambda: empty_utility())
+    """Smokes from detonation to expiry (`UTILITY_COLUMNS`; awpy's tables, none in ESTA's)."""
+    fires: pd.DataFrame = field(default_factory=lambda: empty_utility())
+    """Fires (molotov, incendiary) from their first to their last flame, as `smokes`."""
 
     @property
     def num_frames(self) -> int:

@@ -8,8 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.esta.awpy.names import bomb_action, bomb_site, hit_group, side_name, weapon_name
-from decoy_cli.esta.schema import BombEvent, DamageEvent, KillEvent
+from decoy_cli.esta.frames import RoundClock
+from decoy_cli.esta.reader import UTILITY_COLUMNS, empty_utility
+from decoy_cli.esta.schema import BombEvent, DamageEvent, FlashEvent, KillEvent
 
 
 def round_events(
@@ -19,6 +22,8 @@ def round_events(
     ticks: pd.DataFrame,
     plant_site: str,
     warnings: list[str],
+    *,
+    blinds: pd.DataFrame | None = None,
 ) -> dict[str, list]:
     """A round's kills, damages and bomb events (its rows of awpy's tables, in tick order) as
     ESTA event structs; `ticks` are the round's tick rows (a defuse's start, `_defuse_starts`)
@@ -28,7 +33,65 @@ def round_events(
         "kills": [KillEvent(**_kill(row, warnings)) for row in _records(kills)],
         "damages": [DamageEvent(**_damage(row, warnings)) for row in _records(damages)],
         "bomb": _defuse_starts([BombEvent(**row) for row in bomb_rows if row is not None], ticks),
+        "flashes": [] if blinds is None else _flashes(blinds, warnings),
     }
+
+
+def _flashes(blinds: pd.DataFrame, warnings: list[str]) -> list:
+    """awpy 3's blinds as ESTA's flashes (attacker: the thrower; player: the one blinded); a
+    blind whose duration is not a positive number of seconds is left out, named."""
+    out = []
+    for row in _records(blinds):
+        duration = row.get("duration")
+        if not (isinstance(duration, int | float) and np.isfinite(duration) and duration > 0):
+            warnings.append(f"a blind at tick {row['tick']} lasts {duration!r} s: left out")
+            continue
+        flashed = _player(row, "victim", "player")
+        flashed.pop("playerViewX")
+        flashed.pop("playerViewY")
+        out.append(
+            FlashEvent(
+                tick=row["tick"],
+                **_player(row, "attacker", "attacker"),
+                **flashed,
+                flashDuration=float(duration),
+            )
+        )
+    return out
+
+
+def utility_table(
+    table: pd.DataFrame | None, kind: str, clock: RoundClock, warnings: list[str]
+) -> pd.DataFrame:
+    """A round's smokes or fires (awpy's rows) as `UTILITY_COLUMNS`; one without an end, or
+    ending before it starts, keeps a NaN end and is named."""
+    if table is None or not len(table):
+        return empty_utility()
+    start = table["start_tick"].to_numpy(dtype=np.float64)
+    end = pd.to_numeric(table["end_tick"], errors="coerce").to_numpy(dtype=np.float64)
+    for tick in start[~(end >= start)]:
+        warnings.append(f"a {kind} bursting at tick {int(tick)} has no end in the data")
+    end = np.where(end >= start, end, np.nan)
+
+    def column(name: str) -> np.ndarray:
+        values = table[name] if name in table else pd.Series(None, index=table.index)
+        return values.to_numpy(dtype=object, na_value=None)
+
+    out = pd.DataFrame(
+        {
+            "start_tick": start,
+            "end_tick": end,
+            "start_s": clock.seconds(start),
+            "end_s": clock.seconds(end),
+            **{f"{a}_m": table[a].to_numpy(np.float64) * HAMMER_TO_M for a in "xyz"},
+            "thrower_name": column("thrower_name"),
+            "thrower_side": [None if s is None else side_name(s) for s in column("thrower_side")],
+            "thrower_steamid": pd.array(
+                [steam_id(s) for s in column("thrower_steamid")], dtype="Int64"
+            ),
+        }
+    )
+    return out[list(UTILITY_COLUMNS)].reset_index(drop=True)
 
 
 def _defuse_starts(bomb: list, rows: pd.DataFrame) -> list:

@@ -49,6 +49,10 @@ class Layout:
     kills: TableLayout
     damages: TableLayout
     bomb: TableLayout
+    smokes: TableLayout
+    fires: TableLayout
+    blinds: TableLayout | None
+    """awpy 2 has no blinds table."""
     tick_weapons: Spelling
     """How the tick table spells a weapon in hand."""
 
@@ -71,6 +75,20 @@ def _player(prefix: str, upper_xyz: bool, *, view: bool = False) -> dict[str, tu
 
 def _same(kinds: dict[str, Kind]) -> dict[str, tuple[str, Kind]]:
     return {name: (name, kind) for name, kind in kinds.items()}
+
+
+def _utility(name: str, upper_xyz: bool) -> TableLayout:
+    """A smokes or fires table: its window, where it burst, who threw it."""
+    xyz: dict[str, tuple[str, Kind]] = {
+        (a.upper() if upper_xyz else a): (a, "float") for a in "xyz"
+    }
+    thrower: dict[str, Kind] = {
+        "thrower_name": "str",
+        "thrower_steamid": "int",
+        "thrower_side": "str",
+    }
+    columns = {**_same({"start_tick": "int", "end_tick": "int"}), **xyz, **_same(thrower)}
+    return TableLayout(name, {**columns, "part": ("part", "int")}, ("start_tick", "end_tick", *xyz))
 
 
 _EVENT_KILL: dict[str, Kind] = {
@@ -163,6 +181,9 @@ AWPY2 = Layout(
         },
         ("tick", "event"),
     ),
+    smokes=_utility("smokes", True),
+    fires=_utility("infernos", True),
+    blinds=None,
     tick_weapons="display",
 )
 
@@ -240,6 +261,19 @@ AWPY3 = Layout(
             "part": ("part", "int"),
         },
         ("tick", "event"),
+    ),
+    smokes=_utility("smokes", False),
+    fires=_utility("fires", False),
+    blinds=TableLayout(
+        "blinds",
+        {
+            "tick": ("tick", "int"),
+            "duration": ("duration", "float"),
+            **_player("attacker", False),
+            **_player("victim", False),
+            "part": ("part", "int"),
+        },
+        ("tick", "duration", "victim_name"),
     ),
     tick_weapons="item",
 )

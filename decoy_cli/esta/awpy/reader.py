@@ -111,6 +111,9 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
         kills=kills,
         damages=_damages(source, layout),
         bomb=bomb,
+        smokes=_optional_frame(source, layout.smokes),
+        fires=_optional_frame(source, layout.fires),
+        blinds=_optional_frame(source, layout.blinds),
     )
     match = read_tables_match(tables, implausible=implausible)
     match.meta["tick_rate_rule"] = rule
@@ -180,6 +183,14 @@ def _frame(source: TableSource, table: TableLayout) -> pd.DataFrame:
     if "tick" in frame and frame["tick"].isna().any():
         raise EstaError(f"{source.path}: {table.name}: a row has no tick")
     return frame
+
+
+def _optional_frame(source: TableSource, table: TableLayout | None) -> pd.DataFrame | None:
+    """A table the layout may lack (awpy 2 has no blinds; an awpy 3 folder may leave utility
+    out): None where the source does not hold it."""
+    if table is None or source.open_table(table.name) is None:
+        return None
+    return _frame(source, table)
 
 
 def _damages(source: TableSource, layout: Layout) -> pd.DataFrame:

@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError
-from decoy_cli.esta.awpy.events import is_null, round_events, row_keys
+from decoy_cli.esta.awpy.events import is_null, round_events, row_keys, utility_table
 from decoy_cli.esta.awpy.names import (
     Spelling,
     bomb_site,
@@ -68,6 +68,9 @@ NOT_RECORDED = {
 }
 """Tick columns a source may lack, by the name a round's `not_recorded` gives them."""
 CARRIER = "bomb carrier"
+UTILITY = "utility (smokes, fires, blinds)"
+"""Named not recorded where the match's tables hold no smoke, fire or blind at all: a real
+match always has some."""
 EQUIPMENT = ("armor", "has_helmet", "has_defuser")
 
 
@@ -104,11 +107,17 @@ class AwpyTables:
     kills: pd.DataFrame
     damages: pd.DataFrame
     bomb: pd.DataFrame
+    smokes: pd.DataFrame | None = None
+    fires: pd.DataFrame | None = None
+    blinds: pd.DataFrame | None = None
+    """None: the source does not hold the table (utility not recorded)."""
 
 
 def read_tables_match(tables: AwpyTables, *, implausible: Implausible) -> Match:
     """Every round of the tables, built, or its error kept by round number (as `read_match`)."""
     not_recorded = _not_recorded(tables.ticks)
+    if all(t is None or not len(t) for t in (tables.smokes, tables.fires, tables.blinds)):
+        not_recorded += (UTILITY,)
     ticks = tables.ticks.drop(columns=[c for c in tables.ticks if c in _dropped(not_recorded)])
     owner = assign_rounds(ticks["tick"].to_numpy(np.int64), tables.windows)
     rounds: list[Round] = []
@@ -271,7 +280,10 @@ def _build_round(
         rows,
         window.plant_site,
         warnings,
+        blinds=None if tables.blinds is None else _in_window(tables.blinds, window),
     )
+    smokes = utility_table(_utility_in(tables.smokes, window), "smoke", clock, warnings)
+    fires = utility_table(_utility_in(tables.fires, window), "fire", clock, warnings)
     return Round(
         match_id=tables.match_id,
         path=tables.path,
@@ -298,7 +310,7 @@ def _build_round(
         damages=build_table("damages", events["damages"], DAMAGE_COLUMNS, kept, clock),
         kills=build_table("kills", events["kills"], KILL_COLUMNS, kept, clock),
         bomb_events=build_table("bomb_events", events["bomb"], BOMB_EVENT_COLUMNS, kept, clock),
-        flashes=build_table("flashes", [], FLASH_COLUMNS, kept, clock),
+        flashes=build_table("flashes", events["flashes"], FLASH_COLUMNS, kept, clock),
         winning_side=winner,  # type: ignore[arg-type]  # side_name gives "T", "CT" or None
         end_reason=reason,
         bomb_plant_tick=window.plant_tick,
@@ -307,6 +319,8 @@ def _build_round(
         clock=clock,
         warnings=tuple(warnings),
         source=tables.layout,
+        smokes=smokes,
+        fires=fires,
     )
 
 
@@ -375,3 +389,12 @@ def _in_window(table: pd.DataFrame, window: RoundWindow) -> pd.DataFrame:
     ticks = table["tick"].to_numpy(dtype=np.int64)
     inside = (ticks >= window.start) & (ticks <= window.official_end)
     return table[inside].sort_values("tick", kind="stable")
+
+
+def _utility_in(table: pd.DataFrame | None, window: RoundWindow) -> pd.DataFrame | None:
+    """The smokes or fires that burst in the round (by `start_tick`), in tick order."""
+    if table is None:
+        return None
+    ticks = table["start_tick"].to_numpy(dtype=np.int64)
+    inside = (ticks >= window.start) & (ticks <= window.official_end)
+    return table[inside].sort_values("start_tick", kind="stable")

@@ -16,6 +16,7 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -267,6 +268,44 @@ def _plain(value: object) -> object:
     return value.item() if isinstance(value, np.generic) else value
 
 
+def _utility(match: Match, layout: int) -> dict[str, bytes]:
+    """The smokes and fires tables (`infernos` in awpy 2), and awpy 3's blinds."""
+    upper = layout == 2
+    sides = SIDE2 if upper else SIDE3
+    out = {}
+    for name, field in (("smokes", "smokes"), ("infernos" if upper else "fires", "fires")):
+        rows = pd.concat([getattr(r, field) for r in match.rounds], ignore_index=True)
+        table = {
+            "start_tick": pa.array(rows["start_tick"].astype("int64"), pa.int64()),
+            "end_tick": pa.array(rows["end_tick"].astype("Int64"), pa.int64()),
+            **{
+                (a.upper() if upper else a): pa.array(rows[f"{a}_m"] / HAMMER_TO_M, pa.float64())
+                for a in "xyz"
+            },
+            "thrower_name": pa.array(rows["thrower_name"].astype(object), pa.large_string()),
+            "thrower_side": pa.array(
+                [sides.get(s) for s in rows["thrower_side"]], pa.large_string()
+            ),
+            "thrower_steamid": pa.array(rows["thrower_steamid"].astype("Int64"), pa.uint64()),
+        }
+        out[name] = _write(table)
+    if not upper:
+        flashes = pd.concat([r.flashes for r in match.rounds], ignore_index=True)
+        table = {"tick": pa.array(flashes["tick"].astype("int64"), pa.int32())}
+        for who, esta in (("attacker", "attacker"), ("victim", "player")):
+            table[f"{who}_name"] = pa.array(
+                flashes[f"{esta}Name"].astype(object), pa.large_string()
+            )
+            table[f"{who}_side"] = pa.array(
+                [sides.get(s) for s in flashes[f"{esta}Side"]], pa.large_string()
+            )
+            for axis in "xyz":
+                table[f"{who}_{axis}"] = pa.array(flashes[f"{esta}{axis.upper()}"], pa.float32())
+        table["duration"] = pa.array(flashes["flashDuration"], pa.float32())
+        out["blinds"] = _write(table)
+    return out
+
+
 def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
     """The match as `awpy parse --player-props` writes it (a zip of parquet tables)."""
     rows = _tick_rows(match.rounds, every=every)
@@ -298,7 +337,7 @@ def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
             pa.list_(pa.large_string()),
         ),
     }
-    tables = {"ticks": _write(ticks), **_rounds_and_events(match, 2)}
+    tables = {"ticks": _write(ticks), **_rounds_and_events(match, 2), **_utility(match, 2)}
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
         for name, data in tables.items():
             archive.writestr(f"{name}.parquet", data)
@@ -333,7 +372,7 @@ def write_awpy3_folder(match: Match, folder: Path, *, every: int = 0) -> Path:
         ),
     }
     (folder / "snapshots.parquet").write_bytes(_write(snapshots))
-    for name, data in _rounds_and_events(match, 3).items():
+    for name, data in {**_rounds_and_events(match, 3), **_utility(match, 3)}.items():
         (folder / f"{name}.parquet").write_bytes(data)
     header = {"map_name": match.map_name, "playback_ticks": match.tick_rate * 100}
     header["playback_time"] = 100.0
