@@ -99,6 +99,11 @@ def replay(
         console.print(f"inferred: {note}", style="yellow", markup=False)
     if options.combat:
         console.print(f"deaths decided by: {options.deaths}")
+        used = result.utility
+        console.print(
+            "utility the fight heeds: "
+            + (", ".join(f"{n} {k}" for k, n in used.items()) if used else "none in the data")
+        )
         for line in map_warnings(choice, [round_.map_name]):
             console.print(f"warning: {line}", style="yellow", markup=False)
     _show_bomb(console, result.bomb_row())

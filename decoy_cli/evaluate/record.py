@@ -105,6 +105,9 @@ ROUND_COLUMNS = (
     "warnings",
     "contradictions",
     "inferred",
+    "smokes",
+    "fires",
+    "blinds",
     "wall_seconds",
     *BOMB_COLUMNS,
     *KILL_COLUMNS,
@@ -113,8 +116,9 @@ ROUND_COLUMNS = (
 (`decoy_cli.esta.frame_rate`); `warnings` holds the implausible data a round was replayed with
 under `--implausible warn`, `contradictions` what its frames and events say against each other
 (`decoy_cli.replay.missing`), each joined by `WARNING_SEPARATOR` ("" when none); `inferred` the
-fields the data lacked and the rules that filled them, joined likewise; the bomb columns
-(`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off; the kill columns
+fields the data lacked and the rules that filled them, joined likewise; `smokes`, `fires` and
+`blinds` the data's utility the fight heeded (empty: none in the data, or no shooting); the
+bomb columns (`decoy_cli.replay.bomb_fidelity`) are empty when the bomb was off; the kill columns
 (`decoy_cli.metrics.kills`) compare deaths and alive counts."""
 
 WARNING_SEPARATOR = " | "
@@ -190,6 +194,7 @@ def build_record(
         "warnings": WARNING_SEPARATOR.join(result.warnings),
         "contradictions": WARNING_SEPARATOR.join(result.contradictions),
         "inferred": WARNING_SEPARATOR.join(result.inferred),
+        **(result.utility or dict.fromkeys(("smokes", "fires", "blinds"))),
         "wall_seconds": round(seconds, 4),
         **(result.bomb_row() or dict.fromkeys(BOMB_COLUMNS)),
         **kills,

@@ -186,7 +186,7 @@ def policy_plant(bomb: DataBomb, plans: list[PlayerPlan]) -> DataPlant | None:
     return DataPlant(tick_at(plant.start_s), agent if target >= 0 else -1, target, arrive_by)
 
 
-def _player_row(round_: Round, name: object, steam_id: object) -> int:
+def player_row(round_: Round, name: object, steam_id: object) -> int:
     """The row of the player an event names (by steamID, else name); -1 if none."""
     for i, player in enumerate(round_.players):
         if (steam_id is not None and not pd.isna(steam_id) and player.steam_id == steam_id) or (
@@ -247,7 +247,7 @@ def _plant(
     planter = -1
     if len(plants):
         row = plants.iloc[0]
-        planter = _player_row(round_, row.get("playerName"), row.get("playerSteamID"))
+        planter = player_row(round_, row.get("playerName"), row.get("playerSteamID"))
     if planter < 0:
         held = np.flatnonzero((ticks < plant_tick) & (carriers >= 0))
         planter = int(carriers[held[-1]]) if len(held) else -1
@@ -287,7 +287,7 @@ def _defuses(
     out: list[DataDefuse] = []
     open_starts: dict[int, float] = {}
     for _, row in acts.iterrows():
-        agent = _player_row(round_, row.get("playerName"), row.get("playerSteamID"))
+        agent = player_row(round_, row.get("playerName"), row.get("playerSteamID"))
         seconds = float(clock.seconds(float(row["tick"])))
         if agent < 0:
             continue

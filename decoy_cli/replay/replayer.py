@@ -50,6 +50,7 @@ from decoy_cli.replay.lateness import lateness_table
 from decoy_cli.replay.missing import Missing, contradictions, fill_missing
 from decoy_cli.replay.policy import AgentLog, PlanPolicy
 from decoy_cli.replay.rounds import RoundPlan, snap_round
+from decoy_cli.replay.utility import round_utility
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.recording import Recording
 from decoy_cli.sim.rules import RulesConfig
@@ -80,6 +81,9 @@ class ReplayResult:
     inferred: tuple[str, ...] = ()  # fields the data lacked, filled by rule (replay/missing.py)
     contradictions: tuple[str, ...] = ()  # what the data's frames and events say against each other
     bomb: DataBomb | None = None  # the data's bomb, when the replay followed it
+    utility: dict[str, int] | None = None
+    """The data's smokes, fires and blinds the fight heeded (replay/utility.py); None: the
+    round has none, or nobody shot."""
 
     def bomb_row(self) -> BombRow | None:
         """The bomb fidelity of this replay (`BOMB_COLUMNS`), None when the bomb was off."""
@@ -213,6 +217,7 @@ class ReplayOptions(ReplaySpec):
             kills=self.deaths == "simulated",
             rules=rules,
             sight=self.sight,
+            utility=round_utility(round_),
         )
 
 
@@ -378,6 +383,7 @@ def replay_round(
         contradictions=contradictions(round_),
         data_deaths=truth,
         bomb=bomb,
+        utility=setup.utility.counts if setup.utility is not None and setup.shooting else None,
     )
 
 

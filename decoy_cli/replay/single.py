@@ -172,6 +172,7 @@ def replay_summary(
         "warnings": list(result.warnings),
         "contradictions": list(result.contradictions),
         "inferred": list(result.inferred),
+        "utility": result.utility or "none in the data, or no shooting",
         "bomb": result.bomb_row(),
         "kills": result.kill_row(round_),
     }

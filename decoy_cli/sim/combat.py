@@ -26,6 +26,7 @@ import numpy as np
 from decoy_cli.csgo import seconds_to_ticks
 from decoy_cli.sim.sight import LOS_GROUP, LineOfSight, VisiblePairs
 from decoy_cli.sim.state import Agents, SimEvent
+from decoy_cli.sim.utility import FIRE_HP_PER_S, Utility
 
 __all__ = [
     "HIT_GROUPS",
@@ -273,12 +274,23 @@ class CombatStep:
     applied. Remembers since when each pair has been in sight at every step (one round)."""
 
     def __init__(
-        self, los: LineOfSight, model: DamageModel, map_name: str, *, kills: bool = True
+        self,
+        los: LineOfSight,
+        model: DamageModel,
+        map_name: str,
+        *,
+        kills: bool = True,
+        utility: Utility | None = None,
+        step_s: float = 0.5,
     ) -> None:
         self.los = los
         self.model = model
         self.map_name = map_name
         self.kills = kills
+        self.utility = utility
+        """The data's smokes, fires and blinds (decoy_cli/sim/utility.py); None: none."""
+        self.fire_hp = round(FIRE_HP_PER_S * step_s)
+        """HP a fire takes from a player in it at each step (`step_s` apart)."""
         self._in_sight_since = np.full((los.count, los.count), -1, dtype=np.int64)
         self._reaction_ticks = seconds_to_ticks(REACTION_S)
 
@@ -286,10 +298,12 @@ class CombatStep:
         """Run the step on the agents (changed in place); the model is not called when no
         pair is visible."""
         pairs = self.los.visible_pairs(agents)
+        if self.utility is not None:
+            pairs = self._through_utility(agents, pairs, tick)
         since = self._in_sight_since
         if len(pairs) == 0:
             since.fill(-1)
-            return []
+            return self._burn(agents, tick)
         seen_before = since[pairs.attacker, pairs.victim]
         since.fill(-1)
         seen = np.where(seen_before >= 0, seen_before, tick)
@@ -297,4 +311,34 @@ class CombatStep:
         aims = seen <= tick - self._reaction_ticks
         yaw = aimed_yaw(agents, pairs, aims)
         batch = make_batch(agents, pairs, self.map_name, yaw)
-        return apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)
+        events = apply_damage(agents, batch, self.model(batch, rng), tick, kills=self.kills)
+        return events + self._burn(agents, tick)
+
+    def _through_utility(self, agents: Agents, pairs: VisiblePairs, tick: int) -> VisiblePairs:
+        """The pairs smoke does not hide, less those whose attacker is blind (he does not
+        shoot; a blind victim is still seen)."""
+        assert self.utility is not None
+        eyes = np.asarray(agents.position, dtype=np.float64) + np.array(
+            [0.0, 0.0, self.los.eye_height]
+        )
+        keep = ~self.utility.sight_blocked(eyes[pairs.attacker], eyes[pairs.victim], tick)
+        keep &= ~self.utility.blinded(agents.count, tick)[pairs.attacker]
+        return VisiblePairs(pairs.attacker[keep], pairs.victim[keep])
+
+    def _burn(self, agents: Agents, tick: int) -> list[SimEvent]:
+        """Fire damage to the alive agents standing in an active fire; one it brings to 0 HP
+        dies (unless nothing kills: then it stops at 1)."""
+        if self.utility is None:
+            return []
+        feet = np.asarray(agents.position, dtype=np.float64)
+        burning = np.flatnonzero(self.utility.burning(feet, tick) & agents.alive)
+        events = []
+        for agent in burning.tolist():
+            left = max(0 if self.kills else 1, int(agents.hp[agent]) - self.fire_hp)
+            taken = int(agents.hp[agent]) - left
+            agents.hp[agent] = left
+            events.append(SimEvent(tick, "fire_damage", agent, data={"damage": taken}))
+            if left == 0:
+                agents.alive[agent] = False
+                events.append(SimEvent(tick, "death", agent, data={"reason": "fire"}))
+        return events

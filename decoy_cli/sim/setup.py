@@ -21,6 +21,7 @@ from contextlib import AbstractContextManager, ExitStack, contextmanager
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Literal, get_args
 
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.combat import CombatStep, DamageModel, LineOfSight
 from decoy_cli.sim.engine import COMBAT_EVERY_TICKS, Policy, Simulator
@@ -28,6 +29,7 @@ from decoy_cli.sim.movement import KinematicMover, PhysicsMover
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
 from decoy_cli.sim.state import Agents
+from decoy_cli.sim.utility import Utility
 from decoy_cli.waypoints.graph import WaypointGraph
 
 if TYPE_CHECKING:
@@ -98,6 +100,8 @@ class RoundSetup(Switches):
     the pybullet client's world."""
     rules: RulesConfig | None = None
     zones: SiteZones | None = None
+    utility: Utility | None = None
+    """The data's smokes, fires and blinds the fight heeds (decoy_cli/sim/utility.py)."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -177,7 +181,14 @@ def open_round(
             assert physics is not None and setup.damage_model is not None
             los = LineOfSight(physics, agents.count, scene=setup.sight)
             stack.callback(los.close)
-            combat = CombatStep(los, setup.damage_model, setup.map_name, kills=setup.kills)
+            combat = CombatStep(
+                los,
+                setup.damage_model,
+                setup.map_name,
+                kills=setup.kills,
+                utility=setup.utility,
+                step_s=setup.combat_every_ticks / TICK_RATE,
+            )
         rules = BombRules(setup.site_zones(), setup.rules_config())
         yield Simulator(
             setup.graph,

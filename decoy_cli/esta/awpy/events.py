@@ -70,7 +70,9 @@ def utility_table(
     start = table["start_tick"].to_numpy(dtype=np.float64)
     end = pd.to_numeric(table["end_tick"], errors="coerce").to_numpy(dtype=np.float64)
     for tick in start[~(end >= start)]:
-        warnings.append(f"a {kind} bursting at tick {int(tick)} has no end in the data")
+        warnings.append(
+            f"a {kind} bursting at tick {int(tick)} has no end in the data: not used in the fight"
+        )
     end = np.where(end >= start, end, np.nan)
 
     def column(name: str) -> np.ndarray:
