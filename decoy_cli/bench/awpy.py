@@ -71,7 +71,7 @@ def _read(path: str) -> AwpyReadRecord:
     match = read_match(path)
     seconds = time.perf_counter() - started
     source = open_source(Path(path), 8.0)
-    rows = table_rows(source, "ticks" if source.layout == "awpy 2" else "snapshots") or 0
+    rows = table_rows(source, "ticks" if source.layout == "awpy 2" else "snapshots")
     return {
         "rows": rows,
         "rounds": len(match.rounds),

@@ -92,32 +92,13 @@ def read_table(
     source: TableSource, table: str, columns: Mapping[str, Kind], required: tuple[str, ...]
 ) -> pa.Table:
     """The columns of `table` the source has (all of `required`, or EstaError), type-checked."""
-    where = f"{source.path}: {table}"
-    found = source.open_table(table)
-    if found is None:
-        raise EstaError(f"{source.path}: no {table} table (awpy writes one; is this awpy data?)")
+    found, names = _opened(source, table, columns, required)
+    if isinstance(found, pa.Table):
+        return found.select(names)
     try:
-        if isinstance(found, pa.Table):
-            schema = found.schema
-            names = [c for c in columns if c in schema.names]
-            data = found.select(names)
-        else:
-            handle = pq.ParquetFile(io.BytesIO(found) if isinstance(found, bytes) else found)
-            schema = handle.schema_arrow
-            names = [c for c in columns if c in schema.names]
-            data = handle.read(columns=names, use_threads=False)
+        return found.read(columns=names, use_threads=False)
     except (pa.ArrowException, OSError, ValueError) as error:
-        raise EstaError(f"{where}: not a readable parquet table ({error})") from None
-    missing = [c for c in required if c not in names]
-    if missing:
-        raise EstaError(f"{where}: no column {', '.join(missing)}")
-    for name in names:
-        kind = columns[name]
-        if not _CHECKS[kind](data.schema.field(name).type):
-            raise EstaError(
-                f"{where}: column {name} holds {data.schema.field(name).type}, not {kind} values"
-            )
-    return data
+        raise EstaError(f"{source.path}: {table}: not a readable parquet table ({error})") from None
 
 
 def stream_table(
@@ -125,37 +106,61 @@ def stream_table(
     table: str,
     columns: Mapping[str, Kind],
     required: tuple[str, ...],
-    keep: Callable[[pa.RecordBatch], pa.Array],
+    keep: Callable[[pa.RecordBatch | pa.Table], pa.Array],
 ) -> pa.Table:
     """Like `read_table`, but read in batches and only the rows `keep` marks are held: a tick
     table of millions of rows takes the memory of the rows kept."""
-    found = source.open_table(table)
-    if found is None or isinstance(found, pa.Table):
-        whole = read_table(source, table, columns, required)
-        return whole.filter(keep(whole.to_batches()[0])) if whole.num_rows else whole
-    where = f"{source.path}: {table}"
-    head = read_table(source, table, columns, required).slice(0, 0)  # checks names and types
+    found, names = _opened(source, table, columns, required)
+    if isinstance(found, pa.Table):
+        whole = found.select(names)
+        return whole.filter(keep(whole))
     try:
-        handle = pq.ParquetFile(io.BytesIO(found) if isinstance(found, bytes) else found)
         parts = [
             batch.filter(keep(batch))
-            for batch in handle.iter_batches(columns=head.schema.names, use_threads=False)
+            for batch in found.iter_batches(columns=names, use_threads=False)
         ]
-    except (pa.ArrowException, OSError, ValueError) as error:
-        raise EstaError(f"{where}: not a readable parquet table ({error})") from None
-    return pa.Table.from_batches(parts, schema=head.schema) if parts else head
-
-
-def table_rows(source: TableSource, table: str) -> int | None:
-    """How many rows a parquet table holds, from its footer (None for a demo's tables)."""
-    found = source.open_table(table)
-    if found is None or isinstance(found, pa.Table):
-        return None if found is None else found.num_rows
-    try:
-        handle = pq.ParquetFile(io.BytesIO(found) if isinstance(found, bytes) else found)
+        schema = found.schema_arrow
     except (pa.ArrowException, OSError, ValueError) as error:
         raise EstaError(f"{source.path}: {table}: not a readable parquet table ({error})") from None
-    return int(handle.metadata.num_rows)
+    empty = pa.schema([schema.field(name) for name in names])
+    return pa.Table.from_batches(parts, schema=empty) if parts else empty.empty_table()
+
+
+def _opened(
+    source: TableSource, table: str, columns: Mapping[str, Kind], required: tuple[str, ...]
+) -> tuple[pq.ParquetFile | pa.Table, list[str]]:
+    """The table, opened (its data not yet read), and the names of the columns it has of
+    `columns`, checked: every required one there, each of the kind it should hold."""
+    where = f"{source.path}: {table}"
+    found = source.open_table(table)
+    if found is None:
+        raise EstaError(f"{source.path}: no {table} table (awpy writes one; is this awpy data?)")
+    try:
+        opened = (
+            found
+            if isinstance(found, pa.Table)
+            else pq.ParquetFile(io.BytesIO(found) if isinstance(found, bytes) else found)
+        )
+        schema = opened.schema if isinstance(opened, pa.Table) else opened.schema_arrow
+    except (pa.ArrowException, OSError, ValueError) as error:
+        raise EstaError(f"{where}: not a readable parquet table ({error})") from None
+    names = [c for c in columns if c in schema.names]
+    missing = [c for c in required if c not in names]
+    if missing:
+        raise EstaError(f"{where}: no column {', '.join(missing)}")
+    for name in names:
+        kind = columns[name]
+        if not _CHECKS[kind](schema.field(name).type):
+            raise EstaError(
+                f"{where}: column {name} holds {schema.field(name).type}, not {kind} values"
+            )
+    return opened, names
+
+
+def table_rows(source: TableSource, table: str) -> int:
+    """How many rows a table holds (a parquet file's from its footer)."""
+    opened, _ = _opened(source, table, {}, ())
+    return opened.num_rows if isinstance(opened, pa.Table) else int(opened.metadata.num_rows)
 
 
 def _folder(path: Path) -> TableSource:

@@ -64,13 +64,15 @@ def _write(table: dict[str, pa.Array]) -> bytes:
 
 def _tick_rows(rounds: list[Round], *, every: int = 0) -> dict[str, np.ndarray]:
     """One row per player present per kept tick (each frame's, or with `every` one every
-    `every` ticks between frames, positions interpolated): the long form both layouts share."""
+    `every` ticks from the round's start, freeze time included as awpy's tick tables hold it,
+    positions interpolated between frames): the long form both layouts share."""
     out: dict[str, list[np.ndarray]] = {k: [] for k in ("tick", "player", "round", "frame")}
     xyz: list[np.ndarray] = []
     for r_index, round_ in enumerate(rounds):
         ticks = round_.frame_ticks
         if every:
-            fine = np.arange(ticks[0], ticks[-1] + 1, every, dtype=np.int64)
+            start = int(round_.clock.zero_tick) - FREEZE_TICKS if round_.clock else ticks[0]
+            fine = np.arange(start, ticks[-1] + 1, every, dtype=np.int64)
             frame = np.clip(np.searchsorted(ticks, fine, side="right") - 1, 0, len(ticks) - 1)
         else:
             fine, frame = ticks, np.arange(len(ticks))
