@@ -455,3 +455,44 @@ def test_the_page_works_copied_alone_elsewhere(browser: Browser, run: Path, tmp_
     _set_slider(browser, 25)
     assert browser.console_errors() == []
     assert _clock(browser) == pytest.approx(25.0)
+
+
+def test_a_rounds_smokes_and_fires_are_in_its_trace(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from decoy_cli.replay import ReplayOptions, replay_round
+    from decoy_cli.replay.view_trace import round_trace
+    from decoy_cli.sim.utility import SMOKE_RADIUS_M
+    from decoy_cli.waypoints.build import builtin_graph
+
+    round_ = read_match(next(SAMPLE.glob("*.json.xz"))).rounds[0]
+    smoke = pd.DataFrame(
+        {"start_tick": [0.0], "end_tick": [1.0], "start_s": [5.0], "end_s": [20.0],
+         "x_m": [10.0], "y_m": [20.0], "z_m": [0.0], "thrower_name": ["T-1"],
+         "thrower_side": ["T"], "thrower_steamid": pd.array([11], dtype="Int64")}
+    )  # fmt: skip
+    smoked = replace(round_, smokes=smoke)
+    result = replay_round(smoked, builtin_graph(), ReplayOptions(combat=False, bomb=False))
+    trace = round_trace(smoked, result)
+    assert trace.utility == [[500, 2000, "smoke", 100, 200, round(SMOKE_RADIUS_M * 10)]]
+
+
+@needs_browser
+def test_an_active_smoke_is_drawn(browser: Browser, replay_folder: Path, tmp_path: Path) -> None:
+    pictures = []
+    for utility in ([], [[2000, 4000, "smoke", 0, 0, 316]]):
+        out = tmp_path / f"replay{len(utility)}"
+        shutil.copytree(replay_folder, out)
+        trace = json.loads((out / "trace.json").read_text())
+        trace["utility"] = utility
+        (out / "trace.json").write_text(json.dumps(trace))
+        assert runner.invoke(app, ["view", str(out)]).exit_code == 0
+        browser.open(out / "view.html")
+        shots = []
+        for seconds in (10, 30):  # before the smoke, and while it is there
+            _set_slider(browser, seconds)
+            shots.append(browser.screenshot())
+        assert browser.console_errors() == []
+        pictures.append(shots)
+    assert pictures[1][0] == pictures[0][0]  # not yet: the same picture
+    assert pictures[1][1] != pictures[0][1]  # active: drawn

@@ -70,6 +70,10 @@ class RoundTrace(msgspec.Struct, frozen=True):
     """The first and last data frame (centiseconds)."""
     players: list[PlayerTrace]
     events: list[RoundEvent]
+    utility: list[list[int | str]] = []
+    """The data's smokes and fires with a window: [start, end (centiseconds), "smoke" or
+    "fire", x, y, radius (decimetres)], drawn while active (decoy_cli/sim/utility.py's
+    sizes)."""
 
 
 def thin(times: np.ndarray, points: np.ndarray, tolerance: float = THIN_M) -> np.ndarray:
@@ -164,7 +168,31 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
     events += _data_bomb(round_, result, seconds, original) + _replay_bomb(result, seconds)
     events.sort(key=lambda e: (e.t, e.source, e.kind))
     start, end = (round(float(seconds[i]) * CS) for i in (0, -1)) if len(seconds) else (0, 0)
-    return RoundTrace(round_.map_name, start, end, players, events)
+    return RoundTrace(round_.map_name, start, end, players, events, _utility(round_))
+
+
+def _utility(round_: Round) -> list[list[int | str]]:
+    """The round's smokes and fires as `RoundTrace.utility` rows."""
+    from decoy_cli.sim.utility import FIRE_RADIUS_M, SMOKE_RADIUS_M
+
+    rows: list[list[int | str]] = []
+    for kind, table, radius in (
+        ("smoke", round_.smokes, SMOKE_RADIUS_M),
+        ("fire", round_.fires, FIRE_RADIUS_M),
+    ):
+        whole = table[np.isfinite(table["start_s"]) & np.isfinite(table["end_s"])]
+        for row in whole.itertuples():
+            rows.append(
+                [
+                    round(row.start_s * CS),
+                    round(row.end_s * CS),
+                    kind,
+                    round(row.x_m * DM),
+                    round(row.y_m * DM),
+                    round(radius * DM),
+                ]
+            )
+    return rows
 
 
 def _event(t: float, source: str, kind: str, player: int, other: int, where: object) -> RoundEvent:

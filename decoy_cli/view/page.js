@@ -56,7 +56,10 @@
     }));
     let end = round.end / 100;
     for (const e of events) end = Math.max(end, e.t);
-    round.decoded = { players, events, start: round.start / 100, end };
+    const utility = (round.utility || []).map((u) => ({
+      start: u[0] / 100, end: u[1] / 100, kind: u[2], x: u[3] / 10, y: u[4] / 10, r: u[5] / 10,
+    }));
+    round.decoded = { players, events, utility, start: round.start / 100, end };
     return round.decoded;
   }
 
@@ -184,6 +187,17 @@
     return bomb;
   }
 
+  // The data's smokes and fires active at time t: grey and orange discs of their sizes.
+  function drawUtility(r, t) {
+    for (const u of r.utility) {
+      if (t < u.start || t >= u.end) continue;
+      ctx.beginPath();
+      ctx.arc(px(u.x), py(u.y), Math.abs(px(u.x + u.r) - px(u.x)), 0, 2 * Math.PI);
+      ctx.fillStyle = u.kind === "smoke" ? "rgba(128, 128, 128, 0.45)" : "rgba(230, 110, 20, 0.35)";
+      ctx.fill();
+    }
+  }
+
   function drawBomb(bomb, hollow) {
     if (!bomb) return;
     const x = px(bomb.x), y = py(bomb.y), s = bomb.planted || bomb.defused ? 8 : 5;
@@ -204,6 +218,7 @@
     const t = state.t;
     const showReal = $("show-real").checked, showReplay = $("show-replay").checked;
     ctx.drawImage(floor, 0, 0);
+    drawUtility(r, t);
     const where = positionsAt(r, t);
     ctx.lineWidth = 1.5;
     r.players.forEach((p, i) => {
