@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError, OutputError
+from decoy_cli.reading import load_json
 from decoy_cli.text import csv_inert
 
 JsonValue: TypeAlias = "str | int | float | bool | list[JsonValue] | dict[str, JsonValue] | None"
@@ -139,14 +140,12 @@ def write_json(path: str | Path, data: object, *, sort_keys: bool = True) -> Pat
 
 
 def read_json_object(path: Path, written_by: str) -> JsonObject:
-    """The JSON object a command wrote to `path` (`written_by`: "`decoy replay`", ...); a
-    missing, unreadable or other file is one DecoyError line saying so."""
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DecoyError(f"{path}: not found (is {path.parent} a {written_by} output?)") from None
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        raise DecoyError(f"{path}: not readable JSON ({str(error).splitlines()[0]})") from None
+    """The JSON object a command wrote to `path` (`written_by`: "`decoy replay`", ...), read
+    through the checked loader (`decoy_cli.reading.load_json`: bounded size and depth, finite
+    numbers); a missing, unreadable or other file is one DecoyError line saying so."""
+    if not path.exists():
+        raise DecoyError(f"{path}: not found (is {path.parent} a {written_by} output?)")
+    data = load_json(path)
     if not isinstance(data, dict):
         raise DecoyError(f"{path}: not written by {written_by}")
     return data

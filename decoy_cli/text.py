@@ -12,7 +12,10 @@ and report, the CSV writer), not where it is read, so the data itself stays as r
 * `md_inline` and `md_code`: a string for Markdown text or a code span;
 * `csv_inert`: a table whose text cells cannot start a formula (a leading `'`, the common
   convention, before `=`, `+`, `-`, `@`, tab or carriage return) and hold no control
-  character; numbers, and text that reads as a number, are left as they are.
+  character; numbers, and text that reads as a number, are left as they are;
+* `shortened`: a text cut to a length with a marker (`CUT_MARK`), so that a name of any length
+  takes a bounded place where it is shown (`NAME_LIMIT` for names: figures, terminal tables,
+  the page); CSV files keep it in full.
 """
 
 from __future__ import annotations
@@ -27,6 +30,11 @@ _MARKDOWN = re.compile(r"([\\`*_\[\]<>|~&])")
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 """What a spreadsheet reads as the start of a formula (OWASP's CSV injection list)."""
+CUT_MARK = "…"
+"""Ends a text `shortened` cut."""
+NAME_LIMIT = 40
+"""Characters of a name (a player's, a match id) shown where it is drawn: more than Steam's
+32-character names, so a real name is shown whole."""
 
 
 def visible(text: str, keep: str = "") -> str:
@@ -35,6 +43,12 @@ def visible(text: str, keep: str = "") -> str:
     if not _CONTROLS.search(text):
         return text
     return _CONTROLS.sub(lambda m: m[0] if m[0] in keep else _escape(m[0]), text)
+
+
+def shortened(text: str, limit: int = NAME_LIMIT) -> str:
+    """`text` when it has at most `limit` characters, else its first `limit` - 1 and
+    `CUT_MARK` (`limit` characters in all)."""
+    return text if len(text) <= limit else text[: max(limit - 1, 0)] + CUT_MARK
 
 
 def _escape(char: str) -> str:

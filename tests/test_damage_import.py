@@ -292,7 +292,7 @@ def _bad_folder(tmp_path: Path, damage: str) -> Path:
             "(32, 33), a DipNet needs (32, 34)",
         ),
         ("args", "{folder}/dog_args.json: latent_dim = 16; decoy imports the published"),
-        ("bad-args", "{folder}/dip_args.json: not a readable args JSON"),
+        ("bad-args", "{folder}/dip_args.json: not readable JSON"),
     ],
 )
 def test_bad_checkpoints_are_one_error_line(tmp_path: Path, damage: str, message: str) -> None:

@@ -199,7 +199,7 @@ def _edit_json(path: Path, **changes: object) -> None:
         ("no-folder", "no such model folder"),
         ("no-json", "no dip.json (a model folder holds dip.pt and dip.json)"),
         ("no-weights", "dip.pt: no such file"),
-        ("bad-json", "not JSON (Expecting value, line 1)"),
+        ("bad-json", "not readable JSON (Expecting value, line 1)"),
         ("foreign-json", "not a decoy damage-model description"),
         ("version", "format version 99, this decoy reads version 1"),
         ("kind", "describes a 'dog' model, not dip"),

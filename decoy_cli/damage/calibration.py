@@ -166,12 +166,22 @@ class Calibration:
     @classmethod
     def from_json(cls, text: str) -> Calibration:
         """A calibration written by `to_json`; anything else is a ValueError."""
-        data = json.loads(text)
+        return cls.from_dict(json.loads(text))
+
+    @classmethod
+    def from_dict(cls, data: object) -> Calibration:
+        """A calibration as `to_json` writes it, already parsed; anything else (a field
+        missing, not a number, not finite, a threshold outside [0, 1]) is a ValueError naming
+        the field."""
         if not isinstance(data, dict) or data.get("kind") not in KINDS:
             kind = data.get("kind") if isinstance(data, dict) else None
             raise ValueError(f"not a DIP calibration: kind {kind!r}")
         if not all(k in data for k in ("a", "b", "threshold")):
             raise ValueError("a DIP calibration needs a, b and threshold")
+        for key in ("a", "b", "threshold"):
+            value = data[key]
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"{key} must be a number, not {type(value).__name__}")
         a, b, threshold = (float(data[k]) for k in ("a", "b", "threshold"))
         if not all(math.isfinite(v) for v in (a, b, threshold)) or not 0 <= threshold <= 1:
             raise ValueError("a DIP calibration with non-finite parameters or threshold")

@@ -18,7 +18,6 @@ are written atomically, the weights before the JSON that describes them.
 from __future__ import annotations
 
 import io
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,7 +29,8 @@ from decoy_cli.damage.calibration import CALIBRATION_FILE, Calibration
 from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
-from decoy_cli.files import JsonObject, JsonValue, json_text, object_at, write_atomic
+from decoy_cli.files import JsonObject, json_text, object_at, write_atomic
+from decoy_cli.reading import load_json
 
 FORMAT = "decoy-damage-model"
 FORMAT_VERSION = 1
@@ -149,11 +149,12 @@ def load_dip(folder: str | Path) -> LoadedDip:
 def load_calibration(folder: Path) -> Calibration | None:
     """The folder's DIP calibration, None without one; an unreadable one is a ModelError."""
     path = folder / CALIBRATION_FILE
-    if not path.is_file():
+    if not path.exists():
         return None
+    data = load_json(path, ModelError)
     try:
-        return Calibration.from_json(path.read_text())
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
+        return Calibration.from_dict(data)
+    except ValueError as error:
         raise ModelError(f"{path}: not a DIP calibration ({error})") from None
 
 
@@ -178,16 +179,11 @@ def _load(folder: Path, kind: str) -> tuple[JsonObject, dict[str, torch.Tensor]]
     if not folder.is_dir():
         raise ModelError(f"{folder}: no such model folder")
     path = folder / f"{kind}.json"
-    if not path.is_file():
+    if not path.exists():
         raise ModelError(
             f"{folder}: no {kind}.json (a model folder holds {kind}.pt and {kind}.json)"
         )
-    try:
-        description: JsonValue = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as error:
-        raise ModelError(f"{path}: cannot read: {error}") from None
-    except json.JSONDecodeError as error:
-        raise ModelError(f"{path}: not JSON ({error.msg}, line {error.lineno})") from None
+    description = load_json(path, ModelError)
     if not isinstance(description, dict) or description.get("format") != FORMAT:
         raise ModelError(f"{path}: not a decoy damage-model description")
     if description.get("format_version") != FORMAT_VERSION:

@@ -11,13 +11,14 @@ per step) name no place, but were still measured on these maps only.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.damage.rules_model import RULES_FILE
+from decoy_cli.errors import DecoyError
+from decoy_cli.reading import load_json
 
 
 @dataclass(frozen=True)
@@ -48,13 +49,16 @@ def trained_maps(folder: Path, part: str) -> list[str] | None:
     file does not say (or cannot be read: loading it reports that)."""
     path = part_file(folder, part)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-        maps = data["provenance" if part == "rules" else "metadata"]["maps"]
-    except (OSError, ValueError, KeyError, TypeError):
+        data = load_json(path)
+    except DecoyError:
         return None
-    if not isinstance(maps, list) or not all(isinstance(m, str) for m in maps):
+    key = "provenance" if part == "rules" else "metadata"
+    section = data.get(key) if isinstance(data, dict) else None
+    maps = section.get("maps") if isinstance(section, dict) else None
+    if not isinstance(maps, list):
         return None
-    return sorted(maps)
+    names = [m for m in maps if isinstance(m, str)]
+    return sorted(names) if len(names) == len(maps) else None
 
 
 def map_warnings(choice: ModelChoice, maps: Iterable[str]) -> list[str]:

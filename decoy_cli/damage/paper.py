@@ -25,7 +25,6 @@ Features: the paper's raw Hammer-unit features (`FeatureSpec(units="hammer")`); 
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -41,7 +40,8 @@ from decoy_cli.damage.model_folder import (
 )
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
-from decoy_cli.files import JsonObject, JsonValue
+from decoy_cli.files import JsonObject
+from decoy_cli.reading import load_json
 
 PAPER_HIT_GROUPS = ("Head", "Neck", "Stomach", "Chest", "Arm", "Leg")
 """The hit-group order of the paper's DOG."""
@@ -138,12 +138,9 @@ def _read_checkpoint(path: Path, kind: str) -> tuple[ImportedModel, dict[str, to
 def read_args(path: Path, kind: str) -> JsonObject | None:
     """The training options of a checkpoint (None without the file); a ModelError when they
     name another architecture than the one imported."""
-    if not path.is_file():
+    if not path.exists():
         return None
-    try:
-        args: JsonValue = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise ModelError(f"{path}: not a readable args JSON ({error})") from None
+    args = load_json(path, ModelError)
     if not isinstance(args, dict):
         raise ModelError(f"{path}: args must be a JSON object")
     for key, wanted in _EXPECTED_ARGS[kind].items():

@@ -23,11 +23,10 @@ that vocabulary (a test checks), so a knife, grenade, Zeus or C4 never hits here
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -38,6 +37,7 @@ from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
 from decoy_cli.esta import Round
 from decoy_cli.files import write_json
+from decoy_cli.reading import load_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
@@ -125,8 +125,11 @@ class RulesFile:
     def load(cls, folder: Path) -> RulesFile:
         """The folder's `rules.json`; a missing or unreadable one is one ModelError line."""
         path = Path(folder) / RULES_FILE
+        document = load_json(path, ModelError)
+        if not isinstance(document, dict):
+            raise ModelError(f"{path}: not a rules file (not a JSON object)")
+        data: dict[str, Any] = document
         try:
-            data = json.loads(path.read_text())
             hit_groups = HitGroupModel.from_dict(data["hit_groups"])
             bullets = BulletCounts.from_dict(data["bullets"])
             hurt = data.get("bullets_hurt")
@@ -137,9 +140,7 @@ class RulesFile:
             provenance = dict(data.get("provenance", {}))
             through = data.get("penetration", {"hits": 0, "shares": []})
             penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
-        except OSError as error:
-            raise ModelError(f"{path}: cannot read ({error.strerror or error})") from None
-        except (ValueError, KeyError, TypeError, AttributeError) as error:
+        except (ValueError, KeyError, TypeError, AttributeError, OverflowError) as error:
             raise ModelError(f"{path}: not a rules file ({error})") from None
         if not (0 <= len(penetration.shares) <= penetration.hits) or not all(
             0.0 <= v <= 1.0 for v in penetration.shares

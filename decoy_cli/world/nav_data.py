@@ -6,16 +6,17 @@ assets.
 from __future__ import annotations
 
 import csv
-import json
 from dataclasses import dataclass, field, replace
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.package_data import packaged_dir
+from decoy_cli.reading import load_json
 
 REGIONS = ("t_spawn", "ct_spawn", "bombsite_a", "bombsite_b")
 """Regions the simulator and the replay use; each map's `map.json` names the nav places of each
@@ -112,7 +113,7 @@ def read_navmesh(folder: Path) -> NavMesh:
             rows = list(csv.DictReader(f))
         with open(folder / "nav_connections.csv", newline="") as f:
             links = list(csv.DictReader(f))
-        meta = json.loads((folder / "map.json").read_text())
+        meta: Any = load_json(folder / "map.json", WorldError)
         regions = {region: tuple(meta["regions"][region]) for region in REGIONS}
         radar = {key: float(meta["radar"][key]) for key in ("pos_x", "pos_y", "scale")}
     except (OSError, UnicodeDecodeError, csv.Error, ValueError, KeyError, TypeError) as error:

@@ -1,0 +1,60 @@
+"""Hostile edits of a `decoy evaluate` run's files (issue 51), read by `decoy view` and
+`decoy compare`: each is one `error:` line naming the file (and the column or field), never the
+bug line (exit 2), and nothing the run's files name is a place on disk to read.
+
+One `decoy evaluate` of a small match serves the module; each test edits a copy of it."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from esta_fixtures import make_match, write_match
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.reading import MAX_JSON_DEPTH
+
+runner = CliRunner()
+
+
+def one_error(result) -> str:
+    """The `error:` line of a command that failed on bad input (exit 1, no bug line)."""
+    assert result.exit_code == 1, result.output
+    assert "Traceback" not in result.output and "internal error" not in result.output
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: "), result.stderr
+    return result.stderr.strip()
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("run")
+    (folder / "in").mkdir()
+    write_match(folder / "in" / "m.json", make_match())
+    out = folder / "evaluate"
+    result = runner.invoke(
+        app, ["evaluate", str(folder / "in"), "--no-combat", "--no-view", "--out", str(out)]
+    )
+    # exit 1: the fixture's round without frames is a recorded failure
+    assert result.exit_code == 1 and (out / "rounds.csv").is_file(), result.output
+    return out
+
+
+@pytest.fixture
+def copy(run: Path, tmp_path: Path) -> Path:
+    return Path(shutil.copytree(run, tmp_path / "run"))
+
+
+def view(folder: Path):
+    return runner.invoke(app, ["view", str(folder), "--out", str(folder / "page.html")])
+
+
+def test_deep_json_in_summary_json_is_one_error_line(copy: Path) -> None:
+    summary = copy / "summary.json"
+    data = json.loads(summary.read_text())
+    summary.write_text(json.dumps(data)[:-1] + ', "deep": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    line = one_error(view(copy))
+    assert f"{summary}: JSON nested deeper than {MAX_JSON_DEPTH} levels" in line
+    assert not (copy / "page.html").exists()
