@@ -527,3 +527,133 @@ def test_a_smoke_without_an_end_and_a_blind_of_negative_duration_are_named(
     assert any("a smoke bursting at tick" in w and "no end" in w for w in round_.warnings)
     assert any("lasts -1.0 s: left out" in w for w in round_.warnings)
     assert np.isnan(round_.smokes["end_s"]).all() and len(round_.flashes) == 0
+
+
+# --- a hostile battery's classes (each was a bug line, a hang or silent garbage) ----------------
+
+
+def _rezip(path: Path, members: list[tuple[zipfile.ZipInfo | str, bytes]]) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for info, data in members:
+            archive.writestr(info, data)
+    return path
+
+
+def _members(path: Path) -> dict[str, bytes]:
+    with zipfile.ZipFile(path) as archive:
+        return {name: archive.read(name) for name in archive.namelist()}
+
+
+def test_damaged_zip_members_are_one_error_line(tmp_path: Path) -> None:
+    members = _members(write_awpy2_zip(_sample(), tmp_path / "good.zip"))
+    corrupt = tmp_path / "corrupt.zip"
+    _rezip(corrupt, list(members.items()))
+    raw = bytearray(corrupt.read_bytes())
+    start = raw.find(b"header.json") + len(b"header.json")  # the header's deflated bytes
+    raw[start : start + 8] = b"\xff" * 8
+    corrupt.write_bytes(bytes(raw))
+    with pytest.raises(EstaError, match=r"header\.json cannot be read"):
+        read_match(corrupt)
+    with pytest.warns(UserWarning, match="Duplicate name"):  # zipfile writes it anyway
+        twice = _rezip(tmp_path / "twice.zip", [*members.items(), ("header.json", b"{}")])
+    with pytest.raises(EstaError, match=r"holds header\.json twice"):
+        read_match(twice)
+
+
+@pytest.mark.parametrize(
+    ("header", "said"),
+    [
+        ('{"map_name": ""}', "names no map"),
+        ('{"map_name": "de_dust2", "map_name": "de_mirage"}', "'map_name' is given twice"),
+        ('{"map_name": "de_dust2", "playback_ticks": 6400, "playback_time": 0}', "playback_time"),
+        ('{"map_name": "de_dust2", "playback_ticks": NaN, "playback_time": 100}', "playback_ticks"),
+        ('{"map_name": "de_dust2", "playback_ticks": "6400", "playback_time": 100}', "playback_t"),
+        ('{"map_name": "de_dust2", "tick_rate": 1' + "0" * 400 + "}", "tick_rate"),
+    ],
+)
+def test_bad_headers_are_named(folder: Path, header: str, said: str) -> None:
+    (folder / "header.json").write_text(header)
+    with pytest.raises(EstaError, match=said):
+        read_match(folder)
+
+
+def test_a_header_rate_the_rules_deny_is_said(tmp_path: Path) -> None:
+    path = write_awpy2_zip(_sample(), tmp_path / "m.zip")  # 128 tick: two bomb timers say so
+    members = _members(path)
+    header = json.loads(members["header.json"]) | {"tick_rate": 64}  # a header saying 64
+    _rezip(path, [*((k, v) for k, v in members.items() if k != "header.json"),
+                  ("header.json", json.dumps(header).encode())])  # fmt: skip
+    match = read_match(path)
+    assert match.tick_rate == 64 and "they deny 64 (warning)" in match.meta["tick_rate_rule"]
+
+
+@pytest.mark.parametrize(
+    ("table", "column", "value", "said"),
+    [
+        ("rounds", "start_tick", -1_000_000, "rounds: start -1000000 is not a tick"),
+        ("snapshots", "tick", float("inf"), "snapshots: a row's tick inf"),
+        ("kills", "tick", 1e30, "kills: a row's tick 1e\\+30"),
+    ],
+)
+def test_ticks_no_demo_has_are_named(
+    folder: Path, table: str, column: str, value: float, said: str
+) -> None:
+    def edit(data: pa.Table) -> pa.Table:
+        values = data[column].to_pylist()
+        values[0] = value
+        return data.set_column(data.schema.get_field_index(column), column, pa.array(values))
+
+    _edit_table(folder, table, edit)
+    with pytest.raises(EstaError, match=said):
+        read_match(folder)
+
+
+def test_a_round_longer_than_any_game_fails_by_name(folder: Path) -> None:
+    def stretch(data: pa.Table) -> pa.Table:
+        ticks = data["tick"].to_numpy().copy()
+        ticks[ticks == ticks.max()] += 128 * 700  # 700 s after the rest
+        return data.set_column(0, "tick", pa.array(ticks, pa.int32()))
+
+    _edit_table(folder, "snapshots", stretch)
+
+    def later_end(data: pa.Table) -> pa.Table:
+        ends = data["end_tick"].to_numpy().copy()
+        ends[-1] += 128 * 700
+        index = data.schema.get_field_index("end_tick")
+        data = data.set_column(index, "end_tick", pa.array(ends, pa.int32()))
+        return data.set_column(
+            data.schema.get_field_index("official_end_tick"), "official_end_tick",
+            pa.array(ends, pa.int32()),
+        )  # fmt: skip
+
+    _edit_table(folder, "rounds", later_end)
+    match = read_match(folder)
+    assert "is not within 600 s of freeze-time end" in str(match.round_errors[2])
+
+
+def test_unknown_bomb_events_yaw_and_impossible_damage_are_named(folder: Path) -> None:
+    def teleport(data: pa.Table) -> pa.Table:
+        events = data["event"].to_pylist()
+        events[0] = "teleport"
+        return data.set_column(1, "event", pa.array(events, pa.large_string()))
+
+    _edit_table(folder, "bomb", teleport)
+    assert any("unknown bomb event 'teleport'" in w for w in read_match(folder).round(1).warnings)
+
+    def spin(data: pa.Table) -> pa.Table:
+        yaw = data["yaw"].to_numpy().copy()
+        yaw[-1] = np.inf
+        return data.set_column(data.schema.get_field_index("yaw"), "yaw", pa.array(yaw))
+
+    _edit_table(folder, "snapshots", spin)
+    assert "is not a view angle" in str(read_match(folder).round_errors[2])
+
+    def huge(data: pa.Table) -> pa.Table:
+        pre = data["health_pre"].to_numpy().copy()
+        pre[0] = 10**9
+        return data.set_column(
+            data.schema.get_field_index("health_pre"), "health_pre", pa.array(pre)
+        )
+
+    _edit_table(folder, "damages", huge)
+    assert "HP (a player has 100)" in str(read_match(folder).round_errors[1])

@@ -102,7 +102,7 @@ def build_frames(
     zero_tick = round_clock_zero(written, ticks, tick_rate, freeze_end_tick, start_tick)
     clock = None if zero_tick is None else RoundClock(zero_tick, tick_rate)
     seconds = clock.seconds(ticks) if clock is not None else np.zeros(0)
-    _check_clock(seconds, ticks)
+    check_clock(seconds, ticks)
     _check_written_seconds(written, seconds, ticks)
     bomb_position = _bomb_position(frames, ticks)
     players, arrays = _players(frames, ticks)
@@ -186,7 +186,7 @@ MAX_PLAYERS = 64
 frames) arrays."""
 
 
-def _check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
+def check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
     """Frame times (non-decreasing, as the ticks are) must be finite and within `MAX_ROUND_S`
     of freeze-time end."""
     bad = ~np.isfinite(seconds) | (np.abs(seconds) > MAX_ROUND_S)

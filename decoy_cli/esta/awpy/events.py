@@ -9,10 +9,20 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.esta.awpy.names import bomb_action, bomb_site, hit_group, side_name, weapon_name
+from decoy_cli.esta.awpy.names import (
+    CARRIER_EVENTS,
+    bomb_action,
+    bomb_site,
+    hit_group,
+    side_name,
+    weapon_name,
+)
 from decoy_cli.esta.frames import RoundClock
 from decoy_cli.esta.reader import UTILITY_COLUMNS, empty_utility
-from decoy_cli.esta.schema import BombEvent, DamageEvent, FlashEvent, KillEvent
+from decoy_cli.esta.schema import BombEvent, DamageEvent, FlashEvent, Invalid, KillEvent
+
+MAX_HP = 100
+"""A player's health at most (the game's)."""
 
 
 def round_events(
@@ -28,7 +38,7 @@ def round_events(
     """A round's kills, damages and bomb events (its rows of awpy's tables, in tick order) as
     ESTA event structs; `ticks` are the round's tick rows (a defuse's start, `_defuse_starts`)
     and `plant_site` the rounds table's site of its plant."""
-    bomb_rows = [_bomb_event(row, plant_site) for row in _records(bomb)]
+    bomb_rows = [_bomb_event(row, plant_site, warnings) for row in _records(bomb)]
     return {
         "kills": [KillEvent(**_kill(row, warnings)) for row in _records(kills)],
         "damages": [DamageEvent(**_damage(row, warnings)) for row in _records(damages)],
@@ -209,6 +219,9 @@ def _kill(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
 
 
 def _damage(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
+    taken = row.get("dmg_health_taken")
+    if taken is not None and not 0 <= float(taken) <= MAX_HP:  # type: ignore[arg-type]
+        raise Invalid(f"the damage at tick {row['tick']} takes {taken} HP (a player has {MAX_HP})")
     attacker = _player(row, "attacker", "attacker")
     victim = _player(row, "victim", "victim")
     return {
@@ -238,11 +251,15 @@ def _distance(row: dict[str, object]) -> float | None:
     return float(np.linalg.norm(a - b))
 
 
-def _bomb_event(row: dict[str, object], plant_site: str) -> dict[str, object] | None:
+def _bomb_event(
+    row: dict[str, object], plant_site: str, warnings: list[str]
+) -> dict[str, object] | None:
     """A bomb event as ESTA writes it (the plant's site is the round's where the row names a
     place, as awpy 2 does); None for the events ESTA has no name for (drop, pick-up)."""
     action = bomb_action(row.get("event"))
     if action is None:
+        if row.get("event") not in CARRIER_EVENTS:
+            warnings.append(f"unknown bomb event {row.get('event')!r:.40} at tick {row['tick']}")
         return None
     site = bomb_site(row.get("site")) or (plant_site if action == "plant" else "")
     return {

@@ -54,19 +54,16 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
     source = open_source(path, rate)
     layout = LAYOUTS[source.layout]
     map_name = source.header.get("map_name")
-    if not isinstance(map_name, str):
-        raise EstaError(f"{path}: header.json names no map (map_name {map_name!r})")
+    if not isinstance(map_name, str) or not map_name.strip():
+        raise EstaError(f"{path}: header.json names no map (map_name {map_name!r:.60})")
     bomb = _frame(source, layout.bomb)
     rounds = _rounds(source, layout, bomb)
     windows = round_windows(path, rounds)
     tick_rate, rule = _tick_rate(source, windows, bomb)
     ticks_only = read_table(source, layout.ticks.name, {"tick": "int"}, ("tick",))
-    tick_values = ticks_only["tick"].to_numpy(zero_copy_only=False)
-    if len(tick_values) > MAX_TICK_ROWS:
-        raise EstaError(f"{path}: {len(tick_values):,} tick rows, more than {MAX_TICK_ROWS:,}")
-    if pd.isna(tick_values).any():
-        raise EstaError(f"{path}: {layout.ticks.name}: a row has no tick")
-    tick_values = tick_values.astype(np.int64)
+    if ticks_only.num_rows > MAX_TICK_ROWS:
+        raise EstaError(f"{path}: {ticks_only.num_rows:,} tick rows, more than {MAX_TICK_ROWS:,}")
+    tick_values = _ticks(path, layout.ticks.name, ticks_only["tick"].to_pandas())
     owner = assign_rounds(tick_values, windows)
     if owner.size and (owner < 0).all():
         raise EstaError(
@@ -123,26 +120,44 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
 def _tick_rate(
     source: TableSource, windows: list[RoundWindow], bomb: pd.DataFrame
 ) -> tuple[int, str]:
-    """The demo's tick rate and where it comes from (module docstring)."""
+    """The demo's tick rate and where it comes from (module docstring); header values that
+    are not positive numbers raise, and a header rate the rules' spans deny is said."""
     header = source.header
-    ticks, seconds = header.get("playback_ticks"), header.get("playback_time")
-    if _number(ticks) and _number(seconds) and float(seconds) > 0:  # type: ignore[arg-type]
-        rate = float(ticks) / float(seconds)  # type: ignore[arg-type]
-        return _checked_rate(source.path, rate), "the header's playback_ticks / playback_time"
-    given = header.get("tick_rate")
-    if given is not None:
-        if not _number(given):
-            raise EstaError(f"{source.path}: header.json tick_rate {given!r} is not a number")
-        return _checked_rate(source.path, float(given)), "the header's tick_rate"  # type: ignore[arg-type]
     spans = _rule_spans(windows, bomb)
-    if not spans:
+    measured = float(np.median(spans)) if spans else None
+    if header.get("playback_ticks") is not None or header.get("playback_time") is not None:
+        ticks = _header_number(source, "playback_ticks")
+        seconds = _header_number(source, "playback_time")
+        rate, rule = _checked_rate(source.path, ticks / seconds), "the header's playback"
+    elif header.get("tick_rate") is not None:
+        rate = _checked_rate(source.path, _header_number(source, "tick_rate"))
+        rule = "the header's tick_rate"
+    elif measured is None:
         return CS2_TICK_RATE, "the header gives none, nor a round timed by the rules: CS2's 64"
-    measured = float(np.median(spans))
-    rate = min(KNOWN_TICK_RATES, key=lambda known: abs(math.log(measured / known)))
-    return rate, (
-        f"the header gives none: {len(spans)} span(s) the rules time (bomb timer "
-        f"{BOMB_TIMER_S:g} s, round time {ROUND_TIME_S:g} s) measure {measured:.1f} ticks/s"
-    )
+    else:
+        rate = min(KNOWN_TICK_RATES, key=lambda known: abs(math.log(measured / known)))
+        rule = "the header gives none"
+    if measured is not None:
+        nearest = min(KNOWN_TICK_RATES, key=lambda known: abs(math.log(measured / known)))
+        rule += (
+            f"; {len(spans)} span(s) the rules time (bomb timer {BOMB_TIMER_S:g} s, round time "
+            f"{ROUND_TIME_S:g} s) measure {measured:.1f} ticks/s"
+            + ("" if nearest == rate else f": they deny {rate} (warning)")
+        )
+    return rate, rule
+
+
+def _header_number(source: TableSource, key: str) -> float:
+    """A header value that must be a positive finite number."""
+    value = source.header.get(key)
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        number = math.nan
+    is_number = isinstance(value, int | float) and not isinstance(value, bool)
+    if not (is_number and math.isfinite(number) and number > 0):
+        raise EstaError(f"{source.path}: header.json {key} {value!r:.40} is not a positive number")
+    return number
 
 
 def _rule_spans(windows: list[RoundWindow], bomb: pd.DataFrame) -> list[float]:
@@ -163,10 +178,6 @@ def _rule_spans(windows: list[RoundWindow], bomb: pd.DataFrame) -> list[float]:
     return spans
 
 
-def _number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def _checked_rate(path: Path, rate: float) -> int:
     """A tick rate a demo can have: 64 or 128 ticks a second, within 2%."""
     for known in KNOWN_TICK_RATES:
@@ -180,9 +191,26 @@ def _frame(source: TableSource, table: TableLayout) -> pd.DataFrame:
     data = read_table(source, table.name, table.kinds, table.required)
     frame = _to_pandas(data.rename_columns([table.renames[c] for c in data.column_names]))
     _check_parts(source.path, frame, table.name)
-    if "tick" in frame and frame["tick"].isna().any():
-        raise EstaError(f"{source.path}: {table.name}: a row has no tick")
+    for column in ("tick", "start_tick"):
+        if column in frame:
+            frame[column] = _ticks(source.path, table.name, frame[column])
     return frame
+
+
+MAX_TICK = 2**31 - 1
+"""The largest tick a demo can reach (awpy writes ticks as int32)."""
+
+
+def _ticks(path: Path, table: str, values: pd.Series) -> np.ndarray:
+    """A tick column as int64; a null, fractional, negative or out-of-range tick raises."""
+    numbers = pd.to_numeric(values, errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(numbers) | (numbers != np.round(numbers)) | (numbers < 0)
+        bad |= numbers > MAX_TICK
+    if bad.any():
+        shown = values.iloc[int(np.flatnonzero(bad)[0])]
+        raise EstaError(f"{path}: {table}: a row's tick {shown!s:.30} is not a tick of a demo")
+    return numbers.astype(np.int64)
 
 
 def _optional_frame(source: TableSource, table: TableLayout | None) -> pd.DataFrame | None:
@@ -213,7 +241,8 @@ def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataF
         required = column in ("round_num", "start", "freeze_end", "end")
         given = np.ones(len(values), bool) if required else rounds[column].notna().to_numpy()
         with np.errstate(invalid="ignore"):
-            wrong = ~np.isfinite(values) | (values != np.round(values)) | (np.abs(values) > 2**31)
+            wrong = ~np.isfinite(values) | (values != np.round(values)) | (values < 0)
+            wrong |= values > MAX_TICK
         bad = wrong & given
         if bad.any():
             raw = rounds[column].iloc[int(np.flatnonzero(bad)[0])]

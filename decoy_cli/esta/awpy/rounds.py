@@ -42,6 +42,7 @@ from decoy_cli.esta.frames import (
     FrameArrays,
     PlayerRows,
     RoundClock,
+    check_clock,
     player_arrays,
 )
 from decoy_cli.esta.plausibility import Implausible, check_frames
@@ -67,6 +68,8 @@ NOT_RECORDED = {
     "steamid": "steamids",
 }
 """Tick columns a source may lack, by the name a round's `not_recorded` gives them."""
+MAX_YAW = 720.0
+"""Largest |yaw| a view angle can be written as, degrees (awpy writes -180..180 or 0..360)."""
 CARRIER = "bomb carrier"
 UTILITY = "utility (smokes, fires, blinds)"
 """Named not recorded where the match's tables hold no smoke, fire or blind at all: a real
@@ -259,6 +262,7 @@ def _build_round(
     frame = np.searchsorted(kept, raw)
     infos, arrays = player_arrays(_player_rows(rows, frame, tables, warnings), kept)
     seconds = clock.seconds(kept)
+    check_clock(seconds, kept)
     planted = (
         (kept >= window.plant_tick) if window.plant_tick is not None else np.zeros(kept.size, bool)
     )
@@ -348,6 +352,11 @@ def _player_rows(
         bad = sides[int(np.flatnonzero(side == "")[0])]
         raise Invalid(f"a tick row has side {bad!r} (not a team's)")
     position = np.stack([numbers("x"), numbers("y"), numbers("z")], axis=1).reshape(count, 3)
+    yaw = numbers("yaw")
+    with np.errstate(invalid="ignore"):
+        wrong = np.isinf(yaw) | (np.abs(yaw) > MAX_YAW)
+    if wrong.any():
+        raise Invalid(f"a tick row's yaw {yaw[int(np.argmax(wrong))]:g} is not a view angle")
     alive = numbers("is_alive")
     return PlayerRows(
         frame=frame.astype(np.int64),
@@ -357,7 +366,7 @@ def _player_rows(
         side=side,
         position=position,
         located=~np.isnan(position).any(axis=1),
-        yaw=numbers("yaw") % 360.0,
+        yaw=yaw % 360.0,
         hp=numbers("health"),
         armor=numbers("armor"),
         helmet=flags("has_helmet"),

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import io
 import json
+import lzma
 import zipfile
+import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -184,24 +186,49 @@ def _zip(path: Path) -> TableSource:
     """An awpy 2 zip: `<table>.parquet` members and `header.json`."""
     try:
         archive = zipfile.ZipFile(path)
-        members = {info.filename: info for info in archive.infolist()}
+        listed = archive.infolist()
     except (zipfile.BadZipFile, OSError, ValueError) as error:
         raise EstaError(f"{path}: not a readable zip file ({error})") from None
+    members = {info.filename: info for info in listed}
+    if len(members) != len(listed):
+        twice = sorted(
+            {i.filename for i in listed if [j.filename for j in listed].count(i.filename) > 1}
+        )
+        raise EstaError(f"{path}: the zip holds {twice[0]} twice (which is the table?)")
     _check_size(path, sum(info.file_size for info in members.values()))
 
     def member(name: str) -> bytes | None:
         if name not in members:
             return None
         try:
-            return archive.read(name)
-        except (zipfile.BadZipFile, OSError, ValueError, EOFError) as error:
-            raise EstaError(f"{path}: {name} is corrupt ({error})") from None
+            data = archive.read(name)
+        except _MEMBER_ERRORS as error:
+            raise EstaError(f"{path}: {name} cannot be read ({error})") from None
+        if len(data) != members[name].file_size:
+            raise EstaError(
+                f"{path}: {name} holds {len(data):,} bytes, its entry says "
+                f"{members[name].file_size:,} (a damaged zip)"
+            )
+        return data
 
     raw_header = member(HEADER)
     if raw_header is None:
         raise EstaError(f"{path}: no {HEADER} (awpy 2 writes one into its zip)")
     header = _header(path, raw_header)
     return TableSource(path, "awpy 2", header, lambda name: member(f"{name}.parquet"))
+
+
+_MEMBER_ERRORS = (
+    zipfile.BadZipFile,
+    OSError,
+    ValueError,
+    EOFError,
+    RuntimeError,  # an encrypted member
+    NotImplementedError,  # a compression method Python lacks
+    zlib.error,
+    lzma.LZMAError,
+)
+"""What reading a damaged or unusual zip member can raise."""
 
 
 def _check_size(path: Path, size: int) -> None:
@@ -229,9 +256,17 @@ def _header(where: Path, raw: bytes) -> JsonObject:
     if len(raw) > MAX_HEADER_BYTES:
         raise EstaError(f"{where}: {HEADER} is larger than {MAX_HEADER_BYTES:,} bytes")
     try:
-        header = json.loads(raw)
+        header = json.loads(raw, object_pairs_hook=_no_repeated_keys)
     except (ValueError, RecursionError) as error:
         raise EstaError(f"{where}: {HEADER} is not JSON ({error})") from None
     if not isinstance(header, dict):
         raise EstaError(f"{where}: {HEADER} is not a JSON object")
     return header
+
+
+def _no_repeated_keys(pairs: list[tuple[str, object]]) -> dict[str, object]:
+    """A JSON object; a key given twice raises (which value would be the header's?)."""
+    keys = [key for key, _ in pairs]
+    if len(set(keys)) != len(keys):
+        raise ValueError(f"the key {next(k for k in keys if keys.count(k) > 1)!r} is given twice")
+    return dict(pairs)
