@@ -10,6 +10,7 @@ import json
 import shutil
 from pathlib import Path
 
+import pandas as pd
 import pytest
 from esta_fixtures import make_match, write_match
 from typer.testing import CliRunner
@@ -58,3 +59,39 @@ def test_deep_json_in_summary_json_is_one_error_line(copy: Path) -> None:
     line = one_error(view(copy))
     assert f"{summary}: JSON nested deeper than {MAX_JSON_DEPTH} levels" in line
     assert not (copy / "page.html").exists()
+
+
+def edit_cell(path: Path, column: str, value: str, row: int = 0) -> None:
+    """Write `value` into one cell of the CSV table `path`."""
+    frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+    frame.loc[row, column] = value
+    frame.to_csv(path, index=False)
+
+
+@pytest.mark.parametrize(
+    ("table", "column"),
+    [
+        ("rounds.csv", "seconds"),
+        ("rounds.csv", "round"),
+        ("rounds.csv", "frames"),
+        ("players.csv", "round"),
+        ("players.csv", "mean_dist"),
+        ("players.csv", "late_share"),
+        ("players.csv", "hp_rmse"),
+        ("players.csv", "died_original"),
+        ("tables/places.csv", "mean_error_m"),
+    ],
+)
+def test_a_text_cell_in_a_number_column_is_one_error_line(
+    copy: Path, run: Path, table: str, column: str
+) -> None:
+    edit_cell(copy / table, column, "abc")
+    said = f"{copy / table}: column {column}, data row 1: 'abc' is not"
+    if table != "tables/places.csv":  # the page shows the places table as it is
+        assert said in one_error(view(copy))
+    both = [
+        ["compare", str(a), str(b), "--out", str(copy / "cmp")]
+        for a, b in ((copy, run), (run, copy))
+    ]
+    for args in both:
+        assert said in one_error(runner.invoke(app, args))

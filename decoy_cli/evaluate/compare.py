@@ -24,6 +24,7 @@ import pandas as pd
 
 from decoy_cli.errors import CompareError
 from decoy_cli.evaluate.intervals import round_codes
+from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.metrics import ALL_METRIC_NAMES, METRIC_NAMES
 from decoy_cli.metrics.bootstrap import RoundBootstrap
 
@@ -78,13 +79,11 @@ class Comparison:
 
 
 def _csv(path: Path) -> pd.DataFrame:
-    """A CSV of a run, or a CompareError saying why it cannot be read."""
-    if not path.is_file():
+    """A table of a run, checked (`run_tables.read_run_table`), or a CompareError saying why
+    it cannot be read."""
+    if not path.exists():
         raise CompareError(f"{path}: not found (is {path.parent} a `decoy evaluate` output?)")
-    try:
-        return pd.read_csv(path)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as e:
-        raise CompareError(f"{path}: not a readable CSV ({str(e).splitlines()[0]})") from None
+    return read_run_table(path, CompareError)
 
 
 def read_run(folder: Path) -> Run:
@@ -114,7 +113,7 @@ def read_run(folder: Path) -> Run:
             f"(the first at data row {row + 1}): a truncated or edited file"
         )
     places_file = folder / "tables" / "places.csv"
-    places = _csv(places_file) if places_file.is_file() else None
+    places = _csv(places_file) if places_file.exists() else None
     return Run(folder, players, rounds, places, metrics)
 
 

@@ -14,6 +14,7 @@ import pandas as pd
 from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.compare import read_run
+from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.evaluate.runner import round_id
 from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
@@ -139,12 +140,9 @@ def _tables(folder: Path) -> list[TableSpec]:
     tables = []
     for name, title in TABLES:
         path = folder / "tables" / f"{name}.csv"
-        try:
-            frame = pd.read_csv(path)
-        except FileNotFoundError:
-            raise DecoyError(f"{path}: not found (an incomplete `decoy evaluate` output)") from None
-        except (OSError, pd.errors.ParserError, UnicodeDecodeError, ValueError):
-            raise DecoyError(f"{path}: not a readable CSV") from None
+        if not path.exists():
+            raise DecoyError(f"{path}: not found (an incomplete `decoy evaluate` output)")
+        frame = read_run_table(path)
         if len(frame):
             tables.append(table_spec(title, frame))
     return tables

@@ -13,6 +13,7 @@ import msgspec
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
+from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.output import TRACE_FILE
@@ -43,12 +44,7 @@ def replay_page(folder: Path) -> PageData:
         trace = msgspec.json.decode(trace_path.read_bytes(), type=RoundTrace)
     except (OSError, msgspec.DecodeError) as error:
         raise DecoyError(f"{trace_path}: not a round's trace ({error})") from None
-    try:
-        players = pd.read_csv(folder / "players.csv")
-    except FileNotFoundError:
-        raise DecoyError(f"{folder / 'players.csv'}: not found") from None
-    except (OSError, pd.errors.ParserError, UnicodeDecodeError, ValueError):
-        raise DecoyError(f"{folder / 'players.csv'}: not a readable CSV") from None
+    players = read_run_table(folder / "players.csv")
     metrics = [m for m in ALL_METRIC_NAMES if m in players.columns]
     columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
     missing = [c for c in columns if c not in players.columns]
