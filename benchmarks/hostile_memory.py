@@ -10,8 +10,10 @@ prints per case and command: the exit code, the last line of stderr, the wall ti
 resident memory of the process and its children. Cases: an xz bomb just over the size limit,
 /dev/zero, a document of one million rounds, a round with 100,000 distinct players, a round of
 200,000 frames, the largest round the limits let through, documents that only the `json`
-fallback can read (a NaN) just under its own limit and just under the size limit, and nesting a
-million levels deep.
+fallback can read (a NaN) just under its own limit and just under the size limit, nesting a
+million levels deep, and awpy 3 tables of the synthetic sample whose players' names are each
+100,000 characters long in every tick row (awpy writes a name in every row; parquet stores it
+once).
 """
 
 from __future__ import annotations
@@ -152,6 +154,22 @@ def deep_nesting(folder: Path) -> Path:
     return _write_xz(folder / "deep.json.xz", iter([HEAD, b"[" * depth, b"]" * depth, b"]}"]))
 
 
+def awpy_long_names(folder: Path) -> Path:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from decoy_cli.esta import read_match
+    from decoy_cli.esta.awpy.writer import write_awpy3_folder
+    from decoy_cli.synth.sample import SAMPLE_DIR
+
+    tables = write_awpy3_folder(read_match(next(SAMPLE_DIR.glob("*.json.xz"))), folder / "awpy3")
+    ticks = pq.read_table(tables / "snapshots.parquet")
+    names = pa.array([n + "x" * 100_000 for n in ticks["name"].to_pylist()], pa.large_string())
+    index = ticks.schema.get_field_index("name")
+    pq.write_table(ticks.set_column(index, "name", names), tables / "snapshots.parquet")
+    return tables
+
+
 CASES: dict[str, Callable[[Path], Path]] = {
     "xz_bomb": xz_bomb,
     "dev_zero": dev_zero,
@@ -162,6 +180,7 @@ CASES: dict[str, Callable[[Path], Path]] = {
     "nan_fallback": nan_fallback,
     "nan_large": nan_large,
     "deep_nesting": deep_nesting,
+    "awpy_long_names": awpy_long_names,
 }
 
 

@@ -657,3 +657,13 @@ def test_unknown_bomb_events_yaw_and_impossible_damage_are_named(folder: Path) -
 
     _edit_table(folder, "damages", huge)
     assert "HP (a player has 100)" in str(read_match(folder).round_errors[1])
+
+
+def test_replay_of_a_folder_of_tables_names_its_output_after_its_content(
+    folder: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # the default output folder lies under the working folder
+    result = CliRunner().invoke(app, ["replay", f"{folder}:1", "--models", "none"])
+    assert result.exit_code == 0, result.output
+    written = result.output.strip().splitlines()[-1]
+    assert written.startswith("replay written to") and "m-" in written and "_r1" in written

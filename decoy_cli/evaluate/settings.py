@@ -15,7 +15,7 @@ from functools import cache
 from pathlib import Path
 
 from decoy_cli.damage.choice import ModelChoice
-from decoy_cli.errors import EstaError
+from decoy_cli.esta.content import content_sha256
 from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.world.navmesh import asset_dir
@@ -104,20 +104,8 @@ def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
 
 
 def file_sha256(path: Path) -> str:
-    """SHA-256 of a file's bytes, or of a folder of awpy 3 tables (each regular file's name and
-    bytes, in name order); an unreadable one raises EstaError."""
-    digest = hashlib.sha256()
-    files = sorted(p for p in path.iterdir() if p.is_file()) if path.is_dir() else [path]
-    try:
-        for file in files:
-            if path.is_dir():
-                digest.update(file.name.encode() + b"\0")
-            with file.open("rb") as handle:
-                for block in iter(lambda: handle.read(1 << 20), b""):
-                    digest.update(block)
-    except OSError as error:
-        raise EstaError(f"{path}: cannot read the file ({error.strerror or error})") from None
-    return digest.hexdigest()
+    """SHA-256 of a file, or of a folder of awpy 3 tables (`content_sha256`)."""
+    return content_sha256(path)
 
 
 @cache

@@ -8,7 +8,6 @@ this returns.
 
 from __future__ import annotations
 
-import hashlib
 import re
 import time
 from dataclasses import dataclass, replace
@@ -18,6 +17,7 @@ import pandas as pd
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, load_round
+from decoy_cli.esta.content import content_sha256
 from decoy_cli.esta.frame_rate import describe_frame_rate
 from decoy_cli.esta.reader import MATCH_SUFFIXES
 from decoy_cli.files import staged
@@ -121,11 +121,7 @@ def replay_folder_name(file: Path, round_num: int) -> str:
     for suffix in MATCH_SUFFIXES:
         name = name.removesuffix(suffix)
     safe = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:64] or "match"
-    digest = hashlib.sha256()
-    with file.open("rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return f"{safe}-{digest.hexdigest()[:8]}_r{round_num}"
+    return f"{safe}-{content_sha256(file)[:8]}_r{round_num}"
 
 
 def replay_summary(

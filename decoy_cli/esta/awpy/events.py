@@ -277,7 +277,7 @@ def _bomb_event(
 def row_keys(rows: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     """Each tick row's player key (the steamid as text, else the name) and steamid (None where
     null or 0, a bot)."""
-    names = rows["name"].to_numpy(dtype=object, na_value="")
+    names = texts(rows["name"], "")
     raw = (
         rows["steamid"].to_numpy(dtype=object, na_value=None)
         if "steamid" in rows
@@ -286,3 +286,13 @@ def row_keys(rows: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     steam = np.array([steam_id(s) for s in raw], dtype=object)
     keys = np.array([n if s is None else str(s) for n, s in zip(names, steam, strict=True)], object)
     return keys, steam
+
+
+def texts(values: pd.Series, missing: object) -> np.ndarray:
+    """A text column as an object array, each distinct text one object however many rows hold
+    it (`missing` where null): a long name costs its length once, not once a row."""
+    codes, uniques = pd.factorize(values, use_na_sentinel=True)
+    table = np.empty(len(uniques) + 1, dtype=object)
+    table[:-1] = list(uniques)
+    table[-1] = missing  # code -1, a null
+    return table[codes]

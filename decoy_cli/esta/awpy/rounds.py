@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import EstaError
-from decoy_cli.esta.awpy.events import is_null, round_events, row_keys, utility_table
+from decoy_cli.esta.awpy.events import is_null, round_events, row_keys, texts, utility_table
 from decoy_cli.esta.awpy.names import (
     Spelling,
     bomb_site,
@@ -344,9 +344,9 @@ def _player_rows(
             return np.zeros(count, dtype=bool)
         return rows[column].to_numpy(dtype=object, na_value=False).astype(bool)
 
-    names = rows["name"].to_numpy(dtype=object, na_value="")
+    names = texts(rows["name"], "")
     keys, steam = row_keys(rows)
-    sides = rows["side"].to_numpy(dtype=object, na_value=None)
+    sides = texts(rows["side"], None)
     side = np.array([side_name(s) or "" for s in sides], dtype=object)
     if (side == "").any():
         bad = sides[int(np.flatnonzero(side == "")[0])]
@@ -382,8 +382,8 @@ def _weapons(rows: pd.DataFrame, spelling: Spelling, warnings: list[str]) -> np.
     """ESTA's name of each row's weapon in hand; an unknown one is "" and a named warning."""
     if "weapon" not in rows:
         return np.full(len(rows), "", dtype=object)
-    raw = rows["weapon"].to_numpy(dtype=object, na_value="")
-    names, codes = np.unique(raw.astype(str), return_inverse=True)
+    raw = texts(rows["weapon"], "")
+    codes, names = pd.factorize(raw)
     mapped = []
     for name in names:
         esta = weapon_name(name, spelling)

@@ -44,7 +44,10 @@ _CHECKS: dict[Kind, Callable[[pa.DataType], bool]] = {
         pa.types.is_string(t)
         or pa.types.is_large_string(t)
         or pa.types.is_null(t)
-        or (pa.types.is_dictionary(t) and pa.types.is_string(t.value_type))
+        or (
+            pa.types.is_dictionary(t)
+            and (pa.types.is_string(t.value_type) or pa.types.is_large_string(t.value_type))
+        )
     ),
     "bool": lambda t: pa.types.is_boolean(t) or pa.types.is_null(t),
     "list": lambda t: (
@@ -138,12 +141,13 @@ def _opened(
     if found is None:
         raise EstaError(f"{source.path}: no {table} table (awpy writes one; is this awpy data?)")
     try:
-        opened = (
-            found
-            if isinstance(found, pa.Table)
-            else pq.ParquetFile(io.BytesIO(found) if isinstance(found, bytes) else found)
-        )
-        schema = opened.schema if isinstance(opened, pa.Table) else opened.schema_arrow
+        if isinstance(found, pa.Table):
+            opened: pq.ParquetFile | pa.Table = found
+            schema = found.schema
+        else:
+            schema = _parquet(found).schema_arrow
+            text = [c for c, kind in columns.items() if kind == "str" and c in schema.names]
+            opened = _parquet(found, text)  # each distinct text held once, however many rows
     except (pa.ArrowException, OSError, ValueError) as error:
         raise EstaError(f"{where}: not a readable parquet table ({error})") from None
     names = [c for c in columns if c in schema.names]
@@ -157,6 +161,13 @@ def _opened(
                 f"{where}: column {name} holds {schema.field(name).type}, not {kind} values"
             )
     return opened, names
+
+
+def _parquet(found: bytes | Path, text: list[str] | None = None) -> pq.ParquetFile:
+    """A parquet file opened, its `text` columns to be read dictionary-encoded."""
+    return pq.ParquetFile(
+        io.BytesIO(found) if isinstance(found, bytes) else found, read_dictionary=text
+    )
 
 
 def table_rows(source: TableSource, table: str) -> int:
