@@ -4,10 +4,10 @@ The same `Round` an ESTA file gives: frames run from freeze-time end on the game
 keyed by steamID where the data has one, else by name, T before CT; positions in metres; events
 as ESTA's tables with its names (decoy_cli/esta/awpy/names.py).
 
-* **Rounds and time.** Start, freeze end and end from the rounds table; a tick table row or an
-  event belongs to the round whose start is the latest at or before its tick, up to that round's
-  end (awpy 2's own rule; a tick equal to one round's end and the next one's start is the next
-  round's). The tick rate is the demo's (the header, never assumed).
+* **Rounds and time.** Start, freeze end, end and official end from the rounds table; a tick
+  table row or an event belongs to the round whose start is the latest at or before its tick, up
+  to that round's official end (awpy 2's own rule; a tick equal to one round's end and the next
+  one's start is the next round's). The tick rate is the demo's (decoy_cli/esta/awpy/reader.py).
 * **Frames at a rate.** Full-rate ticks are sampled at `rate` frames a second on the grid from
   freeze-time end (the first tick at or after each grid point, so a missing tick moves a frame
   and never drops it); ticks already sampled at or below that rate are kept as they are.
@@ -129,7 +129,7 @@ def read_tables_match(tables: AwpyTables, *, implausible: Implausible) -> Match:
         try:
             rows = ticks[owner == index]
             built = _build_round(tables, window, tables.frames[index], rows, implausible)
-            lacking = (*not_recorded, *_carrier(rows, window))
+            lacking = (*not_recorded, *_carrier(rows))
             rounds.append(replace(built, not_recorded=lacking))
         except Invalid as problem:
             errors[window.num] = EstaError(f"{tables.path}: round {window.num}: {problem}")
@@ -162,7 +162,7 @@ def _dropped(not_recorded: tuple[str, ...]) -> set[str]:
     return columns
 
 
-def _carrier(rows: pd.DataFrame, window: RoundWindow) -> tuple[str, ...]:
+def _carrier(rows: pd.DataFrame) -> tuple[str, ...]:
     """The bomb carrier, named not recorded where nobody holds the bomb in a round's rows."""
     if "has_bomb" in rows and rows["has_bomb"].fillna(False).astype(bool).any():
         return ()
