@@ -38,7 +38,7 @@ import pandas as pd
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.esta.events import build_table
-from decoy_cli.esta.frames import PlayerInfo, RoundClock, Side, build_frames
+from decoy_cli.esta.frames import FrameArrays, PlayerInfo, RoundClock, Side, build_frames
 from decoy_cli.esta.plausibility import Implausible, check_frames, round_order_problems
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
@@ -340,29 +340,13 @@ def _build_round(
     if winning_side not in (None, "T", "CT"):
         raise Invalid(f"winningSide {winning_side!r} is not T or CT")
     winner = cast("Side | None", winning_side)  # checked just above
-    return Round(
+    return round_from_frames(
+        arrays,
         match_id=match_id,
         path=path,
         round_num=num,
         map_name=map_name,
         tick_rate=tick_rate,
-        frame_ticks=ticks,
-        frame_seconds=arrays.seconds,
-        players=arrays.players,
-        position=arrays.position,
-        yaw=arrays.yaw,
-        hp=arrays.hp,
-        armor=arrays.armor,
-        helmet=arrays.helmet,
-        has_defuser=arrays.has_defuser,
-        weapon=arrays.weapon,
-        alive=arrays.alive,
-        present=arrays.present,
-        has_bomb=arrays.has_bomb,
-        vertical_speed=arrays.vertical_speed,
-        bomb_position=arrays.bomb_position,
-        bomb_planted=arrays.bomb_planted,
-        bombsite=arrays.bombsite,
         damages=build_table("damages", state.damages, DAMAGE_COLUMNS, ticks, clock),
         kills=build_table("kills", state.kills, KILL_COLUMNS, ticks, clock),
         bomb_events=build_table("bomb_events", state.bombEvents, BOMB_EVENT_COLUMNS, ticks, clock),
@@ -379,6 +363,31 @@ def _build_round(
             for side, value in (("T", state.tBuyType), ("CT", state.ctBuyType))
             if isinstance(value, str) and value
         },
+    )
+
+
+def round_from_frames(frames: FrameArrays, **fields: object) -> Round:
+    """A `Round` of the frames' arrays (ticks, seconds, players, and every per-player and
+    per-frame array) and the other `fields` (the round's facts and events)."""
+    return Round(
+        frame_ticks=frames.ticks,
+        frame_seconds=frames.seconds,
+        players=frames.players,
+        position=frames.position,
+        yaw=frames.yaw,
+        hp=frames.hp,
+        armor=frames.armor,
+        helmet=frames.helmet,
+        has_defuser=frames.has_defuser,
+        weapon=frames.weapon,
+        alive=frames.alive,
+        present=frames.present,
+        has_bomb=frames.has_bomb,
+        vertical_speed=frames.vertical_speed,
+        bomb_position=frames.bomb_position,
+        bomb_planted=frames.bomb_planted,
+        bombsite=frames.bombsite,
+        **fields,  # type: ignore[arg-type]
     )
 
 

@@ -46,7 +46,7 @@ from decoy_cli.esta.frames import (
     player_arrays,
 )
 from decoy_cli.esta.plausibility import Implausible, check_frames
-from decoy_cli.esta.reader import Match, Round
+from decoy_cli.esta.reader import Match, Round, round_from_frames
 from decoy_cli.esta.schema import (
     BOMB_EVENT_COLUMNS,
     DAMAGE_COLUMNS,
@@ -288,34 +288,18 @@ def _build_round(
     )
     smokes = utility_table(_utility_in(tables.smokes, window), "smoke", clock, warnings)
     fires = utility_table(_utility_in(tables.fires, window), "fire", clock, warnings)
-    return Round(
+    return round_from_frames(
+        frames,
         match_id=tables.match_id,
         path=tables.path,
         round_num=window.num,
         map_name=tables.map_name,
         tick_rate=tables.tick_rate,
-        frame_ticks=kept,
-        frame_seconds=seconds,
-        players=infos,
-        position=frames.position,
-        yaw=frames.yaw,
-        hp=frames.hp,
-        armor=frames.armor,
-        helmet=frames.helmet,
-        has_defuser=frames.has_defuser,
-        weapon=frames.weapon,
-        alive=frames.alive,
-        present=frames.present,
-        has_bomb=frames.has_bomb,
-        vertical_speed=frames.vertical_speed,
-        bomb_position=frames.bomb_position,
-        bomb_planted=frames.bomb_planted,
-        bombsite=frames.bombsite,
         damages=build_table("damages", events["damages"], DAMAGE_COLUMNS, kept, clock),
         kills=build_table("kills", events["kills"], KILL_COLUMNS, kept, clock),
         bomb_events=build_table("bomb_events", events["bomb"], BOMB_EVENT_COLUMNS, kept, clock),
         flashes=build_table("flashes", events["flashes"], FLASH_COLUMNS, kept, clock),
-        winning_side=winner,  # type: ignore[arg-type]  # side_name gives "T", "CT" or None
+        winning_side=winner,  # side_name gives "T", "CT" or None
         end_reason=reason,
         bomb_plant_tick=window.plant_tick,
         start_tick=window.start,

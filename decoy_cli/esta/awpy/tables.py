@@ -27,6 +27,7 @@ import pyarrow.parquet as pq
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.source import max_match_bytes
 from decoy_cli.files import JsonObject
+from decoy_cli.reading import read_limited
 
 Kind = Literal["int", "float", "str", "bool", "list"]
 """What a column holds; integers may arrive as floats where awpy writes nulls."""
@@ -178,7 +179,7 @@ def table_rows(source: TableSource, table: str) -> int:
 
 def _folder(path: Path) -> TableSource:
     """An awpy 3 folder: one `<dataset>.parquet` per table beside `header.json`."""
-    header = _header(path / HEADER, _read_limited(path / HEADER, MAX_HEADER_BYTES))
+    header = _header(path / HEADER, read_limited(path / HEADER, MAX_HEADER_BYTES, EstaError))
     total = sum(p.stat().st_size for p in path.glob("*.parquet") if p.is_file())
     _check_size(path, total)
 
@@ -249,17 +250,6 @@ def _check_size(path: Path, size: int) -> None:
             f"{path}: {size / 1e6:,.0f} MB of tables, more than {limit / 1e6:g} MB "
             "(set DECOY_MAX_MATCH_MB to allow more)"
         )
-
-
-def _read_limited(path: Path, limit: int) -> bytes:
-    try:
-        with path.open("rb") as handle:
-            data = handle.read(limit + 1)
-    except OSError as error:
-        raise EstaError(f"{path}: cannot read the file ({error.strerror or error})") from None
-    if len(data) > limit:
-        raise EstaError(f"{path}: larger than {limit:,} bytes (not an awpy header)")
-    return data
 
 
 def _header(where: Path, raw: bytes) -> JsonObject:
