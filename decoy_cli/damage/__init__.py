@@ -92,7 +92,8 @@ def damages_by_rules(choice: ModelChoice, folder: Path) -> bool:
     from decoy_cli.damage.rules_model import RULES_FILE
 
     return choice == ModelName.RULES or (
-        (folder / RULES_FILE).is_file() and not (folder / "dog.json").is_file()
+        # exists, not is_file: a rules.json that is no regular file is refused when loaded
+        (folder / RULES_FILE).exists() and not (folder / "dog.json").exists()
     )
 
 

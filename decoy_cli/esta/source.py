@@ -21,6 +21,7 @@ import msgspec
 from decoy_cli.errors import EstaError
 from decoy_cli.esta.schema import Invalid, RoundHead, RoundState
 from decoy_cli.files import JsonObject, JsonValue
+from decoy_cli.reading import open_regular
 
 XZ_MAGIC = b"\xfd7zXZ\x00"
 
@@ -81,15 +82,11 @@ def read_bytes(path: Path) -> bytes:
     too_big = (
         f"{path}: larger than {limit / 1e6:g} MB of JSON (set DECOY_MAX_MATCH_MB to allow more)"
     )
-    try:
-        with path.open("rb") as handle:
+    with open_regular(path, EstaError) as handle:  # a FIFO or a device is refused unopened
+        try:
             data = handle.read(limit + 1)
-    except FileNotFoundError:
-        raise EstaError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise EstaError(f"{path}: is a folder, not a match file") from None
-    except OSError as error:
-        raise EstaError(f"{path}: cannot read the file ({error.strerror})") from None
+        except OSError as error:
+            raise EstaError(f"{path}: cannot read the file ({error.strerror})") from None
     if not data.startswith(XZ_MAGIC):
         if len(data) > limit:
             raise EstaError(too_big)

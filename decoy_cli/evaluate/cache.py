@@ -16,9 +16,11 @@ from typing import TypeVar
 import msgspec
 import numpy as np
 
+from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.job import FileIndex
 from decoy_cli.evaluate.record import RoundRecord
 from decoy_cli.files import write_atomic
+from decoy_cli.reading import open_regular
 
 CACHE_DIR = "cache"
 
@@ -72,7 +74,9 @@ class RunCache:
 
 
 def _load(path: Path, decoder: msgspec.msgpack.Decoder[Stored]) -> Stored | None:
+    """The record in `path`; None when it is missing, not a regular file or unreadable."""
     try:
-        return decoder.decode(path.read_bytes())
-    except (OSError, msgspec.DecodeError):
+        with open_regular(path) as handle:
+            return decoder.decode(handle.read())
+    except (DecoyError, OSError, msgspec.DecodeError):
         return None

@@ -16,6 +16,7 @@ from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
+from decoy_cli.reading import read_limited
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import visible
@@ -25,6 +26,8 @@ REPLAY_MARKER = "replay.csv"
 """The file that tells a replay's folder from an evaluate run's."""
 
 PLAYER_COLUMNS = ("player", "side", "death")
+MAX_TRACE_BYTES = 256_000_000
+"""Largest `trace.json` read: a round's thinned paths take a few hundred kB."""
 
 
 def is_replay_folder(folder: Path) -> bool:
@@ -41,7 +44,7 @@ def replay_page(folder: Path) -> PageData:
             "`decoy replay` again"
         )
     try:
-        trace = msgspec.json.decode(trace_path.read_bytes(), type=RoundTrace)
+        trace = msgspec.json.decode(read_limited(trace_path, MAX_TRACE_BYTES), type=RoundTrace)
     except (OSError, msgspec.DecodeError) as error:
         raise DecoyError(f"{trace_path}: not a round's trace ({error})") from None
     players = read_run_table(folder / "players.csv")

@@ -8,6 +8,7 @@ map's nav mesh, which names the spots players talk about: TSpawn, BombsiteA, Lon
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import asdict
 from functools import cache
 from pathlib import Path
@@ -16,6 +17,7 @@ import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES
 from decoy_cli.errors import GraphError
+from decoy_cli.reading import open_regular
 from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
 from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh, nav_world
@@ -55,8 +57,10 @@ def default_seeds(nav: NavMesh) -> np.ndarray:
 def read_manual_waypoints(path: str | Path) -> np.ndarray:
     """Manual waypoints from a CSV file with a header `x,y,z` (metres, Source axes)."""
     path = Path(path)
+    if not path.exists():
+        raise GraphError(f"cannot read manual waypoints {path}: no such file")
     try:
-        with open(path, newline="") as f:
+        with io.TextIOWrapper(open_regular(path, GraphError), newline="") as f:
             rows = list(csv.DictReader(f))
     except OSError as error:
         raise GraphError(f"cannot read manual waypoints {path}: {error.strerror}") from None

@@ -43,6 +43,7 @@ import numpy as np
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.files import write_atomic
+from decoy_cli.reading import open_regular
 from decoy_cli.world.world import World
 
 UNITS: dict[str, float] = {"hammer": HAMMER_TO_M, "m": 1.0}
@@ -194,12 +195,13 @@ def _read_bytes(path: Path) -> bytes:
         )
     if path.is_dir():
         raise WorldError(f"{path}: is a directory, not a mesh file")
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise WorldError(f"{path}: no such mesh file") from None
-    except OSError as error:
-        raise WorldError(f"{path}: cannot read: {error.strerror or error}") from None
+    if not path.exists():
+        raise WorldError(f"{path}: no such mesh file")
+    with open_regular(path, WorldError) as handle:  # a FIFO or a device is refused unopened
+        try:
+            data = handle.read()
+        except OSError as error:
+            raise WorldError(f"{path}: cannot read: {error.strerror or error}") from None
     if not data:
         raise WorldError(f"{path}: the file is empty")
     return data
