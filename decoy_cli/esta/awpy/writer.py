@@ -308,38 +308,58 @@ def _utility(match: Match, layout: int) -> dict[str, bytes]:
     return out
 
 
-def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
-    """The match as `awpy parse --player-props` writes it (a zip of parquet tables)."""
+def _tick_columns(match: Match, every: int, layout: int) -> dict[str, pa.Array]:
+    """The tick table of a layout (2: awpy 2's `ticks`; 3: awpy 3's `snapshots`)."""
     rows = _tick_rows(match.rounds, every=every)
     cols = _players_columns(match.rounds, rows)
-    xyz = rows["xyz"]
-    ticks = {
+    upper, sides = (True, SIDE2) if layout == 2 else (False, SIDE3)
+    table: dict[str, pa.Array] = {
         "tick": pa.array(rows["tick"], pa.int32()),
         "steamid": pa.array(cols["steamid"], pa.uint64()),
         "name": pa.array(cols["name"], pa.large_string()),
-        "round_num": pa.array([match.rounds[r].round_num for r in rows["round"]], pa.uint32()),
-        "X": pa.array(xyz[:, 0], pa.float32()),
-        "Y": pa.array(xyz[:, 1], pa.float32()),
-        "Z": pa.array(xyz[:, 2], pa.float32()),
+        "side": pa.array([sides[s] for s in cols["side"]], pa.large_string()),
+        **{
+            (axis.upper() if upper else axis): pa.array(rows["xyz"][:, k], pa.float32())
+            for k, axis in enumerate("xyz")
+        },
+        "yaw": pa.array(cols["yaw"], pa.float32()),
         "health": pa.array(cols["health"], pa.int32()),
-        "side": pa.array([SIDE2[s] for s in cols["side"]], pa.large_string()),
         "armor": pa.array(cols["armor"], pa.int32()),
         "has_helmet": pa.array(cols["has_helmet"]),
         "has_defuser": pa.array(cols["has_defuser"]),
-        "is_alive": pa.array(cols["is_alive"]),
-        "yaw": pa.array(cols["yaw"], pa.float32()),
-        "active_weapon_name": pa.array(
+    }
+    if layout == 2:
+        table["round_num"] = pa.array(
+            [match.rounds[r].round_num for r in rows["round"]], pa.uint32()
+        )
+        table["is_alive"] = pa.array(cols["is_alive"])
+        table["active_weapon_name"] = pa.array(
             [DISPLAY.get(w) if w else None for w in cols["weapon"]], pa.large_string()
-        ),
-        "inventory": pa.array(
+        )
+        table["inventory"] = pa.array(
             [
                 ([DISPLAY[w]] if w else []) + ["C4 Explosive"] * int(bomb)
                 for w, bomb in zip(cols["weapon"], cols["has_bomb"], strict=True)
             ],
             pa.list_(pa.large_string()),
-        ),
+        )
+    else:
+        table["pitch"] = pa.array(np.zeros(len(rows["tick"])), pa.float32())
+        table["has_bomb"] = pa.array(cols["has_bomb"])
+        table["is_defusing"] = pa.array(cols["is_defusing"])
+        table["active_weapon"] = pa.array(
+            [ITEM.get(w) if w else None for w in cols["weapon"]], pa.large_string()
+        )
+    return table
+
+
+def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
+    """The match as `awpy parse --player-props` writes it (a zip of parquet tables)."""
+    tables = {
+        "ticks": _write(_tick_columns(match, every, 2)),
+        **_rounds_and_events(match, 2),
+        **_utility(match, 2),
     }
-    tables = {"ticks": _write(ticks), **_rounds_and_events(match, 2), **_utility(match, 2)}
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
         for name, data in tables.items():
             archive.writestr(f"{name}.parquet", data)
@@ -350,30 +370,7 @@ def write_awpy2_zip(match: Match, path: Path, *, every: int = 0) -> Path:
 def write_awpy3_folder(match: Match, folder: Path, *, every: int = 0) -> Path:
     """The match as awpy 3's datasets in this project's folder of tables."""
     folder.mkdir(parents=True, exist_ok=True)
-    rows = _tick_rows(match.rounds, every=every)
-    cols = _players_columns(match.rounds, rows)
-    xyz = rows["xyz"]
-    snapshots = {
-        "tick": pa.array(rows["tick"], pa.int32()),
-        "steamid": pa.array(cols["steamid"], pa.uint64()),
-        "name": pa.array(cols["name"], pa.large_string()),
-        "side": pa.array([SIDE3[s] for s in cols["side"]], pa.large_string()),
-        "x": pa.array(xyz[:, 0], pa.float32()),
-        "y": pa.array(xyz[:, 1], pa.float32()),
-        "z": pa.array(xyz[:, 2], pa.float32()),
-        "pitch": pa.array(np.zeros(len(xyz)), pa.float32()),
-        "yaw": pa.array(cols["yaw"], pa.float32()),
-        "health": pa.array(cols["health"], pa.int32()),
-        "armor": pa.array(cols["armor"], pa.int32()),
-        "has_helmet": pa.array(cols["has_helmet"]),
-        "has_defuser": pa.array(cols["has_defuser"]),
-        "has_bomb": pa.array(cols["has_bomb"]),
-        "is_defusing": pa.array(cols["is_defusing"]),
-        "active_weapon": pa.array(
-            [ITEM.get(w) if w else None for w in cols["weapon"]], pa.large_string()
-        ),
-    }
-    (folder / "snapshots.parquet").write_bytes(_write(snapshots))
+    (folder / "snapshots.parquet").write_bytes(_write(_tick_columns(match, every, 3)))
     for name, data in {**_rounds_and_events(match, 3), **_utility(match, 3)}.items():
         (folder / f"{name}.parquet").write_bytes(data)
     header = {"map_name": match.map_name, "playback_ticks": match.tick_rate * 100}
