@@ -7,6 +7,7 @@ never the bug line (exit 2)."""
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from esta_fixtures import make_match, write_match
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
+from decoy_cli.damage.bullet_counts import MAX_BULLETS, BulletCounts
 from decoy_cli.errors import ModelError
 from decoy_cli.reading import MAX_JSON_DEPTH, load_json
 
@@ -83,3 +85,36 @@ def _nested(levels: int) -> list:
     for _ in range(levels - 1):
         value = [value]
     return value
+
+
+@pytest.mark.parametrize(
+    ("raw", "said"),
+    [
+        ("Infinity", "bullets.counts.AK-47[1]: Infinity is not a finite number"),
+        ("-Infinity", "bullets.counts.AK-47[1]: -Infinity is not a finite number"),
+        ("NaN", "bullets.counts.AK-47[1]: NaN is not a finite number"),
+        ("1e999", "bullets.counts.AK-47[1]: 1e999 is beyond the range of a float"),
+        ("-3", "bullets 'AK-47': counts must be finite and not negative"),
+    ],
+)
+def test_a_bullet_count_that_is_no_count_is_refused_by_name(
+    tmp_path: Path, data: Path, raw: str, said: str
+) -> None:
+    folder = model_folder(tmp_path)
+    rules = folder / "rules.json"
+    document = json.loads(rules.read_text())
+    document["bullets"]["counts"]["AK-47"][1] = "COUNT"
+    rules.write_text(json.dumps(document).replace('"COUNT"', raw))
+    line = one_error(
+        runner.invoke(app, ["models", "evaluate", str(folder), str(data), "--out", str(tmp_path)])
+    )
+    assert line.startswith(f"error: {rules}: ") and said in line, line
+
+
+def test_bullet_counts_check_names_a_count_that_is_not_finite() -> None:
+    counts = BulletCounts({"AK-47": [1.0] * MAX_BULLETS}, {"AK-47": [0.0] * MAX_BULLETS})
+    counts.check("bullets")
+    for bad in (math.inf, math.nan, -1.0):
+        counts.counts["AK-47"][3] = bad
+        with pytest.raises(ValueError, match="bullets_hurt 'AK-47': counts must be finite"):
+            counts.check("bullets_hurt")

@@ -19,11 +19,13 @@ Without `censored`, the plain shares of the counts.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from decoy_cli.damage.hit_groups import band, weapon_class
+from decoy_cli.text import shortened
 
 MAX_BULLETS = 10
 """Bullet counts above this are counted as this many."""
@@ -98,12 +100,17 @@ class BulletCounts:
         counts |= floats(data.get("by_weapon", {}))
         return cls(counts)
 
-    def check(self) -> None:
-        """A ValueError unless every table holds `MAX_BULLETS` counts, none negative, and no
-        more killed than counted."""
+    def check(self, name: str = "bullets") -> None:
+        """A ValueError naming the table (`name`, as in rules.json) and its key unless every
+        table holds `MAX_BULLETS` counts, each finite and not negative, and no more killed
+        than counted."""
         for key, counts in self.counts.items():
             killed = self.killed.get(key, [0.0] * MAX_BULLETS)
+            where = f"{name} {shortened(key)!r}"
             if len(counts) != MAX_BULLETS or len(killed) != MAX_BULLETS:
-                raise ValueError(f"bullet counts must be {MAX_BULLETS} counts")
-            if not all(0 <= k <= c for k, c in zip(killed, counts, strict=True)):
-                raise ValueError("bullet counts must not be negative, nor killed above counted")
+                raise ValueError(f"{where}: bullet counts must be {MAX_BULLETS} counts")
+            for table in (counts, killed):
+                if not all(math.isfinite(v) and v >= 0 for v in table):
+                    raise ValueError(f"{where}: counts must be finite and not negative")
+            if not all(k <= c for k, c in zip(killed, counts, strict=True)):
+                raise ValueError(f"{where}: more steps killed than counted")

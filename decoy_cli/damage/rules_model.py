@@ -134,9 +134,9 @@ class RulesFile:
             bullets = BulletCounts.from_dict(data["bullets"])
             hurt = data.get("bullets_hurt")
             bullets_hurt = None if hurt is None else BulletCounts.from_dict(hurt)
-            for counts in (bullets, bullets_hurt):
-                if counts is not None:
-                    counts.check()
+            bullets.check("bullets")
+            if bullets_hurt is not None:
+                bullets_hurt.check("bullets_hurt")
             provenance = dict(data.get("provenance", {}))
             through = data.get("penetration", {"hits": 0, "shares": []})
             penetration = Penetration(int(through["hits"]), [float(v) for v in through["shares"]])
