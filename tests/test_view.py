@@ -496,3 +496,48 @@ def test_an_active_smoke_is_drawn(browser: Browser, replay_folder: Path, tmp_pat
         pictures.append(shots)
     assert pictures[1][0] == pictures[0][0]  # not yet: the same picture
     assert pictures[1][1] != pictures[0][1]  # active: drawn
+
+
+CS2_ROUNDS = ROOT.parent / "shared" / "data" / "cs2_dust2_both"
+
+
+@pytest.mark.skipif(
+    not CS2_ROUNDS.is_dir(), reason="../shared/data/cs2_dust2_both is absent (real CS2 rounds)"
+)
+def test_inferred_bomb_events_are_marked_with_their_rule() -> None:
+    from decoy_cli.replay import ReplayOptions, replay_round
+    from decoy_cli.replay.view_trace import round_trace
+    from decoy_cli.waypoints.build import builtin_graph
+
+    round_ = read_match(CS2_ROUNDS / "spirit-vs-falcons-m2-dust2-r01-12.json.xz").round(3)
+    result = replay_round(round_, builtin_graph(), ReplayOptions(combat=False))
+    events = [e for e in round_trace(round_, result).events if e.source == "data"]
+    marked = {e.kind: e.inferred for e in events if e.kind in ("carry", "plant", "defuse")}
+    assert marked["plant"] is not None and marked["plant"].startswith("bomb carrier and planter")
+    assert marked["defuse"] is not None and marked["defuse"].startswith("defuse (")
+    assert all(e.inferred is None for e in events if e.kind == "kill")  # recorded
+
+
+def test_recorded_bomb_events_are_not_marked(replay_folder: Path) -> None:
+    trace = json.loads((replay_folder / "trace.json").read_text())
+    data = [e for e in trace["events"] if e[1] == "data" and e[2] in ("carry", "plant")]
+    assert data and all(len(e) < 8 or e[7] is None for e in data)
+
+
+@needs_browser
+@pytest.mark.skipif(
+    not CS2_ROUNDS.is_dir(), reason="../shared/data/cs2_dust2_both is absent (real CS2 rounds)"
+)
+def test_the_page_lists_inferred_events_apart(browser: Browser, tmp_path: Path) -> None:
+    file = CS2_ROUNDS / "spirit-vs-falcons-m2-dust2-r01-12.json.xz"
+    out = tmp_path / "round3"
+    result = runner.invoke(app, ["replay", f"{file}:3", "--models", "none", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert runner.invoke(app, ["view", str(out)]).exit_code == 0
+    browser.open(out / "view.html")
+    listed = browser.evaluate(
+        "Array.from(document.getElementById('events').children).map((li) => li.textContent)"
+    )
+    assert any(" · inferred · " in text and "plants (bomb carrier" in text for text in listed)
+    assert not any(" · real · " in text and "plants" in text for text in listed)
+    assert browser.console_errors() == []

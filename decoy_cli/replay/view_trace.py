@@ -50,7 +50,9 @@ class PlayerTrace(msgspec.Struct, frozen=True):
 class RoundEvent(msgspec.Struct, frozen=True, array_like=True):
     """Something that happened in the data or in the replay: `kind` is "kill" (player: the
     attacker, -1 unknown; other: the victim), "carry" (the bomb's carrier from then on),
-    "drop", "plant", "defuse" or "explode"; (x, y) where, in decimetres (None: not known)."""
+    "drop", "plant", "defuse" or "explode"; (x, y) where, in decimetres (None: not known);
+    `inferred` the rule that filled in a data event the data does not record (None: recorded,
+    or the replay's)."""
 
     t: int
     source: str
@@ -59,6 +61,7 @@ class RoundEvent(msgspec.Struct, frozen=True, array_like=True):
     other: int
     x: int | None
     y: int | None
+    inferred: str | None = None
 
 
 class RoundTrace(msgspec.Struct, frozen=True):
@@ -165,7 +168,8 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
     events = _kills(DATA, result.data_deaths.seconds, result.data_deaths.killer, seconds, original)
     replay_died = replay_deaths(result.events, len(players))
     events += _kills(REPLAY, replay_died.seconds, replay_died.killer, seconds, replayed)
-    events += _data_bomb(round_, result, seconds, original) + _replay_bomb(result, seconds)
+    events += _marked(_data_bomb(round_, result, seconds, original), result.inferred)
+    events += _replay_bomb(result, seconds)
     events.sort(key=lambda e: (e.t, e.source, e.kind))
     start, end = (round(float(seconds[i]) * CS) for i in (0, -1)) if len(seconds) else (0, 0)
     return RoundTrace(round_.map_name, start, end, players, events, _utility(round_))
@@ -193,6 +197,25 @@ def _utility(round_: Round) -> list[list[int | str]]:
                 ]
             )
     return rows
+
+
+INFERRED_BY = {
+    "carry": "bomb carrier and planter",
+    "plant": "bomb carrier and planter",
+    "defuse": "defuse",
+}
+"""The filled field (replay/missing.py's notes begin with it) a data event of each kind comes
+from when the data does not record it."""
+
+
+def _marked(events: list[RoundEvent], notes: tuple[str, ...]) -> list[RoundEvent]:
+    """The data's bomb events, each the replay filled in by a rule marked with that rule."""
+    out = []
+    for event in events:
+        field = INFERRED_BY.get(event.kind)
+        rule = next((n for n in notes if field and n.startswith(field + " (")), None)
+        out.append(msgspec.structs.replace(event, inferred=rule) if rule else event)
+    return out
 
 
 def _event(t: float, source: str, kind: str, player: int, other: int, where: object) -> RoundEvent:

@@ -53,6 +53,7 @@
     const events = round.events.map((e) => ({
       t: e[0] / 100, source: e[1], kind: e[2], player: e[3], other: e[4],
       x: e[5] === null ? null : e[5] / 10, y: e[6] === null ? null : e[6] / 10,
+      inferred: e[7] || null,
     }));
     let end = round.end / 100;
     for (const e of events) end = Math.max(end, e.t);
@@ -178,6 +179,7 @@
       else if (e.kind === "defuse") bomb = { x: e.x, y: e.y, label: "defused", defused: true };
       else if (e.kind === "explode") bomb = { x: e.x, y: e.y, label: "exploded", planted: true };
     }
+    if (bomb) bomb.inferred = latestInferred(r, source, t);
     if (bomb && bomb.carrier !== undefined) {
       const p = where[bomb.carrier];
       const pos = p && (source === "data" ? p.real : p.replay);
@@ -198,6 +200,15 @@
     }
   }
 
+  // Whether the bomb's latest event of a source up to time t was inferred by a rule.
+  function latestInferred(r, source, t) {
+    let inferred = false;
+    for (const e of r.events) {
+      if (e.source === source && e.t <= t + 1e-6 && e.kind !== "kill") inferred = Boolean(e.inferred);
+    }
+    return inferred;
+  }
+
   function drawBomb(bomb, hollow) {
     if (!bomb) return;
     const x = px(bomb.x), y = py(bomb.y), s = bomb.planted || bomb.defused ? 8 : 5;
@@ -207,6 +218,7 @@
     ctx.lineWidth = 2;
     ctx.strokeStyle = bomb.defused ? "#1e8449" : "#b7950b";
     ctx.fillStyle = bomb.defused ? "#58d68d" : "#f4d03f";
+    if (bomb.inferred) ctx.setLineDash([2, 2]);
     if (hollow) ctx.strokeRect(-s / 2, -s / 2, s, s);
     else { ctx.fillRect(-s / 2, -s / 2, s, s); ctx.strokeRect(-s / 2, -s / 2, s, s); }
     ctx.restore();
@@ -298,7 +310,7 @@
 
   function eventText(r, e) {
     const name = (i) => (i >= 0 && r.players[i] ? r.players[i].name : "?");
-    const who = e.source === "data" ? "real" : "replay";
+    const who = e.source === "data" ? (e.inferred ? "inferred" : "real") : "replay";
     const words = {
       kill: () => (e.player >= 0 ? name(e.player) + " → " + name(e.other) : name(e.other) + " dies" +
         (e.source === "replay" ? " (as the data says)" : "")),
@@ -308,7 +320,8 @@
       defuse: () => name(e.player) + " defuses",
       explode: () => "bomb explodes",
     };
-    return e.t.toFixed(1) + " s · " + who + " · " + (words[e.kind] ? words[e.kind]() : e.kind);
+    const rule = e.inferred ? " (" + e.inferred + ")" : "";
+    return e.t.toFixed(1) + " s · " + who + " · " + (words[e.kind] ? words[e.kind]() : e.kind) + rule;
   }
 
   function openRound(index, t) {
