@@ -4,8 +4,10 @@
 A run's folder is anyone's to edit. `read_run_table` reads a table from a regular file of at
 most `MAX_TABLE_MB`, its text columns as text (a match id "0001" stays "0001"), and checks the
 columns the run writes as numbers: every cell a number or empty (`round` a whole number in every
-row), and the flags True, False or empty. A cell that is not is one error naming the file, the
-column, the data row and the cell, never a ValueError where the numbers are used.
+row), and the flags True, False or empty; and the distances (the trajectory metrics, a place's
+mean error) in [0, `MAX_METRIC_M`], so that no mean or difference of them overflows (a value
+near the float limit made `decoy compare` write `inf`). A cell that is not is one error naming
+the file, the column, the data row and the cell, never a ValueError where the numbers are used.
 """
 
 from __future__ import annotations
@@ -23,6 +25,12 @@ from decoy_cli.text import shortened, visible
 
 MAX_TABLE_MB = 1024
 """Largest table read back: a run of a million player-rounds writes about 400 MB."""
+
+MAX_METRIC_M = 1e9
+"""Largest distance a run's metric may be, in metres: a million km, far beyond any replay (the
+largest, DTW, sums at most a round's frames times a map's width: under 1e8 m at 128 frames a
+second), and far below the float limit, so means and differences of a billion rows are exact
+enough and finite."""
 
 _ROUND_COUNTS = (
     "frames",
@@ -117,6 +125,9 @@ FLAG_COLUMNS: dict[str, tuple[str, ...]] = {
 WHOLE_COLUMNS = ("round",)
 """Columns that hold a whole number in every row."""
 
+DISTANCE_COLUMNS = frozenset({*ALL_METRIC_NAMES, "mean_error_m"})
+"""Columns of distances in metres, each in [0, `MAX_METRIC_M`] or empty."""
+
 _FLAGS = {"True": True, "False": False, True: True, False: False}
 
 
@@ -149,6 +160,10 @@ def _numbers(path: Path, frame: pd.DataFrame, column: str, error: type[DecoyErro
         _refuse(path, column, cells, cells.notna(), "is not a number", error)
     numbers = pd.to_numeric(cells, errors="coerce")
     _refuse(path, column, cells, numbers.isna() & cells.notna(), "is not a number", error)
+    if column in DISTANCE_COLUMNS:
+        inside = (numbers >= 0) & (numbers <= MAX_METRIC_M)
+        why = f"is not a distance in [0, {MAX_METRIC_M:g}] m"
+        _refuse(path, column, cells, numbers.notna() & ~inside, why, error)
     if column in WHOLE_COLUMNS:
         values = numbers.to_numpy(np.float64)
         whole = np.isfinite(values) & (np.abs(values) < 2**31) & (values == np.round(values))
