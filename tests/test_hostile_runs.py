@@ -7,16 +7,20 @@ One `decoy evaluate` of a small match serves the module; each test edits a copy 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
+import msgspec
 import pandas as pd
 import pytest
 from esta_fixtures import make_match, write_match
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
+from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.reading import MAX_JSON_DEPTH
+from decoy_cli.world.navmesh import asset_dir
 
 runner = CliRunner()
 
@@ -95,3 +99,36 @@ def test_a_text_cell_in_a_number_column_is_one_error_line(
     ]
     for args in both:
         assert said in one_error(runner.invoke(app, args))
+
+
+@pytest.mark.parametrize("name", ["elsewhere", "../de_dust2", "de_dust2/../de_dust2"])
+def test_a_map_name_that_is_a_path_is_never_read(copy: Path, tmp_path: Path, name: str) -> None:
+    elsewhere = tmp_path / "elsewhere"
+    shutil.copytree(asset_dir("de_dust2"), elsewhere)  # a whole map's files, to be read or not
+    summary = copy / "summary.json"
+    data = json.loads(summary.read_text())
+    data["options"]["map"] = str(elsewhere) if name == "elsewhere" else name
+    summary.write_text(json.dumps(data))
+    line = one_error(view(copy))
+    assert "no built-in map" in line and "this decoy knows: de_ancient" in line
+    assert not (copy / "page.html").exists()
+
+
+def test_a_cache_key_that_is_a_path_is_never_read(copy: Path, tmp_path: Path) -> None:
+    summary = copy / "summary.json"
+    data = json.loads(summary.read_text())
+    cache = RunCache(copy)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    for round_id, key in list(data["cache_keys"].items()):
+        # the same record, moved out of the cache under a key that walks out of it
+        outside = os.path.relpath(elsewhere / key, cache.rounds)
+        record = cache.load_round(key)
+        assert record is not None
+        stored = msgspec.msgpack.encode(msgspec.structs.replace(record, key=outside))
+        (elsewhere / f"{key}.msgpack").write_bytes(stored)
+        cache.round_path(key).unlink()
+        data["cache_keys"][round_id] = outside
+    summary.write_text(json.dumps(data))
+    assert "the cached result of round" in one_error(view(copy))
+    assert not (copy / "page.html").exists()

@@ -5,11 +5,13 @@ so an interrupted run keeps every finished round, and a rerun loads them instead
 them again. Keys come from decoy_cli/evaluate/settings.py (file content, round, options, code),
 so a changed option or a new version never reuses a stale result. A cache file that cannot be
 decoded (written by another format version, or damaged), or that holds another key's result,
-counts as missing.
+counts as missing; so does a key that is not a SHA-256 in hex (a run's summary.json names its
+rounds' keys: an edited one could name a path out of the cache).
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import TypeVar
 
@@ -23,6 +25,8 @@ from decoy_cli.files import write_atomic
 from decoy_cli.reading import open_regular
 
 CACHE_DIR = "cache"
+_KEY = re.compile("[0-9a-f]{64}")
+"""What every cache key is (decoy_cli/evaluate/settings.py: a SHA-256 in hex)."""
 
 Stored = TypeVar("Stored", RoundRecord, FileIndex)
 """What the cache stores."""
@@ -56,6 +60,8 @@ class RunCache:
     def load_round(self, key: str) -> RoundRecord | None:
         """The cached record, or None when missing, unreadable or not the record of `key` (a
         file copied or renamed within the cache)."""
+        if not _KEY.fullmatch(key):
+            return None
         record = _load(self.round_path(key), _ROUND_DECODER)
         return record if record is not None and record.key == key else None
 
@@ -66,6 +72,8 @@ class RunCache:
     def load_index(self, key: str, file_sha: str) -> FileIndex | None:
         """The cached index of the file with content `file_sha`, or None when missing,
         unreadable or another file's."""
+        if not _KEY.fullmatch(key):
+            return None
         index = _load(self.index_path(key), _INDEX_DECODER)
         return index if index is not None and index.file_sha == file_sha else None
 

@@ -13,10 +13,11 @@ from typing import Any
 
 import numpy as np
 
-from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M
+from decoy_cli.csgo import BUILTIN_MAP, HAMMER_TO_M, MAP_NAMES
 from decoy_cli.errors import WorldError
 from decoy_cli.package_data import packaged_dir
 from decoy_cli.reading import load_json
+from decoy_cli.text import shortened, visible
 
 REGIONS = ("t_spawn", "ct_spawn", "bombsite_a", "bombsite_b")
 """Regions the simulator and the replay use; each map's `map.json` names the nav places of each
@@ -85,7 +86,13 @@ class NavMesh:
 
 
 def asset_dir(map_name: str = BUILTIN_MAP) -> Path:
-    """Folder of a built-in map's assets (top-level `assets/`, installed as decoy_cli.assets)."""
+    """Folder of a built-in map's assets (top-level `assets/`, installed as decoy_cli.assets).
+    A map name comes from data (a match file, a run's files): only the names of `MAP_NAMES` are
+    taken, so no name is a path to read from; any other is a WorldError."""
+    if map_name not in MAP_NAMES:
+        known = ", ".join(MAP_NAMES)
+        shown = visible(shortened(str(map_name)))
+        raise WorldError(f"no built-in map {shown!r} (this decoy knows: {known})")
     return packaged_dir("assets") / map_name
 
 
