@@ -14,8 +14,8 @@ and report, the CSV writer), not where it is read, so the data itself stays as r
   convention, before `=`, `+`, `-`, `@`, tab or carriage return) and hold no control
   character; numbers, and text that reads as a number, are left as they are;
 * `shortened`: a text cut to a length with a marker (`CUT_MARK`), so that a name of any length
-  takes a bounded place where it is shown (`NAME_LIMIT` for names: figures, terminal tables,
-  the page); CSV files keep it in full.
+  takes a bounded place where it is shown (`shown_name`: `NAME_LIMIT` characters in figures,
+  terminal tables and the page); CSV files keep it in full.
 """
 
 from __future__ import annotations
@@ -32,9 +32,10 @@ FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 """What a spreadsheet reads as the start of a formula (OWASP's CSV injection list)."""
 CUT_MARK = "…"
 """Ends a text `shortened` cut."""
-NAME_LIMIT = 40
-"""Characters of a name (a player's, a match id) shown where it is drawn: more than Steam's
-32-character names, so a real name is shown whole."""
+NAME_LIMIT = 48
+"""Characters of a name (a player's) shown where it is drawn: half again Steam's 32-character
+names, so a real name is shown whole, even with a control character or two written as
+escapes."""
 
 
 def visible(text: str, keep: str = "") -> str:
@@ -49,6 +50,12 @@ def shortened(text: str, limit: int = NAME_LIMIT) -> str:
     """`text` when it has at most `limit` characters, else its first `limit` - 1 and
     `CUT_MARK` (`limit` characters in all)."""
     return text if len(text) <= limit else text[: max(limit - 1, 0)] + CUT_MARK
+
+
+def shown_name(name: str) -> str:
+    """A name from the data as it is shown where it is drawn: `visible`, then `shortened` to
+    `NAME_LIMIT` characters."""
+    return shortened(visible(name))
 
 
 def _escape(char: str) -> str:

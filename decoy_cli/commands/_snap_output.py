@@ -22,6 +22,7 @@ from decoy_cli.replay.study import (
     SnapTotals,
     worst_intervals,
 )
+from decoy_cli.text import shortened
 from decoy_cli.waypoints.graph import STOP_ACTION, WaypointGraph
 
 _WITHIN = f"within_{WITHIN_M:g}m"
@@ -64,7 +65,7 @@ def show_round(
         )
     for values in study.rows.to_dict("records"):
         table.add_row(
-            str(values["player"]),
+            shortened(str(values["player"])),
             str(values["side"]),
             str(values["frames_alive"]),
             _num(values["snap_median_m"]),
@@ -173,7 +174,7 @@ def show_worst(console: Console, worst: pd.DataFrame, *, with_match: bool = Fals
         cells = [
             *([str(row.match)[:8]] if with_match else []),
             str(row.round),
-            str(row.player),
+            shortened(str(row.player)),
             f"{row.start_frame}→{row.end_frame}",
             _num(row.seconds, 2),
             _num(row.length_m, 1),

@@ -18,6 +18,7 @@ from decoy_cli.errors import EstaError
 from decoy_cli.esta import Match, Round, iter_match_files, parse_round_address, read_match
 from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.replay.missing import lacking
+from decoy_cli.text import shortened
 
 
 def info(
@@ -164,8 +165,8 @@ def _show_round(console: Console, played: Round) -> None:
         known = np.flatnonzero(played.present[row])
         last_hp = str(int(played.hp[row, known[-1]])) if known.size else "-"
         table.add_row(
-            player.key,
-            player.name,
+            shortened(player.key),
+            shortened(player.name),
             player.side,
             str(int(played.present[row].sum())),
             str(int(played.alive[row].sum())),

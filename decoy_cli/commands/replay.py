@@ -21,6 +21,7 @@ from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
+from decoy_cli.text import shortened
 
 
 @with_groups
@@ -118,7 +119,7 @@ def replay(
             table.add_column(name, justify="right")
         for _, row in players.iterrows():
             table.add_row(
-                row["player"],
+                shortened(str(row["player"])),  # whole in players.csv
                 row["side"],
                 *("–" if not np.isfinite(row[name]) else f"{row[name]:.3f}" for name in names),
             )
@@ -128,7 +129,7 @@ def replay(
         timing.add_column(column, justify="right" if column != "player" else "left")
     for _, row in players.iterrows():
         timing.add_row(
-            row["player"],
+            shortened(str(row["player"])),
             f"{row['late_share']:.1%}" if np.isfinite(row["late_share"]) else "–",
             f"{row['late_p95_s']:.2f}" if np.isfinite(row["late_p95_s"]) else "–",
             str(row["stuck"]),

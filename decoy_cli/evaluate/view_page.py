@@ -19,7 +19,7 @@ from decoy_cli.evaluate.runner import round_id
 from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.view_trace import RoundTrace
-from decoy_cli.text import visible
+from decoy_cli.text import shown_name, visible
 from decoy_cli.view.page import (
     PageData,
     TableSpec,
@@ -93,7 +93,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     for row, r, p in zip(players["rows"], players["round"], players["player"], strict=True):
         # match and player (PLAYER_COLUMNS) as recorded, not as the CSV made them inert
         row[0] = visible(labels[r]).rsplit(":", 1)[0]
-        row[2] = visible(traces[r].players[p].name)
+        row[2] = shown_name(traces[r].players[p].name)
     options = object_at(summary, "options")
     return {
         "title": visible(f"decoy evaluate: {(cache_root or folder).resolve().name}"),

@@ -26,7 +26,7 @@ import pandas as pd
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import JsonObject, json_ready, write_atomic
 from decoy_cli.replay.view_trace import RoundTrace
-from decoy_cli.text import visible
+from decoy_cli.text import shortened, shown_name, visible
 
 Cell = str | int | float | bool | None
 """A cell of a page's table."""
@@ -65,6 +65,10 @@ class PageData(TypedDict):
     rounds: list[JsonObject]
     initial: int
 
+
+TEXT_CELL_LIMIT = 200
+"""Characters of a text cell of the page's tables (a reason, a list of names: any longer is
+cut with a marker)."""
 
 _HERE = Path(__file__).resolve().parent
 _ESCAPES = {
@@ -119,10 +123,11 @@ def map_floor(map_name: str) -> MapFloor:
 
 def round_entry(label: str, info: str, trace: RoundTrace) -> JsonObject:
     """One round of the page: its label, a line about it and its trace, the players' names
-    with their control characters written as escapes (`decoy_cli.text.visible`)."""
+    with their control characters written as escapes and cut to a readable length
+    (`decoy_cli.text.shown_name`)."""
     recorded = msgspec.to_builtins(trace)
     for player in recorded["players"]:
-        player["name"] = visible(player["name"])
+        player["name"] = shown_name(player["name"])
     return {"label": visible(label), "info": visible(info), **recorded}
 
 
@@ -151,7 +156,7 @@ def _cell(value: object, digits: int) -> Cell:
         if not math.isfinite(value):
             return None
         return float(f"{value:.{digits}g}")
-    return str(value)
+    return shortened(str(value), TEXT_CELL_LIMIT)
 
 
 def round_index(data: PageData, label: str) -> int:

@@ -19,7 +19,7 @@ from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.reading import read_limited
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
-from decoy_cli.text import visible
+from decoy_cli.text import shown_name, visible
 from decoy_cli.view.page import PageData, map_floor, player_table, round_entry, table_spec
 
 REPLAY_MARKER = "replay.csv"
@@ -61,7 +61,7 @@ def replay_page(folder: Path) -> PageData:
     )
     table = player_table(players[columns], [0] * len(players), list(range(len(players))))
     for row, player in zip(table["rows"], trace.players, strict=True):
-        row[0] = visible(player.name)  # as recorded, not as the CSV made it inert
+        row[0] = shown_name(player.name)  # as recorded, not as the CSV made it inert
     return {
         "title": f"decoy replay: {label}",
         "subtitle": visible(f"{folder.resolve().name} · map {trace.map_name}"),
