@@ -7,6 +7,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import zipfile
 from dataclasses import replace
 from pathlib import Path
@@ -667,3 +668,69 @@ def test_replay_of_a_folder_of_tables_names_its_output_after_its_content(
     assert result.exit_code == 0, result.output
     written = result.output.strip().splitlines()[-1]
     assert written.startswith("replay written to") and "m-" in written and "_r1" in written
+
+
+def test_a_zip_member_lying_small_about_its_size_is_refused_unread(tmp_path: Path) -> None:
+    members = _members(write_awpy2_zip(_sample(), tmp_path / "good.zip"))
+    bomb = tmp_path / "bomb.zip"
+    with zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in members.items():
+            archive.writestr(name, data + (b"\0" * 50_000_000 if name == "ticks.parquet" else b""))
+    raw = bytearray(bomb.read_bytes())
+    with zipfile.ZipFile(bomb) as archive:
+        info = archive.getinfo("ticks.parquet")
+    size_at = info.header_offset + 22  # the local header's uncompressed size
+    raw[size_at : size_at + 4] = (1000).to_bytes(4, "little")
+    central = raw.rfind(b"PK\x01\x02", 0, raw.find(b"ticks.parquet", info.header_offset + 30))
+    raw[central + 24 : central + 28] = (1000).to_bytes(4, "little")
+    bomb.write_bytes(bytes(raw))
+    with pytest.raises(EstaError, match=r"ticks\.parquet cannot be read"):
+        read_match(bomb)
+
+
+@pytest.mark.parametrize(
+    ("table", "column", "value", "said"),
+    [
+        ("snapshots", "name", pa.array([{"first": "a"}]), "column name holds struct"),
+        ("smokes", "x", 1e30, "a smoke bursts at .* off the map"),
+        ("blinds", "duration", 1e30, "lasts 1e\\+30 s: left out"),
+        ("damages", "dmg_health", 10**9, "deals 1000000000 HP raw"),
+    ],
+)
+def test_values_no_game_has_are_named(
+    tmp_path: Path, table: str, column: str, value: object, said: str
+) -> None:
+    folder = write_awpy3_folder(_with_utility(_sample()), tmp_path / "m")
+
+    def edit(data: pa.Table) -> pa.Table:
+        index = data.schema.get_field_index(column)
+        if isinstance(value, pa.Array):
+            return data.set_column(index, column, pa.repeat(value[0], len(data)))
+        values = data[column].to_pylist()
+        values[0] = value
+        return data.set_column(index, column, pa.array(values, data.schema.field(column).type))
+
+    _edit_table(folder, table, edit)
+    try:
+        match = read_match(folder)
+    except EstaError as error:
+        assert re.search(said, str(error))
+        return
+    told = [str(e) for e in match.round_errors.values()]
+    told += [w for r in match.rounds for w in r.warnings]
+    assert any(re.search(said, text) for text in told), told
+
+
+def test_too_many_rounds_and_a_map_name_that_is_a_path_are_refused(folder: Path) -> None:
+    rounds = pq.read_table(folder / "rounds.parquet")
+    many = pa.concat_tables([rounds] * 101)  # 202 rounds, repeated: refused before reading them
+    pq.write_table(many, folder / "rounds.parquet")
+    with pytest.raises(EstaError, match="202 rounds"):
+        read_match(folder)
+    pq.write_table(rounds, folder / "rounds.parquet")
+    header = json.loads((folder / "header.json").read_text())
+    for name in ("../../etc/de_dust2", "de_" + "x" * 100_000):
+        (folder / "header.json").write_text(json.dumps({**header, "map_name": name}))
+        with pytest.raises(EstaError, match="names no map") as raised:
+            read_match(folder)
+        assert len(str(raised.value)) < 500

@@ -17,12 +17,18 @@ from decoy_cli.esta.awpy.names import (
     side_name,
     weapon_name,
 )
-from decoy_cli.esta.frames import RoundClock
+from decoy_cli.esta.frames import MAX_COORD_U, RoundClock
 from decoy_cli.esta.reader import UTILITY_COLUMNS, empty_utility
 from decoy_cli.esta.schema import BombEvent, DamageEvent, FlashEvent, Invalid, KillEvent
 
 MAX_HP = 100
 """A player's health at most (the game's)."""
+MAX_RAW_DAMAGE = 1000
+"""Most HP one hit may deal before the victim's health caps it: about twice the game's most (an
+AWP head shot, 115 x 4; the real events' largest is 452)."""
+MAX_BLIND_S = 20.0
+"""Longest blind kept, seconds: a flashbang blinds for a few (awpy 3's own tests bound its
+durations by 6 s); longer is not a flash."""
 
 
 def round_events(
@@ -53,8 +59,9 @@ def _flashes(blinds: pd.DataFrame, warnings: list[str]) -> list:
     out = []
     for row in _records(blinds):
         duration = row.get("duration")
-        if not (isinstance(duration, int | float) and np.isfinite(duration) and duration > 0):
-            warnings.append(f"a blind at tick {row['tick']} lasts {duration!r} s: left out")
+        if not (isinstance(duration, int | float) and 0 < duration <= MAX_BLIND_S):
+            shown = f"{duration:.3g}" if isinstance(duration, int | float) else repr(duration)
+            warnings.append(f"a blind at tick {row['tick']} lasts {shown:.20} s: left out")
             continue
         flashed = _player(row, "victim", "player")
         flashed.pop("playerViewX")
@@ -84,6 +91,12 @@ def utility_table(
             f"a {kind} bursting at tick {int(tick)} has no end in the data: not used in the fight"
         )
     end = np.where(end >= start, end, np.nan)
+    where = table[["x", "y", "z"]].to_numpy(np.float64)
+    with np.errstate(invalid="ignore"):
+        off = ~(np.abs(where) <= MAX_COORD_U).all(axis=1)
+    if off.any():
+        x, y, z = where[int(np.argmax(off))]
+        raise Invalid(f"a {kind} bursts at ({x:.3g}, {y:.3g}, {z:.3g}) u, off the map")
 
     def column(name: str) -> np.ndarray:
         values = table[name] if name in table else pd.Series(None, index=table.index)
@@ -219,9 +232,11 @@ def _kill(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
 
 
 def _damage(row: dict[str, object], warnings: list[str]) -> dict[str, object]:
-    taken = row.get("dmg_health_taken")
+    taken, raw = row.get("dmg_health_taken"), row.get("dmg_health")
     if taken is not None and not 0 <= float(taken) <= MAX_HP:  # type: ignore[arg-type]
         raise Invalid(f"the damage at tick {row['tick']} takes {taken} HP (a player has {MAX_HP})")
+    if raw is not None and not 0 <= float(raw) <= MAX_RAW_DAMAGE:  # type: ignore[arg-type]
+        raise Invalid(f"the damage at tick {row['tick']} deals {raw} HP raw (no hit deals that)")
     attacker = _player(row, "attacker", "attacker")
     victim = _player(row, "victim", "victim")
     return {

@@ -13,6 +13,7 @@ time (the 115 s round time), the median of their ticks per second taken to the n
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -35,9 +36,13 @@ from decoy_cli.esta.awpy.tables import TableSource, open_source, read_table, str
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.esta.reader import Match
 from decoy_cli.esta.records import BOMB_TIMER_S, ROUND_TIME_S
+from decoy_cli.esta.source import MAX_ROUNDS
 
 CS2_TICK_RATE = 64
 """Ticks a second of a CS2 server (sub-tick, 64 ticks/s): the rate where the header gives none."""
+
+MAP_NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
+"""What a map's name can be (de_dust2, cs_office, workshop names): a short word, no path."""
 
 KNOWN_TICK_RATES = (64, 128)
 """The tick rates of Counter-Strike demos: CS2's 64, CS:GO's 64 and 128."""
@@ -54,7 +59,7 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
     source = open_source(path, rate)
     layout = LAYOUTS[source.layout]
     map_name = source.header.get("map_name")
-    if not isinstance(map_name, str) or not map_name.strip():
+    if not isinstance(map_name, str) or not MAP_NAME.fullmatch(map_name):
         raise EstaError(f"{path}: header.json names no map (map_name {map_name!r:.60})")
     bomb = _frame(source, layout.bomb)
     rounds = _rounds(source, layout, bomb)
@@ -234,6 +239,10 @@ def _damages(source: TableSource, layout: Layout) -> pd.DataFrame:
 def _rounds(source: TableSource, layout: Layout, bomb: pd.DataFrame) -> pd.DataFrame:
     """The rounds table under the reader's names; awpy 3's plants come from its bomb table."""
     rounds = _frame(source, layout.rounds)
+    if len(rounds) > MAX_ROUNDS:
+        raise EstaError(
+            f"{source.path}: {len(rounds):,} rounds (a match holds at most {MAX_ROUNDS})"
+        )
     for column in ("round_num", "start", "freeze_end", "end", "official_end", "bomb_plant"):
         if column not in rounds:
             continue

@@ -142,13 +142,7 @@ def _opened(
     if found is None:
         raise EstaError(f"{source.path}: no {table} table (awpy writes one; is this awpy data?)")
     try:
-        if isinstance(found, pa.Table):
-            opened: pq.ParquetFile | pa.Table = found
-            schema = found.schema
-        else:
-            schema = _parquet(found).schema_arrow
-            text = [c for c, kind in columns.items() if kind == "str" and c in schema.names]
-            opened = _parquet(found, text)  # each distinct text held once, however many rows
+        schema = found.schema if isinstance(found, pa.Table) else _parquet(found).schema_arrow
     except (pa.ArrowException, OSError, ValueError) as error:
         raise EstaError(f"{where}: not a readable parquet table ({error})") from None
     names = [c for c in columns if c in schema.names]
@@ -156,12 +150,16 @@ def _opened(
     if missing:
         raise EstaError(f"{where}: no column {', '.join(missing)}")
     for name in names:
-        kind = columns[name]
-        if not _CHECKS[kind](schema.field(name).type):
-            raise EstaError(
-                f"{where}: column {name} holds {schema.field(name).type}, not {kind} values"
-            )
-    return opened, names
+        kind, held = columns[name], schema.field(name).type
+        if not _CHECKS[kind](held):
+            raise EstaError(f"{where}: column {name} holds {held}, not {kind} values")
+    if isinstance(found, pa.Table):
+        return found, names
+    text = [c for c in names if columns[c] == "str" and not pa.types.is_null(schema.field(c).type)]
+    try:
+        return _parquet(found, text), names  # each distinct text held once, however many rows
+    except (pa.ArrowException, OSError, ValueError) as error:
+        raise EstaError(f"{where}: not a readable parquet table ({error})") from None
 
 
 def _parquet(found: bytes | Path, text: list[str] | None = None) -> pq.ParquetFile:
@@ -212,8 +210,9 @@ def _zip(path: Path) -> TableSource:
     def member(name: str) -> bytes | None:
         if name not in members:
             return None
-        try:
-            data = archive.read(name)
+        try:  # read by the declared size, so a member that lies about it cannot inflate on
+            with archive.open(members[name]) as handle:
+                data = handle.read(members[name].file_size + 1)
         except _MEMBER_ERRORS as error:
             raise EstaError(f"{path}: {name} cannot be read ({error})") from None
         if len(data) != members[name].file_size:
