@@ -9,6 +9,8 @@ One `decoy evaluate` of the shipped sample serves the module (about 15 s).
 
 from __future__ import annotations
 
+import base64
+import hashlib
 import json
 import re
 import shutil
@@ -541,3 +543,52 @@ def test_the_page_lists_inferred_events_apart(browser: Browser, tmp_path: Path) 
     assert any(" · inferred · " in text and "plants (bomb carrier" in text for text in listed)
     assert not any(" · real · " in text and "plants" in text for text in listed)
     assert browser.console_errors() == []
+
+
+# ---- the page's Content-Security-Policy (issue 51) --------------------------------------------
+
+
+def _policy(html: str) -> dict[str, list[str]]:
+    found = re.search(r'<meta http-equiv="Content-Security-Policy" content="([^"]*)">', html)
+    assert found is not None
+    directives = [part.split() for part in found.group(1).split(";") if part.strip()]
+    return {name: values for name, *values in directives}
+
+
+def _inline(html: str, tag: str) -> list[str]:
+    """The contents of the page's inline elements `tag` (scripts that run, or styles)."""
+    return re.findall(rf"<{tag}>(.*?)</{tag}>", html, re.S)
+
+
+def _digest(text: str) -> str:
+    return "'sha256-" + base64.b64encode(hashlib.sha256(text.encode()).digest()).decode() + "'"
+
+
+def test_the_policy_names_the_page_s_script_and_style_by_hash(hostile: Path) -> None:
+    html = hostile.read_text(encoding="utf-8")
+    policy = _policy(html)
+    assert "'unsafe-inline'" not in str(policy) and "'unsafe-eval'" not in str(policy)
+    assert policy["default-src"] == ["'none'"]
+    assert policy["script-src"] == [_digest(s) for s in _inline(html, "script")]
+    assert policy["style-src"] == [_digest(s) for s in _inline(html, "style")]
+    assert len(policy["script-src"]) == len(policy["style-src"]) == 1
+    assert not re.search(r"<[^>]+\son[a-z]+\s*=", html, re.I)  # no inline handler
+    assert not re.search(r"<[^>]+\sstyle\s*=", html, re.I)  # no inline style attribute
+
+
+@needs_browser
+def test_an_injected_handler_or_script_does_not_run(browser: Browser, hostile: Path) -> None:
+    browser.open(hostile)
+    assert browser.evaluate("document.body.dataset.ready") == "1"  # the page's own script ran
+    background = "getComputedStyle(document.body).backgroundColor"
+    assert browser.evaluate(background) == "rgb(250, 250, 250)"  # and its own style applies
+    browser.evaluate(
+        "(() => { window.ran = []; "
+        "document.body.insertAdjacentHTML('beforeend', "
+        '\'<img src="data:," onerror="window.ran.push(1)">'
+        '<button id=b onclick="window.ran.push(2)">b</button>\'); '
+        "const s = document.createElement('script'); s.textContent = 'window.ran.push(3)'; "
+        "document.body.appendChild(s); document.getElementById('b').click(); })()"
+    )
+    browser.wait_for("document.images.length > 0 && document.images[0].complete")
+    assert browser.evaluate("window.ran.length") == 0

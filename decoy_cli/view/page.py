@@ -3,7 +3,10 @@
 `write_page` fills the slots of page.html with page.css, page.js and the page's data as JSON.
 The JSON is written so that no text from the data can end its script element or start markup
 (`<`, `>`, `&` and the line separators as `\\u` escapes), and the script shows every text
-through `textContent` or the canvas, never as markup.
+through `textContent` or the canvas, never as markup. Escaping is the first protection; the
+page's Content-Security-Policy (`policy`) is the second: it allows the page's one script and
+one style by their SHA-256 and nothing else (no inline handler, no other script, no network),
+so markup injected into the page could not run.
 
 The data (`PageData`): `title`, `subtitle`, `map` (`map_floor`), `tables` (each `title`,
 `columns`, `rows`), `players` (the player-round list: `columns`, `rows`, and per row the index
@@ -13,6 +16,8 @@ of its `round` and of its `player` in that round), `rounds` (each `label`, `info
 
 from __future__ import annotations
 
+import base64
+import hashlib
 import json
 import math
 from functools import cache
@@ -88,12 +93,30 @@ def embedded_json(data: object) -> str:
     return text
 
 
+def policy(script: str, style: str) -> str:
+    """The page's Content-Security-Policy: its one inline `script` and `style` by hash, images
+    only from data: URLs (the canvas), nothing else (no other script, no inline handler, no
+    request, no form, no base URL)."""
+    return (
+        f"default-src 'none'; script-src {_sha256(script)}; style-src {_sha256(style)}; "
+        "img-src data:; base-uri 'none'; form-action 'none'"
+    )
+
+
+def _sha256(text: str) -> str:
+    """A CSP source naming `text` by its SHA-256 (of its UTF-8 bytes, as browsers hash it)."""
+    return f"'sha256-{base64.b64encode(hashlib.sha256(text.encode('utf-8')).digest()).decode()}'"
+
+
 def page_html(data: PageData) -> str:
     """The page's HTML with everything inline."""
     html = (_HERE / "page.html").read_text(encoding="utf-8")
+    style = (_HERE / "page.css").read_text(encoding="utf-8")
+    script = (_HERE / "page.js").read_text(encoding="utf-8")
     parts = {
-        "/*STYLE*/": (_HERE / "page.css").read_text(encoding="utf-8"),
-        "/*SCRIPT*/": (_HERE / "page.js").read_text(encoding="utf-8"),
+        "/*POLICY*/": policy(script, style),
+        "/*STYLE*/": style,
+        "/*SCRIPT*/": script,
         "/*DATA*/": embedded_json(data),
     }
     for slot, text in parts.items():  # each slot once, in the order of the page
