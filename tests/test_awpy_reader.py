@@ -526,7 +526,7 @@ def test_a_smoke_without_an_end_and_a_blind_of_negative_duration_are_named(
     )
     round_ = read_match(folder).round(1)
     assert any("a smoke bursting at tick" in w and "no end" in w for w in round_.warnings)
-    assert any("lasts -1.0 s: left out" in w for w in round_.warnings)
+    assert any("lasts -1 s: left out" in w for w in round_.warnings)
     assert np.isnan(round_.smokes["end_s"]).all() and len(round_.flashes) == 0
 
 
