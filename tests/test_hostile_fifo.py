@@ -8,6 +8,7 @@ hanging it."""
 from __future__ import annotations
 
 import csv
+import json
 import os
 import shutil
 import subprocess
@@ -122,3 +123,45 @@ def test_a_fifo_in_a_model_folder_is_one_error_line(tmp_path: Path) -> None:
         )
         assert done.returncode == 1, done.stderr
         assert f"{folder / name}: not a regular file (a FIFO)" in done.stderr
+
+
+def test_a_fifo_as_weights_is_one_error_line(tmp_path: Path) -> None:
+    folder = tmp_path / "models"
+    folder.mkdir()
+    for name in ("dip.json", "rules.json"):
+        shutil.copy(ROOT / "models" / name, folder / name)
+    os.mkfifo(folder / "dip.pt")
+    write_match(tmp_path / "m.json", make_match())
+    done = decoy(
+        "replay", f"{tmp_path / 'm.json'}:1", "--models", str(folder), "--out", "r", cwd=tmp_path
+    )
+    assert done.returncode == 1, done.stderr
+    assert done.stderr.strip() == f"error: {folder / 'dip.pt'}: not a regular file (a FIFO)"
+
+
+def test_evaluate_over_one_bad_file_of_each_kind_keeps_the_good(tmp_path: Path) -> None:
+    data = tmp_path / "data"
+    data.mkdir()
+    for name in ("a.json", "z.json.xz"):
+        write_match(data / name, make_match() | {"matchID": name})
+    bad = {
+        "deep.json": "[" * 100_000 + "]" * 100_000,
+        "truncated.json": json.dumps(make_match())[:5000],
+        "empty.json": "",
+        "binary.json.xz": "\xfd7zXZ\x00 not really xz",
+    }
+    for name, text in bad.items():
+        (data / name).write_text(text, encoding="latin-1")
+    os.mkfifo(data / "fifo.json.xz")
+    (data / "folder.json").mkdir()
+    (data / "loop.json").symlink_to(data / "loop.json")
+    out = tmp_path / "out"
+    done = decoy("evaluate", str(data), "--no-combat", "--no-view", "--out", str(out), cwd=tmp_path)
+    assert done.returncode == 1, done.stderr
+    assert "internal error" not in done.stderr and "Traceback" not in done.stderr
+    with (out / "failures.csv").open(newline="") as handle:
+        failed = {Path(row["file"]).name for row in csv.DictReader(handle)}
+    assert {*bad, "fifo.json.xz", "loop.json"} <= failed, failed
+    with (out / "rounds.csv").open(newline="") as handle:
+        matches = {row["match"] for row in csv.DictReader(handle)}
+    assert matches == {"a.json", "z.json.xz"}

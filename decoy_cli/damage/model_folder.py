@@ -30,7 +30,7 @@ from decoy_cli.damage.features import HIT_GROUPS, MAPS, WEAPONS, FeatureSpec
 from decoy_cli.damage.networks import DipNet, DogNet
 from decoy_cli.errors import ModelError
 from decoy_cli.files import JsonObject, json_text, object_at, write_atomic
-from decoy_cli.reading import load_json
+from decoy_cli.reading import load_json, open_regular
 
 FORMAT = "decoy-damage-model"
 FORMAT_VERSION = 1
@@ -208,10 +208,13 @@ def _load(folder: Path, kind: str) -> tuple[JsonObject, dict[str, torch.Tensor]]
 def read_torch_file(path: Path) -> object:
     """What a torch.save file holds, loaded on the CPU with `weights_only=True` (no code runs);
     a missing, foreign or damaged file is one ModelError line."""
-    if not path.is_file():
+    if not path.exists():
         raise ModelError(f"{path}: no such file")
     try:
-        return torch.load(path, map_location="cpu", weights_only=True)
+        with open_regular(path, ModelError) as handle:  # a FIFO is refused, not waited on
+            return torch.load(handle, map_location="cpu", weights_only=True)
+    except ModelError:
+        raise
     except Exception as error:  # torch raises many kinds for foreign or damaged files
         text = str(error).strip()
         first = text.splitlines()[0] if text else type(error).__name__
