@@ -734,3 +734,14 @@ def test_too_many_rounds_and_a_map_name_that_is_a_path_are_refused(folder: Path)
         with pytest.raises(EstaError, match="names no map") as raised:
             read_match(folder)
         assert len(str(raised.value)) < 500
+
+
+def test_a_round_without_play_is_refused(folder: Path) -> None:
+    def no_play(data: pa.Table) -> pa.Table:
+        freeze = data["freeze_end_tick"].to_numpy().copy()
+        index = data.schema.get_field_index("end_tick")
+        return data.set_column(index, "end_tick", pa.array(freeze, pa.int32()))
+
+    _edit_table(folder, "rounds", no_play)
+    with pytest.raises(EstaError, match=r"not in order \(a round has play\)"):
+        read_match(folder)

@@ -194,10 +194,10 @@ def round_windows(path: Path, table: pd.DataFrame) -> list[RoundWindow]:
         repeated = sorted({n for n in numbers if numbers.count(n) > 1})
         raise EstaError(f"{path}: the rounds table holds round {repeated[0]} twice")
     for w in windows:
-        if not w.start <= w.freeze_end <= w.end <= w.official_end:
+        if not w.start <= w.freeze_end < w.end <= w.official_end:
             raise EstaError(
                 f"{path}: round {w.num}: start {w.start}, freeze end {w.freeze_end}, end {w.end} "
-                f"and official end {w.official_end} are not in order"
+                f"and official end {w.official_end} are not in order (a round has play)"
             )
     for before, after in itertools.pairwise(windows):
         if after.start < before.end:
