@@ -15,20 +15,13 @@ import shutil
 import tempfile
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
-from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
 
 from decoy_cli.errors import DecoyError, OutputError
-from decoy_cli.reading import load_json
+from decoy_cli.reading import JsonObject, JsonValue, load_json  # the JSON types: read there
 from decoy_cli.text import csv_inert
-
-JsonValue: TypeAlias = "str | int | float | bool | list[JsonValue] | dict[str, JsonValue] | None"
-"""What a JSON file holds, as `json.loads` returns it."""
-
-JsonObject: TypeAlias = "dict[str, JsonValue]"
-"""A JSON object: what the outputs' JSON files are."""
 
 
 def write_atomic(path: str | Path, payload: bytes | Callable[[Path], None]) -> Path:

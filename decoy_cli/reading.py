@@ -9,7 +9,8 @@ Every file a user can hand decoy or edit (a run's `summary.json`, a model folder
   error naming the file and what it is, and nothing is opened that is not a regular file (the
   open itself does not block: it checks the opened file again, so a file swapped in between
   fails the same way);
-* `read_limited` reads at most a given number of bytes of it;
+* `read_limited` reads at most a given number of bytes of it, `read_csv_table` a CSV table of
+  at most a given size (with the columns named as text read as text);
 * `load_json` and `parse_json` read JSON as Python's `json` does, but refuse a document nested
   deeper than `MAX_JSON_DEPTH` (which would end in a RecursionError), a number that is not
   finite (`NaN`, `Infinity` or one beyond the float range, which strict JSON, and decoy's own
@@ -24,14 +25,21 @@ import json
 import math
 import os
 import stat
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, BinaryIO
+from typing import TYPE_CHECKING, BinaryIO, TypeAlias
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.text import shortened, visible
 
 if TYPE_CHECKING:
-    from decoy_cli.files import JsonValue
+    import pandas as pd
+
+JsonValue: TypeAlias = "str | int | float | bool | list[JsonValue] | dict[str, JsonValue] | None"
+"""What a JSON file holds, as `json.loads` returns it."""
+
+JsonObject: TypeAlias = "dict[str, JsonValue]"
+"""A JSON object: what the outputs' JSON files are."""
 
 MAX_JSON_MB = 64
 """Largest JSON file decoy reads besides match files (which have their own limit,
@@ -99,6 +107,30 @@ def read_limited(path: str | Path, limit: int, error: type[DecoyError] = DecoyEr
     if len(data) > limit:
         raise error(f"{path}: larger than {limit / 1e6:g} MB, more than decoy reads of it")
     return data
+
+
+def read_csv_table(
+    path: str | Path,
+    error: type[DecoyError] = DecoyError,
+    *,
+    limit_mb: float,
+    text: Sequence[str] = (),
+) -> pd.DataFrame:
+    """The CSV table of the regular file `path` (at most `limit_mb` MB), the columns `text` read
+    as text whatever they hold; a missing, unreadable or larger file is one `error` naming
+    it."""
+    path = Path(path)
+    if not path.exists():
+        raise error(f"{path}: not found (is {path.parent} an output folder of decoy?)")
+    import pandas as pd
+
+    with open_regular(path, error) as handle:
+        if os.fstat(handle.fileno()).st_size > limit_mb * 1e6:
+            raise error(f"{path}: larger than {limit_mb:g} MB, not a table decoy wrote")
+        try:
+            return pd.read_csv(handle, dtype=dict.fromkeys(text, "str"))
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, OSError) as e:
+            raise error(f"{path}: not a readable CSV ({str(e).splitlines()[0]})") from None
 
 
 def load_json(

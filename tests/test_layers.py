@@ -14,6 +14,7 @@ LAYERS = {
     "compiled": 0,
     "errors": 0,
     "files": 0,
+    "reading": 0,
     "text": 0,
     "weapons": 0,
     "package_data": 0,

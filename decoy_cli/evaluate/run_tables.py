@@ -12,7 +12,6 @@ the file, the column, the data row and the cell, never a ValueError where the nu
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +19,7 @@ import pandas as pd
 
 from decoy_cli.errors import DecoyError
 from decoy_cli.metrics import ALL_METRIC_NAMES
-from decoy_cli.reading import open_regular
+from decoy_cli.reading import read_csv_table
 from decoy_cli.text import shortened, visible
 
 MAX_TABLE_MB = 1024
@@ -134,16 +133,8 @@ _FLAGS = {"True": True, "False": False, True: True, False: False}
 def read_run_table(path: Path, error: type[DecoyError] = DecoyError) -> pd.DataFrame:
     """The run table `path` (rounds.csv, players.csv or places.csv), checked (module doc); a
     missing, unreadable or edited table is one `error` naming it (and the column and row)."""
-    if not path.exists():
-        raise error(f"{path}: not found (is {path.parent} an output folder of decoy?)")
-    with open_regular(path, error) as handle:
-        if os.fstat(handle.fileno()).st_size > MAX_TABLE_MB * 1_000_000:
-            raise error(f"{path}: larger than {MAX_TABLE_MB} MB, not a table decoy wrote")
-        text = dict.fromkeys(TEXT_COLUMNS.get(path.name, ()), "str")
-        try:
-            frame = pd.read_csv(handle, dtype=text)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, OSError) as e:
-            raise error(f"{path}: not a readable CSV ({str(e).splitlines()[0]})") from None
+    text = TEXT_COLUMNS.get(path.name, ())
+    frame = read_csv_table(path, error, limit_mb=MAX_TABLE_MB, text=text)
     for column in NUMBER_COLUMNS.get(path.name, ()):
         if column in frame.columns:
             frame[column] = _numbers(path, frame, column, error)

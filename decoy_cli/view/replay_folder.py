@@ -13,10 +13,9 @@ import msgspec
 import pandas as pd
 
 from decoy_cli.errors import DecoyError
-from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.files import JsonObject, object_at, read_json_object
 from decoy_cli.metrics import ALL_METRIC_NAMES
-from decoy_cli.reading import read_limited
+from decoy_cli.reading import read_csv_table, read_limited
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import shown_name, visible
@@ -28,6 +27,8 @@ REPLAY_MARKER = "replay.csv"
 PLAYER_COLUMNS = ("player", "side", "death")
 MAX_TRACE_BYTES = 256_000_000
 """Largest `trace.json` read: a round's thinned paths take a few hundred kB."""
+MAX_PLAYERS_MB = 64
+"""Largest players.csv of a replay read: it holds one row a player."""
 
 
 def is_replay_folder(folder: Path) -> bool:
@@ -47,7 +48,7 @@ def replay_page(folder: Path) -> PageData:
         trace = msgspec.json.decode(read_limited(trace_path, MAX_TRACE_BYTES), type=RoundTrace)
     except (OSError, msgspec.DecodeError) as error:
         raise DecoyError(f"{trace_path}: not a round's trace ({error})") from None
-    players = read_run_table(folder / "players.csv")
+    players = read_csv_table(folder / "players.csv", limit_mb=MAX_PLAYERS_MB, text=("player",))
     metrics = [m for m in ALL_METRIC_NAMES if m in players.columns]
     columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
     missing = [c for c in columns if c not in players.columns]
