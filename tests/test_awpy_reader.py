@@ -745,3 +745,30 @@ def test_a_round_without_play_is_refused(folder: Path) -> None:
     _edit_table(folder, "rounds", no_play)
     with pytest.raises(EstaError, match=r"not in order \(a round has play\)"):
         read_match(folder)
+
+
+def test_replay_output_does_not_grow_with_the_names(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Players named with 20,000 characters: the notes that name them are cut when printed."""
+    sample = _sample()
+    long = [replace(p, name=p.name + "x" * 20_000) for p in sample.rounds[0].players]
+    tables = {}
+    for table, columns in (
+        ("kills", ("attackerName", "victimName")),
+        ("damages", ("attackerName", "victimName")),
+        ("bomb_events", ("playerName",)),
+    ):
+        tables[table] = getattr(sample.rounds[0], table).copy()
+        for column in columns:
+            tables[table][column] = tables[table][column].map(
+                lambda n: n + "x" * 20_000 if isinstance(n, str) else n
+            )
+    first = replace(sample.rounds[0], players=long, **tables)
+    folder = write_awpy3_folder(replace(sample, rounds=[first]), tmp_path / "m")
+    _edit_table(folder, "snapshots", lambda t: t.drop_columns(["active_weapon"]))  # inferred
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["replay", f"{folder}:1", "--no-combat", "--no-bomb"])
+    assert result.exit_code == 0, result.output[-500:]
+    assert "inferred: weapon in hand" in result.output
+    assert len(result.output) < 40_000  # each name is 20,000 characters; ten of them

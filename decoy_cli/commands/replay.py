@@ -21,7 +21,10 @@ from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
 from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
-from decoy_cli.text import shortened
+from decoy_cli.text import shortened, visible
+
+NOTE_LIMIT = 400
+"""Most characters of a note printed (the names in it come from the data)."""
 
 
 @with_groups
@@ -90,14 +93,14 @@ def replay(
         replayed = simulated
     outcome.add_row("replay", *map(str, replayed))
     console.print(outcome)
-    for warning in result.warnings:
-        console.print(
-            f"warning: implausible data replayed anyway: {warning}", style="yellow", markup=False
-        )
-    for note in result.contradictions:
-        console.print(f"data contradicts itself: {note}", style="yellow", markup=False)
-    for note in result.inferred:
-        console.print(f"inferred: {note}", style="yellow", markup=False)
+    for prefix, notes in (
+        ("warning: implausible data replayed anyway: ", result.warnings),
+        ("data contradicts itself: ", result.contradictions),
+        ("inferred: ", result.inferred),
+    ):
+        for note in notes:  # they name players: a line as long as a screen's, whole in the files
+            text = shortened(visible(prefix + note), NOTE_LIMIT)
+            console.print(text, style="yellow", markup=False, highlight=False)
     if options.combat:
         console.print(f"deaths decided by: {options.deaths}")
         used = result.utility
