@@ -772,3 +772,14 @@ def test_replay_output_does_not_grow_with_the_names(
     assert result.exit_code == 0, result.output[-500:]
     assert "inferred: weapon in hand" in result.output
     assert len(result.output) < 40_000  # each name is 20,000 characters; ten of them
+
+
+def test_a_tick_table_of_more_rows_than_a_match_holds_is_refused(
+    folder: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from decoy_cli.esta.awpy import reader
+
+    rows = pq.read_metadata(folder / "snapshots.parquet").num_rows
+    monkeypatch.setattr(reader, "MAX_TICK_ROWS", rows - 1)
+    with pytest.raises(EstaError, match=f"{rows:,} tick rows, more than {rows - 1:,}"):
+        read_match(folder)

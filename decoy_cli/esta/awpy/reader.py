@@ -32,7 +32,13 @@ from decoy_cli.esta.awpy.rounds import (
     read_tables_match,
     round_windows,
 )
-from decoy_cli.esta.awpy.tables import TableSource, open_source, read_table, stream_table
+from decoy_cli.esta.awpy.tables import (
+    TableSource,
+    open_source,
+    read_table,
+    stream_table,
+    table_rows,
+)
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.esta.reader import Match
 from decoy_cli.esta.records import BOMB_TIMER_S, ROUND_TIME_S
@@ -65,9 +71,10 @@ def read_awpy_match(path: Path, *, rate: float, implausible: Implausible = "fail
     rounds = _rounds(source, layout, bomb)
     windows = round_windows(path, rounds)
     tick_rate, rule = _tick_rate(source, windows, bomb)
+    rows_held = table_rows(source, layout.ticks.name)  # the footer's count, before any is read
+    if rows_held > MAX_TICK_ROWS:
+        raise EstaError(f"{path}: {rows_held:,} tick rows, more than {MAX_TICK_ROWS:,}")
     ticks_only = read_table(source, layout.ticks.name, {"tick": "int"}, ("tick",))
-    if ticks_only.num_rows > MAX_TICK_ROWS:
-        raise EstaError(f"{path}: {ticks_only.num_rows:,} tick rows, more than {MAX_TICK_ROWS:,}")
     tick_values = _ticks(path, layout.ticks.name, ticks_only["tick"].to_pandas())
     owner = assign_rounds(tick_values, windows)
     if owner.size and (owner < 0).all():
