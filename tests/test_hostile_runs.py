@@ -78,6 +78,7 @@ def edit_cell(path: Path, column: str, value: str, row: int = 0) -> None:
         ("rounds.csv", "seconds"),
         ("rounds.csv", "round"),
         ("rounds.csv", "frames"),
+        ("rounds.csv", "smokes"),
         ("players.csv", "round"),
         ("players.csv", "mean_dist"),
         ("players.csv", "late_share"),

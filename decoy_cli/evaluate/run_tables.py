@@ -45,6 +45,9 @@ _ROUND_COUNTS = (
     "killers_agree",
 )
 _ROUND_VALUES = (
+    "smokes",  # counts, empty where the data has no utility or nobody shot
+    "fires",
+    "blinds",
     "frame_rate",
     "seconds",
     "played_out_s",
