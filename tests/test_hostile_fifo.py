@@ -21,7 +21,7 @@ from run_fixtures import write_run
 
 from decoy_cli.errors import DecoyError, EstaError
 from decoy_cli.esta import read_match
-from decoy_cli.evaluate.settings import file_sha256
+from decoy_cli.esta.content import content_sha256
 from decoy_cli.reading import load_json, open_regular
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -86,7 +86,7 @@ def test_the_readers_refuse_a_fifo_without_opening_it(data: Path) -> None:
     with pytest.raises(EstaError, match=r"not a regular file \(a FIFO\)"):
         read_match(fifo)
     with pytest.raises(EstaError, match=r"not a regular file \(a FIFO\)"):
-        file_sha256(fifo)
+        content_sha256(fifo)
     with pytest.raises(DecoyError, match=r"not a regular file \(a FIFO\)"):
         load_json(fifo)
     with pytest.raises(DecoyError, match="is a folder, not a file"):

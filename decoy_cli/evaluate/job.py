@@ -29,9 +29,10 @@ from decoy_cli.damage.choice import ModelChoice
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Match, Round, RoundFailure, failure_from, read_match
 from decoy_cli.esta.batch import UNREADABLE_FILE
+from decoy_cli.esta.content import content_sha256
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import RoundRecord, build_record
-from decoy_cli.evaluate.settings import EvalSettings, file_sha256, round_seed
+from decoy_cli.evaluate.settings import EvalSettings, round_seed
 from decoy_cli.files import JsonValue
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import PlaceFinder
@@ -125,7 +126,7 @@ class _WorkerState:
             self.matches.move_to_end(key)
             return self.matches[key]
         path = Path(file)
-        if file_sha256(path) != file_sha:
+        if content_sha256(path) != file_sha:
             raise DecoyError(f"{file}: the file changed while the evaluation ran")
         match = read_match(path, implausible=implausible, rate=rate)
         self.matches[key] = match
@@ -144,7 +145,7 @@ def run_graph(settings: EvalSettings) -> WaypointGraph:
 
     if not settings.graph:
         return builtin_graph(settings.map_name)
-    if file_sha256(Path(settings.graph)) != settings.graph_sha:
+    if content_sha256(Path(settings.graph)) != settings.graph_sha:
         raise DecoyError(f"{settings.graph}: the graph file changed while the evaluation ran")
     return WaypointGraph.load(settings.graph)
 

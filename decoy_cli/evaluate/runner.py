@@ -31,6 +31,7 @@ from decoy_cli.damage.choice import ModelChoice, ModelFolder, ModelName
 from decoy_cli.errors import DecoyError, EstaError, GraphError
 from decoy_cli.esta import RoundFailure, collect_match_files
 from decoy_cli.esta.batch import BROKEN_ROUND, INTERNAL_ERROR, UNREADABLE_FILE, map_failure
+from decoy_cli.esta.content import content_sha256
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.backends import Outcome, Outcomes, Task
 from decoy_cli.evaluate.cache import RunCache
@@ -47,7 +48,6 @@ from decoy_cli.evaluate.record import RoundRecord
 from decoy_cli.evaluate.settings import (
     EvalSettings,
     code_fingerprint,
-    file_sha256,
     folder_fingerprint,
     index_key,
     round_key,
@@ -143,7 +143,7 @@ def make_settings(
     graph_of_run = None
     if graph is not None:  # absolute, for workers elsewhere; its map must be the run's
         graph_path = str(graph.expanduser().resolve())
-        graph_sha = file_sha256(Path(graph_path))
+        graph_sha = content_sha256(Path(graph_path))
         graph_of_run = WaypointGraph.load(graph_path)
         graph_map = str(graph_of_run.meta.get("map", ""))
         if graph_map != name:
@@ -236,7 +236,7 @@ def run_evaluation(
     by_sha: dict[str, Path] = {}
     for path in paths:
         try:
-            sha = file_sha256(path)
+            sha = content_sha256(path)
         except EstaError as error:
             failures.append(RoundFailure(str(path), None, UNREADABLE_FILE, str(error)))
             continue

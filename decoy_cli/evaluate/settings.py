@@ -103,11 +103,6 @@ def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
     return int.from_bytes(digest[:8], "little") & (2**63 - 1)
 
 
-def file_sha256(path: Path) -> str:
-    """SHA-256 of a file, or of a folder of awpy 3 tables (`content_sha256`)."""
-    return content_sha256(path)
-
-
 @cache
 def code_fingerprint(map_name: str) -> str:
     """Hash of the result-deciding source files and the map's asset files.
@@ -136,5 +131,5 @@ def folder_fingerprint(folder: Path) -> str:
     digest = hashlib.sha256()
     for path in sorted(p for p in folder.rglob("*") if p.is_file()):
         digest.update(str(path.relative_to(folder)).encode() + b"\0")
-        digest.update(file_sha256(path).encode())
+        digest.update(content_sha256(path).encode())
     return digest.hexdigest()
