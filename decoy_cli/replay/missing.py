@@ -290,7 +290,6 @@ def _plant_site(round_: Round) -> str:
 
 def _defuse(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
     """The defuser (module docstring); called when `lacking` names the defuser."""
-    events = round_.bomb_events
     if round_.clock is None or round_.end_tick is None:
         return round_
     planted = np.flatnonzero(np.asarray(round_.bomb_planted, bool))
@@ -308,19 +307,17 @@ def _defuse(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
     seconds = rules.defuse_kit_s if kit else rules.defuse_s
     start = round_.end_tick - seconds * round_.clock.tick_rate
     name = round_.players[defuser].name
-    rows = pd.DataFrame(
-        [
-            {"tick": start, "bombAction": "defuse_start", "playerName": name},
-            {"tick": float(round_.end_tick), "bombAction": "defuse", "playerName": name},
-        ]
-    )
-    rows["seconds"] = round_.clock.seconds(rows["tick"].to_numpy(np.float64))
-    table = pd.concat([events, rows], ignore_index=True) if len(events) else rows
     notes.append(
         f"defuse ({name}): the CT alive at the end nearest the bomb, from {seconds:g} s "
         f"before the round's end ({'with' if kit else 'without'} a kit)"
     )
-    return replace(round_, bomb_events=table)
+    return _with_bomb_events(
+        round_,
+        [
+            {"tick": start, "bombAction": "defuse_start", "playerName": name},
+            {"tick": float(round_.end_tick), "bombAction": "defuse", "playerName": name},
+        ],
+    )
 
 
 def _defuse_start(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
@@ -347,12 +344,19 @@ def _defuse_start(round_: Round, rules: RulesConfig, notes: list[str]) -> Round:
             f"defuse start ({name or 'unnamed'}): {seconds:g} s before the data's defuse "
             f"({'with' if kit else 'without'} a kit)"
         )
-    if not rows:
-        return round_
+    return _with_bomb_events(round_, rows) if rows else round_
+
+
+def _with_bomb_events(round_: Round, rows: list[dict[str, object]]) -> Round:
+    """The round with bomb events added (each on the round's clock), in tick order."""
+    assert round_.clock is not None  # both callers return earlier without one
     added = pd.DataFrame(rows)
     added["seconds"] = round_.clock.seconds(added["tick"].to_numpy(np.float64))
-    table = pd.concat([events, added], ignore_index=True).sort_values("tick", kind="stable")
-    return replace(round_, bomb_events=table.reset_index(drop=True))
+    events = round_.bomb_events
+    table = pd.concat([events, added], ignore_index=True) if len(events) else added
+    return replace(
+        round_, bomb_events=table.sort_values("tick", kind="stable").reset_index(drop=True)
+    )
 
 
 def contradictions(round_: Round) -> tuple[str, ...]:
