@@ -24,6 +24,6 @@ setup(
     package_dir=SHIPPED_DATA,
     package_data={
         **{package: DATA_FILES for package in shipped},
-        "decoy_cli.view": ["page.html", "page.js", "page.css"],
+        "decoy_cli.view": ["page.html", "page.css", "data.js", "draw.js", "controls.js", "tables.js"],
     },
 )

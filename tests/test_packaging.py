@@ -37,7 +37,10 @@ REQUIRED = (
     "decoy_cli/models/DOG_CARD.md",
     "decoy_cli/cli.py",
     "decoy_cli/view/page.html",
-    "decoy_cli/view/page.js",
+    "decoy_cli/view/data.js",
+    "decoy_cli/view/draw.js",
+    "decoy_cli/view/controls.js",
+    "decoy_cli/view/tables.js",
     "decoy_cli/view/page.css",
 )
 

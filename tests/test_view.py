@@ -139,7 +139,7 @@ def test_the_thinned_paths_follow_the_round_s_frames(run: Path) -> None:
         for p, player in enumerate(shown["players"]):
             alive = np.asarray(round_.alive[p]) & np.asarray(round_.present[p])
             points = np.concatenate(
-                [decode_path(s) for s in player["original"]] or [np.zeros((0, 4))]
+                [decode_path(s) for s in player["original"]] or [np.zeros((0, 5))]
             )
             assert len(points) <= alive.sum()
             frames = np.flatnonzero(alive)

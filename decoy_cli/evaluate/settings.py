@@ -20,7 +20,7 @@ from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.world.navmesh import asset_dir
 
-RECORD_VERSION = 8
+RECORD_VERSION = 9
 """Format of the cached per-round records and file indexes; bump when it changes."""
 
 HP_BIN_S = 1.0

@@ -14,6 +14,8 @@ import pandas as pd
 from decoy_cli.errors import DecoyError
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.compare import read_run
+from decoy_cli.evaluate.heat import HeatGrid, read_grid_sums
+from decoy_cli.evaluate.record import RoundRecord
 from decoy_cli.evaluate.run_tables import read_run_table
 from decoy_cli.evaluate.runner import round_id
 from decoy_cli.files import JsonObject, object_at, read_json_object
@@ -21,12 +23,14 @@ from decoy_cli.metrics import ALL_METRIC_NAMES
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import shown_name, visible
 from decoy_cli.view.page import (
+    HeatLayer,
     PageData,
     TableSpec,
     map_floor,
     player_table,
     round_entry,
     table_spec,
+    winner_info,
 )
 
 TABLES = (
@@ -47,6 +51,10 @@ PLAYER_COLUMNS = ("match", "round", "player", "side", "death", "hp_rmse")
 """The player-round list's columns before the trajectory metrics; `late_share`, `stuck` and
 `reason` follow them."""
 
+HEAT_FACTOR = 4
+"""Cells of the run's heat grid (decoy_cli/evaluate/heat.py) per side of a cell of the page's
+heatmap: a coarser grid keeps the page small."""
+
 
 def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     """The page's data of the run in `folder`; its cache is under `cache_root` (default: the
@@ -65,6 +73,7 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
     rounds: list[JsonObject] = []
     labels: list[str] = []
     traces: list[RoundTrace] = []
+    records: list[RoundRecord] = []
     for row in run.rounds.itertuples():
         label = f"{visible(str(row.match))}:{row.round}"
         key = keys.get(round_id(str(row.file_sha), int(row.round)))
@@ -74,15 +83,15 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
                 f"{folder}: the cached result of round {label} is missing or was written by "
                 "another decoy version; run the same `decoy evaluate` into it again"
             )
-        said = {k: _said(getattr(row, k)) for k in ("winner_original", "reason_original")}
-        said |= {k: _said(getattr(row, k)) for k in ("winner_replay", "reason_replay")}
+        sides = {p.side for p in record.trace.players}
+        winners = (row.winner_original, row.reason_original, row.winner_replay)
         info = (
-            f"winner: data {said['winner_original']} ({said['reason_original']}), replay "
-            f"{said['winner_replay']} ({said['reason_replay']}) · {row.frames} frames, "
+            f"{winner_info(*winners, row.reason_replay, sides)} · {row.frames} frames, "
             f"{float(row.seconds):.0f} s"
         )
         labels.append(f"{record.match_id}:{record.round_num}")
         traces.append(record.trace)
+        records.append(record)
         rounds.append(round_entry(labels[-1], info, record.trace))
     metrics = [m for m in ALL_METRIC_NAMES if m in run.players.columns]
     columns = [*PLAYER_COLUMNS, *metrics, "late_share", "stuck", "reason"]
@@ -95,21 +104,56 @@ def run_page(folder: Path, cache_root: Path | None = None) -> PageData:
         row[0] = visible(labels[r]).rsplit(":", 1)[0]
         row[2] = shown_name(traces[r].players[p].name)
     options = object_at(summary, "options")
+    map_name = str(options.get("map") or _map_of(traces))
     return {
-        "title": visible(f"decoy evaluate: {(cache_root or folder).resolve().name}"),
+        "title": visible(f"decoy evaluate: {_named(summary, cache_root or folder)}"),
         "subtitle": f"{summary.get('data', '?')} data · {summary.get('mechanics', '')} · "
         f"{len(rounds)} rounds · map {options.get('map', '?')}",
-        "map": map_floor(str(options.get("map") or _map_of(traces))),
+        "map": map_floor(map_name),
         "tables": _tables(folder),
         "players": players,
         "rounds": rounds,
         "initial": 0,
+        "heat": heat_layer(map_name, records),
     }
 
 
-def _said(value: object) -> str:
-    """A cell of rounds.csv as text; an empty one as "–"."""
-    return "–" if pd.isna(value) else str(value)
+def _named(summary: JsonObject, folder: Path) -> str:
+    """What the run evaluated: its inputs' names (a few), else its folder's name."""
+    inputs = summary.get("inputs")
+    names = [Path(str(p)).name for p in inputs] if isinstance(inputs, list) else []
+    if not names:
+        return folder.resolve().name
+    more = f" and {len(names) - 2} more" if len(names) > 2 else ""
+    return ", ".join(names[:2]) + more
+
+
+def heat_layer(map_name: str, records: list[RoundRecord]) -> HeatLayer | None:
+    """The run's heatmaps (the position samples of every round's record, real and replayed)
+    on a grid `HEAT_FACTOR` times coarser than the run's, or None without a round."""
+    if not records:
+        return None
+    grid = HeatGrid.for_map(map_name)
+    nx = -(-grid.nx // HEAT_FACTOR)
+    layer: HeatLayer = {
+        "x0": round(grid.x0 * 10),
+        "y0": round(grid.y0 * 10),
+        "cell": round(grid.cell * HEAT_FACTOR * 10),
+        "nx": nx,
+        "real": [],
+        "replay": [],
+    }
+    for name in ("real", "replay"):
+        totals: dict[int, int] = {}
+        for record in records:
+            cells, counts = read_grid_sums(
+                record.heat_original if name == "real" else record.heat_replay
+            )
+            coarse = (cells // grid.nx // HEAT_FACTOR) * nx + (cells % grid.nx) // HEAT_FACTOR
+            for cell, count in zip(coarse.tolist(), counts.tolist(), strict=True):
+                totals[cell] = totals.get(cell, 0) + count
+        layer[name] = [v for cell in sorted(totals) for v in (cell, totals[cell])]
+    return layer
 
 
 def _map_of(traces: list[RoundTrace]) -> str:

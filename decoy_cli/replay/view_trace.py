@@ -5,7 +5,9 @@ Times are integer centiseconds on the round's clock (seconds since freeze-time e
 integer decimetres. A path is a list of segments (the frames a player is alive and present in
 a row); a segment keeps the frames that linear interpolation between its neighbours would miss
 by more than `THIN_M`, each frame as (t, x, y, z) written as its difference from the frame
-kept before it (the first one as it is), which keeps the page's numbers short.
+kept before it (the first one as it is), which keeps the page's numbers short, then the
+heading at that frame in `HEADING_STEP` steps (0 = +x, counter-clockwise, -1 not known), as
+it is. HP and the weapon in hand change seldom: they are kept as their changes only.
 """
 
 from __future__ import annotations
@@ -30,6 +32,11 @@ CS = 100
 DM = 10
 """Decimetres per metre."""
 
+HEADING_STEP = 10
+"""Degrees per step of a kept heading (the page draws it as a short tick)."""
+ROW = 5
+"""Integers per kept frame of a segment: t, x, y, z (differences), heading."""
+
 DATA = "data"
 REPLAY = "replay"
 
@@ -45,6 +52,13 @@ class PlayerTrace(msgspec.Struct, frozen=True):
     """When the distance between the real and the replayed position was largest (both alive;
     None when never both alive)."""
     worst_m: float | None
+    hp_original: list[int] = []
+    """The data's HP where it changes: [t (centiseconds), hp, t, hp, ...] (-1: not known)."""
+    hp_replay: list[int] = []
+    """The replay's HP where it changes, as `hp_original`."""
+    weapon: list[int] = []
+    """The data's weapon in hand where it changes: [t, index in `RoundTrace.weapons` (-1:
+    none), ...]; the replay holds the data's weapon."""
 
 
 class RoundEvent(msgspec.Struct, frozen=True, array_like=True):
@@ -77,6 +91,8 @@ class RoundTrace(msgspec.Struct, frozen=True):
     """The data's smokes and fires with a window: [start, end (centiseconds), "smoke" or
     "fire", x, y, radius (decimetres)], drawn while active (decoy_cli/sim/utility.py's
     sizes)."""
+    weapons: list[str] = []
+    """The names of the weapons `PlayerTrace.weapon` indexes."""
 
 
 def thin(times: np.ndarray, points: np.ndarray, tolerance: float = THIN_M) -> np.ndarray:
@@ -113,12 +129,16 @@ def _thin(times, points, tolerance):
     return keep
 
 
-def encode_path(seconds: np.ndarray, position: np.ndarray, shown: np.ndarray) -> list[list[int]]:
-    """The segments of one path (module docstring): frames where `shown`, thinned."""
+def encode_path(
+    seconds: np.ndarray, position: np.ndarray, shown: np.ndarray, yaw: np.ndarray | None = None
+) -> list[list[int]]:
+    """The segments of one path (module docstring): frames where `shown`, thinned; `yaw` the
+    heading (degrees) at each frame (None: not known)."""
     segments = []
     frames = np.flatnonzero(shown & np.isfinite(position).all(axis=1))
     if not len(frames):
         return []
+    heading = headings(np.full(len(seconds), np.nan) if yaw is None else yaw)
     breaks = np.flatnonzero(np.diff(frames) > 1) + 1
     for run in np.split(frames, breaks):
         kept = run[thin(seconds[run], position[run])]
@@ -126,14 +146,38 @@ def encode_path(seconds: np.ndarray, position: np.ndarray, shown: np.ndarray) ->
             np.int64
         )
         rows[1:] -= rows[:-1].copy()
-        segments.append(rows.reshape(-1).tolist())
+        segments.append(np.column_stack([rows, heading[kept]]).reshape(-1).tolist())
     return segments
 
 
+def headings(yaw: np.ndarray) -> np.ndarray:
+    """Headings in degrees as int64 `HEADING_STEP` steps in [0, 360 / step), -1 where not
+    finite."""
+    yaw = np.asarray(yaw, np.float64)
+    finite = np.isfinite(yaw)
+    steps = 360 // HEADING_STEP
+    out = np.full(len(yaw), -1, np.int64)
+    out[finite] = np.rint(np.mod(yaw[finite], 360.0) / HEADING_STEP).astype(np.int64) % steps
+    return out
+
+
 def decode_path(segment: list[int]) -> np.ndarray:
-    """(K, 4) t (s), x, y, z (m) of an encoded segment."""
-    rows = np.cumsum(np.asarray(segment, np.int64).reshape(-1, 4), axis=0).astype(np.float64)
-    return rows / np.array([CS, DM, DM, DM])
+    """(K, 5) t (s), x, y, z (m), heading (degrees; NaN not known) of an encoded segment."""
+    rows = np.asarray(segment, np.int64).reshape(-1, ROW)
+    out = np.cumsum(rows[:, :4], axis=0).astype(np.float64) / np.array([CS, DM, DM, DM])
+    heading = np.where(rows[:, 4] >= 0, rows[:, 4] * float(HEADING_STEP), np.nan)
+    return np.column_stack([out, heading])
+
+
+def changes(seconds: np.ndarray, values: np.ndarray) -> list[int]:
+    """[t (centiseconds), value, ...] at the first frame and at each frame whose integer value
+    differs from the one before it."""
+    values = np.asarray(values, np.int64)
+    if not len(values):
+        return []
+    at = np.flatnonzero(np.r_[True, values[1:] != values[:-1]])
+    pairs = np.column_stack([np.rint(np.asarray(seconds)[at] * CS).astype(np.int64), values[at]])
+    return pairs.reshape(-1).tolist()
 
 
 def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
@@ -147,6 +191,13 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
     rec = result.recording
     replayed = rec.position.transpose(1, 0, 2)
     alive_r = rec.alive.T & present
+    hp_o = np.where(alive_o, np.asarray(round_.hp, np.int64), 0)
+    hp_r = np.where(alive_r, rec.hp.T.astype(np.int64), 0)
+    yaw_o = np.asarray(round_.yaw, np.float64)
+    yaw_r = rec.yaw.T
+    held = np.where(alive_o, np.asarray(round_.weapon).astype(str), "")
+    weapons = sorted({w for w in held.reshape(-1).tolist() if w})
+    index = {w: i for i, w in enumerate(weapons)} | {"": -1}
     players = []
     for p, info in enumerate(result.plan.players):
         both = np.flatnonzero(alive_o[p] & alive_r[p] & np.isfinite(original[p]).all(axis=1))
@@ -159,10 +210,13 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
             PlayerTrace(
                 name=info.name,
                 side=info.side,
-                original=encode_path(seconds, original[p], alive_o[p]),
-                replay=encode_path(seconds, replayed[p], alive_r[p]),
+                original=encode_path(seconds, original[p], alive_o[p], yaw_o[p]),
+                replay=encode_path(seconds, replayed[p], alive_r[p], yaw_r[p]),
                 worst_s=worst_s,
                 worst_m=worst_m,
+                hp_original=changes(seconds, hp_o[p]),
+                hp_replay=changes(seconds, hp_r[p]),
+                weapon=changes(seconds, np.array([index[w] for w in held[p].tolist()])),
             )
         )
     events = _kills(DATA, result.data_deaths.seconds, result.data_deaths.killer, seconds, original)
@@ -172,7 +226,9 @@ def round_trace(round_: Round, result: ReplayResult) -> RoundTrace:
     events += _replay_bomb(result, seconds)
     events.sort(key=lambda e: (e.t, e.source, e.kind))
     start, end = (round(float(seconds[i]) * CS) for i in (0, -1)) if len(seconds) else (0, 0)
-    return RoundTrace(round_.map_name, start, end, players, events, _utility(round_))
+    return RoundTrace(
+        round_.map_name, start, end, players, events, _utility(round_), weapons=weapons
+    )
 
 
 def _utility(round_: Round) -> list[list[int | str]]:

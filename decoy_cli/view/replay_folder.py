@@ -19,7 +19,14 @@ from decoy_cli.reading import read_csv_table, read_limited
 from decoy_cli.replay.output import TRACE_FILE
 from decoy_cli.replay.view_trace import RoundTrace
 from decoy_cli.text import shown_name, visible
-from decoy_cli.view.page import PageData, map_floor, player_table, round_entry, table_spec
+from decoy_cli.view.page import (
+    PageData,
+    map_floor,
+    player_table,
+    round_entry,
+    table_spec,
+    winner_info,
+)
 
 REPLAY_MARKER = "replay.csv"
 """The file that tells a replay's folder from an evaluate run's."""
@@ -56,10 +63,10 @@ def replay_page(folder: Path) -> PageData:
         raise DecoyError(f"{folder / 'players.csv'}: not the players of {trace_path.name}")
     label = visible(f"{summary.get('match_id', '?')}:{summary.get('round_num', '?')}")
     original, replay = object_at(summary, "outcome_original"), object_at(summary, "outcome_replay")
-    info = (
-        f"winner: data {original.get('winner')} ({original.get('reason')}), replay "
-        f"{replay.get('winner')} ({replay.get('reason')}) · {summary.get('frames', '?')} frames"
-    )
+    sides = {p.side for p in trace.players}
+    winners = (original.get("winner"), original.get("reason"), replay.get("winner"))
+    frames = summary.get("frames", "?")
+    info = f"{winner_info(*winners, replay.get('reason'), sides)} · {frames} frames"
     table = player_table(players[columns], [0] * len(players), list(range(len(players))))
     for row, player in zip(table["rows"], trace.players, strict=True):
         row[0] = shown_name(player.name)  # as recorded, not as the CSV made it inert
@@ -71,6 +78,7 @@ def replay_page(folder: Path) -> PageData:
         "players": table,
         "rounds": [round_entry(label, info, trace)],
         "initial": 0,
+        "heat": None,
     }
 
 
