@@ -24,6 +24,10 @@ setup(
     package_dir=SHIPPED_DATA,
     package_data={
         **{package: DATA_FILES for package in shipped},
-        "decoy_cli.view": ["page.html", "page.css", "data.js", "draw.js", "controls.js", "tables.js"],
+        "decoy_cli.view": [
+            "page.html",
+            "page.css",
+            *(f"{n}.js" for n in ("data", "draw", "controls", "tables")),
+        ],
     },
 )
