@@ -108,8 +108,16 @@ function setTime(t) {
   if (!state.playing) remember();
 }
 
-// The round and time in the URL's fragment, without a new history entry.
+// The round and time in the URL's fragment, without a new history entry; a quarter of a second
+// after the last change (a browser's history call costs more than a draw).
+let remembering = 0;
 function remember() {
+  clearTimeout(remembering);
+  remembering = setTimeout(rememberNow, 250);
+}
+
+function rememberNow() {
+  if (state.round < 0) return;
   const fragment = "#round=" + encodeURIComponent(DATA.rounds[state.round].label) + "&t=" + state.t.toFixed(1);
   if (location.hash !== fragment) history.replaceState(null, "", fragment);
 }

@@ -6,10 +6,10 @@ const COLOUR = {
   T: "#d35400", CT: "#1f5fa8", other: "#555555",
   join: "#9a9a9a", // the line joining a player's real and replayed positions
   kill: "#8e24aa", // attacker to victim, 3 s after the kill: dashed real, solid replay
-  deathReal: "#888888", // the replay's deaths are crosses in the side's colour
+  deathReal: "#7f8c8d", // the replay's deaths are crosses in the side's colour
   bomb: "#b7950b", bombFill: "#f4d03f", defused: "#1e8449", defusedFill: "#58d68d",
   smoke: "rgba(128, 128, 128, 0.45)", fire: "rgba(230, 110, 20, 0.35)",
-  hpBack: "#e0e0e0", focus: "rgba(255, 190, 0, 0.75)", place: "rgba(60, 50, 40, 0.7)",
+  hpReal: "#444444", hpBack: "#e0e0e0", focus: "rgba(255, 190, 0, 0.75)", place: "rgba(60, 50, 40, 0.7)",
 };
 const sideColour = (side) => COLOUR[side === "T" || side === "CT" ? side : "other"];
 
@@ -32,7 +32,7 @@ function mapBounds() {
 
 // The backing store's size follows the canvas's CSS size and the device pixel ratio.
 function fitCanvas() {
-  const size = Math.max(canvas.clientWidth, 1), ratio = window.devicePixelRatio || 1;
+  const size = Math.max(canvas.getBoundingClientRect().width, 1), ratio = window.devicePixelRatio || 1;
   const backing = Math.round(size * ratio);
   if (canvas.width !== backing || canvas.height !== backing) {
     canvas.width = backing; canvas.height = backing;
@@ -289,7 +289,7 @@ function draw() {
     const at = b || a;
     if (at) {
       label(placed, px(at[0]), py(at[1]), p.name, [
-        { value: a ? valueAt(p.hpReal, t) : null, colour: COLOUR.deathReal },
+        { value: a ? valueAt(p.hpReal, t) : null, colour: COLOUR.hpReal },
         { value: b ? valueAt(p.hpReplay, t) : null, colour: colour },
       ]);
     }

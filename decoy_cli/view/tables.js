@@ -7,7 +7,7 @@ const LEGEND = [ // what the map draws, each with the colour it is drawn in
   ["line", COLOUR.kill, "a kill in the replay"],
   ["cross", COLOUR.deathReal, "a real death (in the replay: the side's colour)"],
   ["square", COLOUR.bomb, "the bomb: hollow real, filled replay, dashed inferred by a rule"],
-  ["bar", COLOUR.deathReal, "HP under the name: real above (grey), replay below (side colour)"],
+  ["bar", COLOUR.hpReal, "HP under the name: real above (dark grey), replay below (side colour)"],
   ["disc", COLOUR.smoke, "a smoke (the data's)"],
   ["disc", COLOUR.fire, "a fire (the data's)"],
 ];
@@ -104,6 +104,7 @@ function playerTable() {
   fill();
 }
 
+// The round is drawn first; the tables (thousands of rows in a large run) are filled after.
 function start() {
   document.title = DATA.title;
   $("title").textContent = DATA.title;
@@ -111,13 +112,15 @@ function start() {
   legend();
   if (!DATA.heat) $("heat").disabled = true;
   DATA.rounds.forEach((r, i) => roundSelect.appendChild(new Option(r.label, String(i))));
-  const tables = $("tables");
-  for (const spec of DATA.tables) tables.appendChild(tableOf(spec));
-  playerTable();
   const asked = fromFragment();
   if (asked) openRound(asked.index, asked.t);
   else if (DATA.rounds.length) openRound(DATA.initial || 0);
   else $("round-info").textContent = "no round to show";
-  document.body.dataset.ready = "1";
+  setTimeout(() => {
+    const tables = $("tables");
+    for (const spec of DATA.tables) tables.appendChild(tableOf(spec));
+    playerTable();
+    document.body.dataset.ready = "1";
+  }, 0);
 }
 start();
