@@ -27,6 +27,7 @@ from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult
 from decoy_cli.waypoints.plot import plot_graph
 from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_aligned
 from decoy_cli.world import patch_learning
+from decoy_cli.world.cs2_world import cs2_world
 from decoy_cli.world.meshfile import check_extent, read_mesh
 from decoy_cli.world.navmesh import load_navmesh, nav_world
 from decoy_cli.world.world import World
@@ -83,6 +84,12 @@ def build_waypoints(
         "dust2", "--map", help=f"Map whose places and spawns to use: {MAPS_HELP}."
     ),
     user_mesh: UserMesh = UserMesh(),
+    nav_file: Path | None = typer.Option(
+        None,
+        "--nav",
+        help="A CS2 nav mesh of the map in awpy's JSON form (plain, .xz or .gz): build the world "
+        "from it; the graph carries that world.",
+    ),
     spacing: float = typer.Option(0.7, "--spacing", help="Lattice spacing in metres.", min=0.2),
     wall_nodes: bool = typer.Option(
         True,
@@ -129,9 +136,14 @@ def build_waypoints(
     """Build a waypoint graph: BFS lattice, drop pass, verification, pruning, manual points."""
     console = make_console()
     map_id = canonical_map(map_name)
-    if learn_patches is not None and user_mesh.mesh is not None:
-        raise GraphError("--learn-patches learns on the built-in nav world; leave out --mesh")
-    if user_mesh.mesh is None:
+    if learn_patches is not None and (user_mesh.mesh is not None or nav_file is not None):
+        raise GraphError("--learn-patches learns on the built-in nav world; leave out --mesh/--nav")
+    if user_mesh.mesh is not None and nav_file is not None:
+        raise GraphError("--mesh and --nav each give the world: give one")
+    if nav_file is not None:
+        world = cs2_world(nav_file, map_id)
+        name = f"{map_id}.cs2"
+    elif user_mesh.mesh is None:
         world = nav_world(map_id)
         name = map_id
     else:
@@ -232,7 +244,7 @@ def build_waypoints(
     console.print(table)
     regions = ", ".join(f"{name} {len(nodes):,}" for name, nodes in graph.regions.items())
     console.print(f"region waypoints: {regions}", highlight=False)
-    if user_mesh.mesh is None:
+    if user_mesh.mesh is None and nav_file is None:
         _show_coverage(console, nav_coverage(graph, load_navmesh(map_id)))
     console.print(f"graph written to {out}")
     if plot:
@@ -240,7 +252,7 @@ def build_waypoints(
         plot_graph(
             graph,
             png,
-            nav=load_navmesh(map_id),
+            nav=None if nav_file is not None else load_navmesh(map_id),
             removed_segments=result.removed_segments,
             pruned_positions=result.pruned_positions,
             title=f"{graph.num_nodes:,} waypoints, {graph.num_edges:,} edges ({world.source})",

@@ -20,11 +20,14 @@ from decoy_cli.errors import GraphError
 from decoy_cli.reading import open_regular
 from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
+from decoy_cli.world.nav_polygons import POLYGON_NAV_KIND
 from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh, nav_world
 from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
 GRAPH_FILE = "waypoints.npz"
+CARRIED_KIND = POLYGON_NAV_KIND
+"""Worlds of this kind are not in the package: a graph built on one carries it."""
 
 
 def canonical_map(name: str) -> str:
@@ -103,6 +106,7 @@ def build_graph(
         region: np.nonzero(np.isin(node_place, [place_index[p] for p in region_places]))[0]
         for region, region_places in nav.regions.items()
     }
+    carried = world.meta.get("kind") == CARRIED_KIND
     stats = result.stats.as_dict()
     stats.pop("seconds")  # timings vary run to run; the file must not
     graph = WaypointGraph(
@@ -122,6 +126,7 @@ def build_graph(
                 "source": world.source,
                 "triangles": world.num_triangles,
                 "sha256": world.fingerprint(),
+                **({"kind": CARRIED_KIND} if carried else {}),
             },
             "params": asdict(params),
             "seeds_m": np.round(seed_points, 6).tolist(),
@@ -129,6 +134,7 @@ def build_graph(
             **({"patches": world.meta["patch_boxes"]} if "patch_boxes" in world.meta else {}),
             "stats": stats,
         },
+        world_triangles=world.triangles if carried else None,
     )
     return graph, result
 
@@ -140,9 +146,21 @@ def builtin_graph(map_name: str = BUILTIN_MAP) -> WaypointGraph:
 
 
 def graph_world(graph: WaypointGraph) -> World:
-    """The nav world a graph of a built-in map was built on: the map's shipped patches, or the
-    patches recorded in the graph (built with learned ones)."""
+    """The world a graph was built on: the one it carries (a CS2 nav world), else the built-in
+    nav world of its map with the map's shipped patches, or with the patches recorded in the
+    graph (built with learned ones)."""
     map_name = str(graph.meta.get("map", "")) or BUILTIN_MAP
+    if graph.world_triangles is not None:
+        described = graph.meta.get("world", {})
+        world = World(
+            triangles=graph.world_triangles,
+            name=str(described.get("name", map_name)),
+            source=str(described.get("source", "the world the graph carries")),
+            meta={"kind": CARRIED_KIND},
+        )
+        if world.fingerprint() != described.get("sha256"):
+            raise GraphError("the world this graph carries does not match its own fingerprint")
+        return world
     boxes = graph.meta.get("patches")
     if boxes is None:
         return nav_world(map_name)

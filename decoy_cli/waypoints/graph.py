@@ -124,6 +124,9 @@ class WaypointGraph:
     place_names: list[str]
     regions: dict[str, np.ndarray]  # region name -> sorted node indices
     meta: dict[str, Any] = field(default_factory=dict)
+    world_triangles: np.ndarray | None = None
+    """(T, 3, 3) metres: the world the graph was built on, carried in the file when it is not
+    a built-in one (a CS2 nav world), so the graph replays on it wherever it goes."""
 
     # ---- basic properties -------------------------------------------------------------------
 
@@ -411,6 +414,8 @@ class WaypointGraph:
             ),
             "meta": np.array(json.dumps(self.meta, sort_keys=True)),
         }
+        if self.world_triangles is not None:
+            arrays["world_triangles"] = np.asarray(self.world_triangles, dtype=np.float64)
         write_npz_atomic(Path(path), arrays)
 
     @classmethod
@@ -440,6 +445,11 @@ class WaypointGraph:
                         for k, v in json.loads(str(data["regions"])).items()
                     },
                     meta=json.loads(str(data["meta"])),
+                    world_triangles=(
+                        data["world_triangles"].astype(np.float64)
+                        if "world_triangles" in data.files
+                        else None
+                    ),
                 )
         except GraphError:
             raise
@@ -469,6 +479,11 @@ class WaypointGraph:
             problems.append("an edge points outside the node list")
         if len(self.node_place) != n:
             problems.append("node_place length differs from the node count")
+        world = self.world_triangles
+        if world is not None and (
+            world.ndim != 3 or world.shape[1:] != (3, 3) or not np.all(np.isfinite(world))
+        ):
+            problems.append("its world is not finite (T, 3, 3) triangles")
         if problems:
             raise GraphError(f"{origin}: corrupt waypoint graph ({problems[0]})")
 

@@ -1,0 +1,412 @@
+"""The triangles of a polygon nav mesh (CS2): floors, step faces, and what stands at each open
+edge (a wall, a ledge, the foot of a box, or floor across a small hole).
+
+The same rules as the CS:GO rectangle world (`nav_geometry.py`, whose constants it shares, and
+`navmesh.py`, which says why each exists), on convex polygons with a height at every corner:
+
+* **Floors.** Each area's polygon, triangulated; no heights to fit.
+* **Shared edges.** Stretches where two areas' edges lie on one line (within 1 u) join their
+  floors, with a step face where the heights differ, except where the lower floor goes on
+  under the upper one (a walkway over a passage).
+* **Open edges.** The rest of every edge is cut into pieces of at most `PIECE_U`; each piece
+  looks outward along its normal for the nearest other area within the last of `PROBES_U`
+  (CS:GO's `LEDGE_REACH_U`) and gets: nothing near: a wall `POLYGON_WALL_PUSH_U` beyond the
+  edge (where the nav stops short of the real walls), full height, capped below any floor
+  overhead, left out where it would stand on another floor of the same level; an area within
+  a jump in height across a gap of at most `BRIDGE_MAX_GAP_U`: floor to the gap's middle (a
+  hole in the mesh), closed by a face from the higher side; any other area near (higher or
+  lower): floor to the push, then a face between the two heights (a ledge to drop from, the
+  foot of a box to jump onto), none where that face would hang into a passage under a
+  walkway. Every open piece's floor runs on under its push.
+* **Corners.** Where two walls meet at a corner of the open boundary, a wall joins their ends
+  so that no gap opens at the corner.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from itertools import pairwise
+from pathlib import Path
+
+import numpy as np
+
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.world.nav_geometry import (
+    BRIDGE_MAX_GAP_U,
+    JUMP_U,
+    MAX_SHARED_STEP_U,
+    STEP_U,
+    TOUCH_TOL_U,
+    WALL_HEIGHT_U,
+)
+from decoy_cli.world.nav_json import PolygonNav
+from decoy_cli.world.world import World
+
+PIECE_U = 16.0
+"""Open edges are judged piece by piece, each at most this long."""
+PROBES_U = (1.0, 4.0, 8.0, 16.0, 24.0, 32.0, 40.0, 48.0, 64.0, 80.0, 96.0, 112.0, 128.0)
+"""Distances beyond an open piece at which other areas are looked for."""
+POLYGON_WALL_PUSH_U = 24.0
+"""How far walls stand beyond an open edge: measured, the median distance from the CS2
+de_dust2 nav's open edges to the walls of the brush mesh of ../shared/data/meshes
+(benchmarks/cs2_world.py), where CS:GO's nav stops `WALL_PUSH_U` short."""
+GRID_U = 64.0
+"""Cell size of the index that finds the areas under a point."""
+OVERHEAD_U = 72.0
+"""A floor more than this above a wall's foot is a floor overhead: the wall stops below it."""
+
+POLYGON_NAV_KIND = "polygon-nav"
+"""`World.meta["kind"]` of a world made from a polygon nav mesh."""
+
+
+def polygon_world(nav: PolygonNav, map_name: str) -> World:
+    """The triangle world of a polygon nav mesh of a map, in metres."""
+    return World(
+        triangles=polygon_triangles(nav) * HAMMER_TO_M,
+        name=map_name,
+        source=f"CS2 {map_name} nav mesh ({Path(nav.source).name}, nav version {nav.version})",
+        meta={"kind": POLYGON_NAV_KIND, "areas": nav.num_areas},
+    )
+
+
+def polygon_triangles(nav: PolygonNav) -> np.ndarray:
+    """Floors, step faces and open-edge faces of a polygon nav mesh, (T, 3, 3) Hammer units."""
+    floors = _Floors(nav)
+    edges = _Edges(nav)
+    covered, tris = _shared_stretches(edges, floors)
+    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]] = defaultdict(list)
+    for e in range(edges.count):
+        for lo, hi in _subtract((0.0, edges.length[e]), covered[e]):
+            tris += _open_faces(edges, floors, e, lo, hi, walls)
+    tris += _corner_walls(walls)
+    floor_tris = floors.triangles.reshape(-1, 3, 3)
+    faces = np.asarray(tris, dtype=np.float64).reshape(-1, 3, 3)
+    return np.concatenate([floor_tris, faces])
+
+
+# ---- floors -------------------------------------------------------------------------------
+
+
+class _Floors:
+    """The floor triangles of every area, and the areas and heights under a point."""
+
+    def __init__(self, nav: PolygonNav) -> None:
+        tris, owner = [], []
+        for a in range(nav.num_areas):
+            for tri in _triangulate(nav.polygon(a)):
+                tris.append(tri)
+                owner.append(a)
+        self.triangles = np.asarray(tris, dtype=np.float64)
+        self.owner = np.asarray(owner, dtype=np.int64)
+        self.cells: dict[tuple[int, int], list[int]] = defaultdict(list)
+        low = np.floor(self.triangles[:, :, :2].min(axis=1) / GRID_U).astype(int)
+        high = np.floor(self.triangles[:, :, :2].max(axis=1) / GRID_U).astype(int)
+        for t in range(len(self.triangles)):
+            for i in range(low[t, 0], high[t, 0] + 1):
+                for j in range(low[t, 1], high[t, 1] + 1):
+                    self.cells[(i, j)].append(t)
+
+    def under(self, x: float, y: float) -> list[tuple[int, float]]:
+        """(area, floor height) of every area whose floor lies under the point (x, y)."""
+        found = []
+        for t in self.cells.get((int(np.floor(x / GRID_U)), int(np.floor(y / GRID_U))), []):
+            z = _height_in(self.triangles[t], x, y)
+            if z is not None:
+                found.append((int(self.owner[t]), z))
+        return found
+
+
+def _triangulate(polygon: np.ndarray) -> list[np.ndarray]:
+    """Triangles of a convex (or nearly convex) polygon, dropping degenerate ones; a
+    quadrilateral is cut along the diagonal that leaves both halves turning the same way."""
+    n = len(polygon)
+    if n == 4 and (_twice_area(polygon[[0, 1, 2]]) <= 0 or _twice_area(polygon[[0, 2, 3]]) <= 0):
+        polygon = polygon[[1, 2, 3, 0]]
+    tris = [polygon[[0, k, k + 1]] for k in range(1, n - 1)]
+    return [t for t in tris if _twice_area(t) > 1e-3]
+
+
+def _twice_area(tri: np.ndarray) -> float:
+    (x0, y0), (x1, y1), (x2, y2) = tri[:, :2]
+    return float((x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0))
+
+
+def _height_in(tri: np.ndarray, x: float, y: float, tol: float = 1e-6) -> float | None:
+    """Height of the triangle's plane at (x, y) when the point lies in it (seen from above)."""
+    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = tri
+    det = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)
+    if abs(det) < 1e-9:
+        return None
+    l0 = ((y1 - y2) * (x - x2) + (x2 - x1) * (y - y2)) / det
+    l1 = ((y2 - y0) * (x - x2) + (x0 - x2) * (y - y2)) / det
+    l2 = 1 - l0 - l1
+    if min(l0, l1, l2) < -tol:
+        return None
+    return float(l0 * z0 + l1 * z1 + l2 * z2)
+
+
+# ---- edges --------------------------------------------------------------------------------
+
+
+class _Edges:
+    """Every polygon edge: start, direction, length, outward normal (seen from above)."""
+
+    def __init__(self, nav: PolygonNav) -> None:
+        start, end, area = [], [], []
+        for a in range(nav.num_areas):
+            poly = nav.polygon(a)
+            for k in range(len(poly)):
+                p, q = poly[k], poly[(k + 1) % len(poly)]
+                if np.hypot(*(q - p)[:2]) > TOUCH_TOL_U:
+                    start.append(p)
+                    end.append(q)
+                    area.append(a)
+        self.start = np.asarray(start)
+        self.end = np.asarray(end)
+        self.area = np.asarray(area, dtype=np.int64)
+        delta = (self.end - self.start)[:, :2]
+        self.length = np.hypot(delta[:, 0], delta[:, 1])
+        self.direction = delta / self.length[:, None]
+        self.normal = np.stack([self.direction[:, 1], -self.direction[:, 0]], axis=1)
+        self.count = len(self.area)
+
+    def point(self, e: int, t: float, out: float = 0.0) -> np.ndarray:
+        """(x, y, z) at `t` along edge e (z on the edge), moved `out` along its normal."""
+        s = t / self.length[e]
+        p = self.start[e] + s * (self.end[e] - self.start[e])
+        return np.array([*(p[:2] + out * self.normal[e]), p[2]])
+
+
+def _shared_stretches(edges: _Edges, floors: _Floors) -> tuple[list[list], list]:
+    """Per edge, the stretches [lo, hi] (along it) that another area's edge lies on, and the
+    step faces of those where the two floors differ in height (made once per pair)."""
+    covered: list[list[tuple[float, float]]] = [[] for _ in range(edges.count)]
+    tris: list = []
+    for first in range(0, edges.count, 256):
+        rows = slice(first, min(first + 256, edges.count))
+        rel_s = edges.start[None, :, :2] - edges.start[rows, None, :2]
+        rel_e = edges.end[None, :, :2] - edges.start[rows, None, :2]
+        n = edges.normal[rows, None, :]
+        d = edges.direction[rows, None, :]
+        off = np.maximum(np.abs((rel_s * n).sum(-1)), np.abs((rel_e * n).sum(-1)))
+        t0, t1 = (rel_s * d).sum(-1), (rel_e * d).sum(-1)
+        lo = np.maximum(np.minimum(t0, t1), 0.0)
+        hi = np.minimum(np.maximum(t0, t1), edges.length[rows, None])
+        ok = (off <= TOUCH_TOL_U) & (hi - lo > TOUCH_TOL_U)
+        ok &= edges.area[rows, None] != edges.area[None, :]
+        for i, j in zip(*np.nonzero(ok), strict=True):
+            e = first + int(i)
+            a_lo, a_hi = float(lo[i, j]), float(hi[i, j])
+            za = [edges.point(e, t)[2] for t in (a_lo, a_hi)]
+            zb = [_z_on_edge(edges, int(j), edges.point(e, t)) for t in (a_lo, a_hi)]
+            if abs((za[0] + za[1]) - (zb[0] + zb[1])) / 2 > MAX_SHARED_STEP_U:
+                continue  # floors far apart in height only look touching from above
+            covered[e].append((a_lo, a_hi))
+            rise = max(abs(za[0] - zb[0]), abs(za[1] - zb[1]))
+            if rise > OVERHEAD_U and _lower_goes_under(edges, floors, e, int(j), a_lo, a_hi):
+                continue
+            if edges.area[e] < edges.area[j] and rise > 1:
+                p0, p1 = edges.point(e, a_lo), edges.point(e, a_hi)
+                low = ((*p0[:2], za[0]), (*p1[:2], za[1]))
+                tris += _quad(*low, (*p1[:2], zb[1]), (*p0[:2], zb[0]))
+    return covered, tris
+
+
+def _lower_goes_under(edges: _Edges, floors: _Floors, e: int, f: int, lo: float, hi: float) -> bool:
+    """True where edges e and f meet far apart in height and the lower floor goes on under the
+    upper one across their line (a walkway over a passage): no face stands there."""
+    mid = edges.point(e, (lo + hi) / 2)
+    z_e, z_f = float(mid[2]), _z_on_edge(edges, f, mid)
+    into_upper = -PROBES_U[1] if z_e > z_f else PROBES_U[1]  # e's inside, or f's (e's outside)
+    upper, low = (edges.area[e], z_f) if z_e > z_f else (edges.area[f], z_e)
+    x, y, _ = edges.point(e, (lo + hi) / 2, into_upper)
+    return any(area != upper and abs(h - low) <= JUMP_U for area, h in floors.under(x, y))
+
+
+def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
+    """Height of edge e at the point of it nearest to `point` (seen from above)."""
+    along = np.dot(point[:2] - edges.start[e, :2], edges.direction[e])
+    t = float(np.clip(along, 0, edges.length[e]))
+    return float(edges.point(e, t)[2])
+
+
+def _subtract(interval: tuple[float, float], covers: list[tuple[float, float]]) -> list:
+    """Parts of a 1-D interval not covered by any of `covers`, longer than the touch tolerance."""
+    pieces = [interval]
+    for lo, hi in covers:
+        pieces = [
+            part
+            for a, b in pieces
+            for part in (((a, b),) if hi <= a or lo >= b else ((a, min(lo, b)), (max(hi, a), b)))
+        ]
+    return [(a, b) for a, b in pieces if b - a > TOUCH_TOL_U]
+
+
+# ---- open edges ---------------------------------------------------------------------------
+
+
+def _beyond(
+    edges: _Edges, floors: _Floors, e: int, t: float, z: float
+) -> tuple[float, float] | None:
+    """(gap, height) of the nearest other floor beyond edge e at `t` within reach, or None."""
+    own = edges.area[e]
+
+    def nearest_floor(distance: float) -> float | None:
+        x, y, _ = edges.point(e, t, distance)
+        near = [(abs(h - z), h) for a, h in floors.under(x, y) if a != own]
+        near = [(dz, h) for dz, h in near if dz <= MAX_SHARED_STEP_U]
+        return min(near)[1] if near else None
+
+    before = 0.0
+    for distance in PROBES_U:
+        height = nearest_floor(distance)
+        if height is not None:
+            for _ in range(5):  # where the floor begins, to a thirty-second of the step
+                middle = (before + distance) / 2
+                found = nearest_floor(middle)
+                before, distance = (before, middle) if found is not None else (middle, distance)
+                height = found if found is not None else height
+            return distance, height
+        before = distance
+    return None
+
+
+def _open_faces(
+    edges: _Edges,
+    floors: _Floors,
+    e: int,
+    lo: float,
+    hi: float,
+    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+) -> list:
+    """Faces of the open stretch [lo, hi] of edge e (module docstring), piece by piece; the
+    wall ends at the edge's corners are noted in `walls` for `_corner_walls`."""
+    tris: list = []
+    count = max(1, int(np.ceil((hi - lo) / PIECE_U)))
+    cuts = np.linspace(lo, hi, count + 1)
+    for t0, t1 in pairwise(cuts):
+        mid = (t0 + t1) / 2
+        z0, z1, zm = (float(edges.point(e, t)[2]) for t in (t0, t1, mid))
+        found = _beyond(edges, floors, e, mid, zm)
+        if found is None:
+            top = _wall_top(edges, floors, e, mid, zm)
+            tris += _strip(edges, e, t0, t1, POLYGON_WALL_PUSH_U, z0, z1)
+            if top is not None:
+                tris += _face(edges, e, t0, t1, POLYGON_WALL_PUSH_U, (z0, z1), (z0 + top, z1 + top))
+                _note_ends(edges, e, t0, t1, top, walls)
+            continue
+        gap, other = found
+        rise = other - zm
+        if abs(rise) <= JUMP_U and gap <= BRIDGE_MAX_GAP_U:
+            tris += _strip(edges, e, t0, t1, gap / 2, z0, z1)
+            if rise < -STEP_U:  # the higher side closes the step
+                tris += _face(edges, e, t0, t1, gap / 2, (z0, z1), (other, other))
+            continue
+        push = min(POLYGON_WALL_PUSH_U, gap / 2)
+        tris += _strip(edges, e, t0, t1, push, z0, z1)
+        # under a walkway the lower floor goes on beneath the upper one: no face there
+        beneath = -PROBES_U[1] if rise < 0 else gap + PROBES_U[1]
+        x, y, _ = edges.point(e, mid, beneath)
+        low = min(zm, other)
+        upper = edges.area[e] if rise < 0 else -1
+        if abs(rise) > OVERHEAD_U and any(
+            a != upper and a != edges.area[e] and abs(h - low) <= JUMP_U
+            for a, h in floors.under(x, y)
+        ):
+            continue
+        tris += _face(edges, e, t0, t1, push, (z0, z1), (other, other))
+    return tris
+
+
+def _wall_top(edges: _Edges, floors: _Floors, e: int, t: float, z: float) -> float | None:
+    """A wall's height above its foot at `t` of edge e: `WALL_HEIGHT_U`, capped below a floor
+    overhead; None where the wall would stand on another floor of about the same level."""
+    x, y, _ = edges.point(e, t, POLYGON_WALL_PUSH_U)
+    top = WALL_HEIGHT_U
+    for area, h in floors.under(x, y):
+        if area == edges.area[e]:
+            continue
+        if abs(h - z) <= JUMP_U:
+            return None
+        if h - z > OVERHEAD_U:
+            top = min(top, h - z - 8)
+    return top
+
+
+def _note_ends(
+    edges: _Edges,
+    e: int,
+    t0: float,
+    t1: float,
+    top: float,
+    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+) -> None:
+    """Note a wall piece's ends that sit at a corner of its edge, keyed by the corner."""
+    for t, kind in ((t0, "starts"), (t1, "ends")):
+        at_corner = t <= TOUCH_TOL_U or t >= edges.length[e] - TOUCH_TOL_U
+        if at_corner:
+            corner = edges.point(e, 0.0 if kind == "starts" else edges.length[e])
+            key = (round(float(corner[0]), 0), round(float(corner[1]), 0))
+            walls[key].append((kind, edges.point(e, t, POLYGON_WALL_PUSH_U), float(corner[2]), top))
+
+
+def _corner_walls(
+    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+) -> list:
+    """A wall from each wall that ends at a corner to each that starts there (same level)."""
+    tris: list = []
+    for ends in walls.values():
+        for kind_a, pa, za, top_a in ends:
+            for kind_b, pb, zb, top_b in ends:
+                if kind_a != "ends" or kind_b != "starts" or abs(za - zb) > JUMP_U:
+                    continue
+                if np.hypot(*(pa - pb)[:2]) <= 0.5:
+                    continue
+                top = min(top_a, top_b)
+                tris += _quad(
+                    (pa[0], pa[1], za), (pb[0], pb[1], zb), (pb[0], pb[1], zb + top),
+                    (pa[0], pa[1], za + top),
+                )  # fmt: skip
+    return tris
+
+
+def _strip(edges: _Edges, e: int, t0: float, t1: float, width: float, z0: float, z1: float):
+    """The area's floor carried `width` beyond edge e between t0 and t1."""
+    if width <= 0.5:
+        return []
+    a, b = edges.point(e, t0), edges.point(e, t1)
+    c, d = edges.point(e, t1, width), edges.point(e, t0, width)
+    return _quad((*a[:2], z0), (*b[:2], z1), (*c[:2], z1), (*d[:2], z0))
+
+
+def _face(edges: _Edges, e: int, t0: float, t1: float, push: float, low, high):
+    """A vertical face on the line `push` beyond edge e, between two height profiles."""
+    a, b = edges.point(e, t0, push), edges.point(e, t1, push)
+    return _quad((*a[:2], low[0]), (*b[:2], low[1]), (*b[:2], high[1]), (*a[:2], high[0]))
+
+
+def _quad(p0, p1, p2, p3) -> list:
+    """Two triangles of the quad p0-p1-p2-p3 (in order around its boundary)."""
+    return [[p0, p1, p2], [p0, p2, p3]]
+
+
+def open_edge_rays(
+    nav: PolygonNav, heights: tuple[float, ...], reach: float, back: float = 8.0
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Horizontal rays out of the open edges that have no floor beyond them (where this world
+    puts a wall): one per piece and height above its floor, from `back` inside the edge to
+    `reach` beyond it. (starts, ends) in Hammer units and `back`: what a study of how far the
+    real walls stand casts against a map's geometry (benchmarks/cs2_world.py)."""
+    floors, edges = _Floors(nav), _Edges(nav)
+    covered, _ = _shared_stretches(edges, floors)
+    starts, ends = [], []
+    for e in range(edges.count):
+        for lo, hi in _subtract((0.0, edges.length[e]), covered[e]):
+            for t in np.arange(lo + PIECE_U / 2, hi - PIECE_U / 2, PIECE_U):
+                z = float(edges.point(e, t)[2])
+                if _beyond(edges, floors, e, t, z) is not None:
+                    continue
+                for height in heights:
+                    starts.append([*edges.point(e, t, -back)[:2], z + height])
+                    ends.append([*edges.point(e, t, reach)[:2], z + height])
+    return np.asarray(starts).reshape(-1, 3), np.asarray(ends).reshape(-1, 3), back

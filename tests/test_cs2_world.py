@@ -1,0 +1,274 @@
+"""CS2 nav meshes (awpy's JSON form): reading, the polygon world's walls, steps and walkways,
+the map check, graphs that carry their world, and `decoy build-waypoints --nav`."""
+
+from __future__ import annotations
+
+import gzip
+import json
+import lzma
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from decoy_cli.cli import app
+from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.errors import GraphError, WorldError
+from decoy_cli.waypoints.build import build_graph, graph_world
+from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.lattice import LatticeParams
+from decoy_cli.world.cs2_world import cs2_world
+from decoy_cli.world.nav_data import load_navmesh
+from decoy_cli.world.nav_json import read_nav_json
+from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+CS2_NAV = DATA / "cs2_maps" / "de_dust2.nav.json.xz"
+runner = CliRunner()
+
+
+def nav_document(polygons: list[list[tuple[float, float, float]]], **extra: object) -> dict:
+    """An awpy JSON nav of the given polygons (Hammer units), each linked to the next."""
+    areas = {}
+    for k, polygon in enumerate(polygons, start=1):
+        areas[str(k)] = {
+            "area_id": k,
+            "hull_index": 0,
+            "dynamic_attribute_flags": 0,
+            "corners": [{"x": x, "y": y, "z": z} for x, y, z in polygon],
+            "connections": [k + 1] if k < len(polygons) else [],
+            "ladders_above": [],
+            "ladders_below": [],
+        }
+    return {"version": 35, "sub_version": 1, "is_analyzed": True, "areas": areas, **extra}
+
+
+def square(x0: float, y0: float, size: float, z: float) -> list[tuple[float, float, float]]:
+    return [(x0, y0, z), (x0 + size, y0, z), (x0 + size, y0 + size, z), (x0, y0 + size, z)]
+
+
+def write_nav(path: Path, document: dict) -> Path:
+    path.write_text(json.dumps(document))
+    return path
+
+
+def triangles_of(tmp_path: Path, polygons: list) -> np.ndarray:
+    return polygon_triangles(read_nav_json(write_nav(tmp_path / "t.json", nav_document(polygons))))
+
+
+def faces_on_line(tris: np.ndarray, axis: int, value: float, tol: float = 0.5) -> np.ndarray:
+    """Vertical triangles lying on the plane `axis` = value (Hammer units)."""
+    normal_z = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])[:, 2]
+    vertical = np.abs(normal_z) < 1e-6
+    on = np.all(np.abs(tris[:, :, axis] - value) <= tol, axis=1)
+    return tris[vertical & on]
+
+
+# ---- the reader -------------------------------------------------------------------------------
+
+
+def test_a_nav_reads_plain_xz_and_gzip_alike(tmp_path: Path) -> None:
+    text = json.dumps(nav_document([square(0, 0, 100, 0), square(100, 0, 100, 0)]))
+    (tmp_path / "a.json").write_text(text)
+    (tmp_path / "a.json.xz").write_bytes(lzma.compress(text.encode()))
+    (tmp_path / "a.json.gz").write_bytes(gzip.compress(text.encode()))
+    navs = [read_nav_json(tmp_path / name) for name in ("a.json", "a.json.xz", "a.json.gz")]
+    for nav in navs:
+        assert nav.num_areas == 2 and nav.version == 35
+        assert np.array_equal(nav.corners, navs[0].corners)
+        assert nav.connections.tolist() == [[0, 1]]
+
+
+def test_clockwise_corners_are_turned_counter_clockwise(tmp_path: Path) -> None:
+    nav = read_nav_json(write_nav(tmp_path / "c.json", nav_document([square(0, 0, 50, 0)[::-1]])))
+    x, y = nav.polygon(0)[:, 0], nav.polygon(0)[:, 1]
+    assert np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda d: d.update(version=16), "nav version 16"),
+        (lambda d: d.update(version="35"), "nav version '35'"),
+        (lambda d: d.update(areas=[]), "no 'areas' object"),
+        (lambda d: d.update(areas={}), "0 areas"),
+        (lambda d: d["areas"]["1"].update(area_id=7), "the key's whole number"),
+        (lambda d: d["areas"]["1"].update(corners=[{"x": 0, "y": 0, "z": 0}]), "3 to 8 points"),
+        (lambda d: d["areas"]["1"]["corners"][0].update(x="a"), "numbers x, y and z"),
+        (lambda d: d["areas"]["1"]["corners"][0].update(x=1e9), "outside any map"),
+        (lambda d: d["areas"]["1"].update(connections=[99]), "names area 99"),
+        (lambda d: d["areas"]["1"].update(connections="2"), "list of area ids"),
+    ],
+)
+def test_a_bad_nav_is_one_world_error(tmp_path: Path, change, message: str) -> None:
+    document = nav_document([square(0, 0, 100, 0), square(100, 0, 100, 0)])
+    change(document)
+    with pytest.raises(WorldError, match=message):
+        read_nav_json(write_nav(tmp_path / "bad.json", document))
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"\xfd7zXZ\x00broken", "damaged compressed file"),
+        (b"\x1f\x8b\x08\x00broken", "damaged compressed file"),
+        (b"{not json", "JSON"),
+    ],
+)
+def test_damaged_files_are_one_world_error(tmp_path: Path, content: bytes, message: str) -> None:
+    (tmp_path / "bad.json").write_bytes(content)
+    with pytest.raises(WorldError, match=message):
+        read_nav_json(tmp_path / "bad.json")
+
+
+def test_a_compressed_bomb_is_refused_without_unpacking_it(tmp_path: Path) -> None:
+    (tmp_path / "bomb.json.xz").write_bytes(lzma.compress(b" " * 70_000_000))
+    with pytest.raises(WorldError, match="unpacks to more than"):
+        read_nav_json(tmp_path / "bomb.json.xz")
+
+
+# ---- the world --------------------------------------------------------------------------------
+
+
+def test_an_open_edge_gets_a_wall_and_a_shared_edge_none(tmp_path: Path) -> None:
+    tris = triangles_of(tmp_path, [square(0, 0, 100, 0), square(100, 0, 100, 0)])
+    assert len(faces_on_line(tris, 0, 100)) == 0  # the shared edge is open floor
+    outer = faces_on_line(tris, 0, 200 + POLYGON_WALL_PUSH_U)
+    assert len(outer) and outer[:, :, 2].max() > 150  # a full wall beyond the open edge
+
+
+def test_a_shared_edge_between_heights_gets_a_step_face(tmp_path: Path) -> None:
+    tris = triangles_of(tmp_path, [square(0, 0, 100, 0), square(100, 0, 100, 40)])
+    step = faces_on_line(tris, 0, 100)
+    assert len(step) and step[:, :, 2].min() == pytest.approx(0) and step[:, :, 2].max() == 40
+
+
+def test_a_walkway_over_a_passage_leaves_the_passage_open(tmp_path: Path) -> None:
+    """A bridge (z 200) over a passage (z 0): the passage's floor goes on under the bridge, so
+    no face hangs from the bridge's edges into the passage, and none stands on the line the
+    two floors share seen from above."""
+    passage = [square(0, 0, 100, 0), square(100, 0, 100, 0), square(200, 0, 100, 0)]
+    bridge = [(100, -200, 200), (200, -200, 200), (200, 300, 200), (100, 300, 200)]
+    tris = triangles_of(tmp_path, [*passage, bridge])
+    for x in (100, 200, 100 - POLYGON_WALL_PUSH_U, 200 + POLYGON_WALL_PUSH_U):
+        faces = faces_on_line(tris, 0, x)
+        crossing = (faces[:, :, 1].min(axis=1) < 99) & (faces[:, :, 1].max(axis=1) > 1)
+        in_passage = faces[crossing]
+        assert in_passage.size == 0 or in_passage[:, :, 2].min() >= 190, x
+
+
+def test_a_walkway_edge_over_a_passage_hangs_no_face_into_it(tmp_path: Path) -> None:
+    """The same with the bridge's edges over the middle of the passage's areas: no face hangs
+    from them down to the passage."""
+    passage = [square(0, 0, 150, 0), square(150, 0, 150, 0)]
+    bridge = [(100, -200, 200), (200, -200, 200), (200, 300, 200), (100, 300, 200)]
+    tris = triangles_of(tmp_path, [*passage, bridge])
+    vertical = np.abs(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])[:, 2]) < 1e-6
+    faces = tris[vertical]
+    inside = np.all((faces[:, :, 0] > 50) & (faces[:, :, 0] < 250), axis=1)
+    crossing = (faces[:, :, 1].min(axis=1) < 99) & (faces[:, :, 1].max(axis=1) > 1)
+    hanging = faces[inside & crossing]
+    assert hanging.size == 0 or hanging[:, :, 2].min() >= 190
+
+
+def test_a_ledge_is_a_face_down_with_no_wall_above(tmp_path: Path) -> None:
+    """A floor at 150 beside a lower one at 0 across a 20 u gap: a face down from the upper
+    edge, and nothing above the upper floor there (a drop, not a wall)."""
+    tris = triangles_of(tmp_path, [square(0, 0, 100, 150), square(120, 0, 100, 0)])
+    face = faces_on_line(tris, 0, 110)
+    assert len(face) and face[:, :, 2].max() == pytest.approx(150)
+
+
+def test_a_nav_of_another_map_is_refused(tmp_path: Path) -> None:
+    far = nav_document([square(20000, 20000, 100, 0), square(20100, 20000, 100, 0)])
+    with pytest.raises(WorldError, match="not a nav mesh of de_dust2"):
+        cs2_world(write_nav(tmp_path / "far.json", far), "de_dust2")
+
+
+# ---- graphs that carry their world -------------------------------------------------------------
+
+
+def dust2_piece(tmp_path: Path) -> Path:
+    """A small piece of de_dust2 as a CS2-style nav: the built-in nav's areas around the
+    T spawn, each as a four-corner polygon at its mean height."""
+    nav = load_navmesh("de_dust2")
+    centre = np.array([-700.0, -900.0])
+    near = np.hypot(
+        (nav.x_min + nav.x_max) / 2 - centre[0], (nav.y_min + nav.y_max) / 2 - centre[1]
+    )
+    polygons = []
+    for a in np.argsort(near)[:40]:
+        z = float(nav.z_at_min[a] + nav.z_at_max[a]) / 2
+        polygons.append(
+            [
+                (float(nav.x_min[a]), float(nav.y_min[a]), z),
+                (float(nav.x_max[a]), float(nav.y_min[a]), z),
+                (float(nav.x_max[a]), float(nav.y_max[a]), z),
+                (float(nav.x_min[a]), float(nav.y_max[a]), z),
+            ]
+        )
+    return write_nav(tmp_path / "piece.json", nav_document(polygons))
+
+
+def piece_seed(path: Path) -> list[float]:
+    nav = read_nav_json(path)
+    areas = (nav.corners[:, 2, 0] - nav.corners[:, 0, 0]) * (
+        nav.corners[:, 2, 1] - nav.corners[:, 0, 1]
+    )
+    biggest = nav.polygon(int(np.argmax(areas)))
+    return (biggest.mean(axis=0) * HAMMER_TO_M).tolist()
+
+
+def test_a_graph_built_on_a_cs2_world_carries_it_and_replays_on_it(tmp_path: Path) -> None:
+    path = dust2_piece(tmp_path)
+    world = cs2_world(path, "de_dust2")
+    graph, _ = build_graph(world, "de_dust2", np.array([piece_seed(path)]), LatticeParams())
+    graph.save(tmp_path / "g.npz")
+    loaded = WaypointGraph.load(tmp_path / "g.npz")
+    carried = graph_world(loaded)
+    assert np.array_equal(carried.triangles, world.triangles)
+    assert "CS2 de_dust2 nav mesh" in carried.source
+    loaded.world_triangles[0, 0, 0] += 1.0  # a graph whose world was changed after the build
+    with pytest.raises(GraphError, match="does not match its own fingerprint"):
+        graph_world(loaded)
+
+
+def test_build_waypoints_nav_writes_a_graph_with_its_world(tmp_path: Path) -> None:
+    path = dust2_piece(tmp_path)
+    seed = ",".join(f"{v:g}" for v in piece_seed(path))
+    out = tmp_path / "cs2.npz"
+    result = runner.invoke(
+        app,
+        ["build-waypoints", "--nav", str(path), "--seed", seed, "--out", str(out), "--no-plot"],
+        env={"COLUMNS": "200"},
+    )
+    assert result.exit_code == 0, result.output
+    assert "CS2 de_dust2 nav mesh" in result.output
+    assert WaypointGraph.load(out).world_triangles is not None
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--nav", "missing.json"], "missing.json"),
+        (["--nav", "x.json", "--mesh", "y.obj"], "give one"),
+    ],
+)
+def test_build_waypoints_nav_refuses_bad_requests(
+    tmp_path: Path, args: list[str], message: str
+) -> None:
+    result = runner.invoke(app, ["build-waypoints", *args, "--out", str(tmp_path / "g.npz")])
+    assert result.exit_code == 1
+    assert result.output.startswith("error:") and message in result.output
+    assert len(result.output.strip().splitlines()) == 1
+
+
+@pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
+def test_the_cs2_dust2_nav_makes_a_world_of_the_map() -> None:
+    world = cs2_world(CS2_NAV, "de_dust2")
+    low, high = world.bounds
+    assert world.meta["areas"] == 2248
+    assert 70 < high[0] - low[0] < 90 and 75 < high[1] - low[1] < 90  # de_dust2's size (m)
+    with pytest.raises(WorldError, match="not a nav mesh of de_nuke"):
+        cs2_world(CS2_NAV, "de_nuke")
