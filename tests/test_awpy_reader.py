@@ -421,19 +421,36 @@ def test_a_round_of_an_unknown_map_reads_and_fails_to_replay_by_name(
 
 @needs_data
 def test_replay_of_a_zip_round_matches_the_esta_shaped_file(tmp_path: Path) -> None:
-    """The 8 Hz round is identical in every form (its positions are float32 in the source)."""
+    """The 8 Hz round is identical in every form (its positions are float32 in the source) on
+    the same world: CS2's, which a zip (CS2 data) gets by itself and the ESTA-shaped file, which
+    does not say it is CS2's, by `--world cs2`."""
     outputs = []
-    for path in (
-        SHARED / "cs2_dust2_both" / f"{STEMS[1]}.json.xz",
-        SHARED / "cs2_dust2_awpy" / "awpy2" / f"{STEMS[1]}.zip",
+    for path, world in (
+        (SHARED / "cs2_dust2_both" / f"{STEMS[1]}.json.xz", ["--world", "cs2"]),
+        (SHARED / "cs2_dust2_awpy" / "awpy2" / f"{STEMS[1]}.zip", []),
     ):
         out = tmp_path / path.name
-        result = CliRunner().invoke(app, ["replay", f"{path}:2", "--seed", "3", "--out", str(out)])
+        args = ["replay", f"{path}:2", "--seed", "3", "--out", str(out), *world]
+        result = CliRunner().invoke(app, args)
         assert result.exit_code == 0, result.output
         summary = json.loads(next(out.rglob("summary.json")).read_text())
+        assert summary["world"].startswith("CS2 de_dust2 nav mesh")
         outputs.append((summary["outcome_replay"], pd.read_csv(next(out.rglob("players.csv")))))
     assert outputs[0][0] == outputs[1][0]
     pd.testing.assert_frame_equal(outputs[0][1], outputs[1][1])
+
+
+def test_cs2_data_replays_on_the_cs2_world_unless_told_otherwise(tmp_path: Path) -> None:
+    zipped = write_awpy2_zip(_sample(), tmp_path / "m.zip")
+    for world, expected in (([], "world: CS2 de_dust2"), (["--world", "csgo"], "world: built-in")):
+        out = tmp_path / f"out{len(world)}"
+        args = ["replay", f"{zipped}:1", "--no-combat", "--no-bomb", "--out", str(out), *world]
+        result = CliRunner().invoke(app, args, env={"COLUMNS": "200"})
+        assert result.exit_code == 0, result.output
+        assert expected in result.output
+    both = ["replay", f"{zipped}:1", "--graph", str(tmp_path / "g.npz"), "--world", "cs2"]
+    result = CliRunner().invoke(app, both)
+    assert result.exit_code == 1 and "leave out --world" in result.output
 
 
 def test_sides_swap_at_halftime_by_round_and_players_keep_their_steamids(tmp_path: Path) -> None:

@@ -10,16 +10,23 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from differences import npz_difference
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import GraphError, WorldError
-from decoy_cli.waypoints.build import build_graph, graph_world
+from decoy_cli.waypoints.build import (
+    CS2_GRAPH_FILE,
+    build_graph,
+    builtin_graph,
+    graph_world,
+    pick_world,
+)
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import cs2_world
-from decoy_cli.world.nav_data import load_navmesh
+from decoy_cli.world.nav_data import REGIONS, asset_dir, load_navmesh
 from decoy_cli.world.nav_json import read_nav_json
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
 
@@ -272,3 +279,65 @@ def test_the_cs2_dust2_nav_makes_a_world_of_the_map() -> None:
     assert 70 < high[0] - low[0] < 90 and 75 < high[1] - low[1] < 90  # de_dust2's size (m)
     with pytest.raises(WorldError, match="not a nav mesh of de_nuke"):
         cs2_world(CS2_NAV, "de_nuke")
+
+
+# ---- the shipped CS2 world and the choice of world ----------------------------------------------
+
+
+@pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
+def test_the_shipped_cs2_graph_is_current(tmp_path: Path) -> None:
+    """Rebuilding the CS2 de_dust2 graph from the nav file gives the shipped bytes (the command
+    in assets/de_dust2/ATTRIBUTION.md)."""
+    shipped = asset_dir("de_dust2") / CS2_GRAPH_FILE
+    out = tmp_path / "cs2.npz"
+    result = runner.invoke(
+        app, ["build-waypoints", "--nav", str(CS2_NAV), "--out", str(out), "--no-plot"]
+    )
+    assert result.exit_code == 0, result.output
+    assert out.read_bytes() == shipped.read_bytes(), npz_difference(out, shipped)
+
+
+def test_the_shipped_cs2_graph_carries_a_cs2_world() -> None:
+    graph = builtin_graph("de_dust2", "cs2")
+    world = graph_world(graph)
+    assert world.source.startswith("CS2 de_dust2 nav mesh")
+    assert graph.world_triangles is not None and set(graph.regions) == set(REGIONS)
+    assert all(len(nodes) > 50 for nodes in graph.regions.values())
+
+
+def test_auto_picks_the_cs2_world_for_cs2_data_of_a_map_that_has_one() -> None:
+    assert pick_world("auto", cs2_data=True, map_name="de_dust2") == "cs2"
+    assert pick_world("auto", cs2_data=False, map_name="de_dust2") == "csgo"
+    assert pick_world("auto", cs2_data=True, map_name="de_nuke") == "csgo"  # none shipped
+    assert pick_world("cs2", cs2_data=False, map_name="de_dust2") == "cs2"
+    with pytest.raises(GraphError, match="ships no CS2 world of de_nuke"):
+        builtin_graph("de_nuke", "cs2")
+
+
+def test_evaluate_names_the_world_it_picked_for_cs2_data(tmp_path: Path) -> None:
+    from decoy_cli.esta import read_match
+    from decoy_cli.esta.awpy.writer import write_awpy2_zip
+    from decoy_cli.synth.sample import SAMPLE_DIR
+
+    sample = read_match(sorted(SAMPLE_DIR.glob("*.json*"))[0])
+    zipped = write_awpy2_zip(sample, tmp_path / "m.zip")
+    out = tmp_path / "run"
+    args = ["evaluate", str(zipped), "--sample", "1", "--no-combat", "--no-bomb"]
+    result = runner.invoke(app, [*args, "--workers", "1", "--no-view", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["world"].startswith("CS2 de_dust2 nav mesh")
+    assert "--world cs2" in summary["command"]
+    assert "| world | CS2 de_dust2 nav mesh" in (out / "report.md").read_text()
+
+
+def test_snap_snaps_cs2_data_to_the_cs2_world_unless_told_otherwise(tmp_path: Path) -> None:
+    from decoy_cli.esta import read_match
+    from decoy_cli.esta.awpy.writer import write_awpy2_zip
+    from decoy_cli.synth.sample import SAMPLE_DIR
+
+    zipped = write_awpy2_zip(read_match(sorted(SAMPLE_DIR.glob("*.json*"))[0]), tmp_path / "m.zip")
+    for world, expected in (([], "world: CS2 de_dust2"), (["--world", "csgo"], "world: built-in")):
+        result = runner.invoke(app, ["snap", f"{zipped}:1", *world], env={"COLUMNS": "200"})
+        assert result.exit_code == 0, result.output
+        assert expected in result.output

@@ -30,6 +30,7 @@ from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.sim.setup import MoverName
+from decoy_cli.waypoints.build import WorldChoice
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
 """The built-in maps, for the help of every `--map`."""
@@ -59,6 +60,17 @@ MOVER_HELP = (
     "measured the more faithful in replays) or physics (pybullet capsules that block each "
     "other, as the paper's engine)"
 )
+
+
+WORLD_HELP = (
+    "The world to replay on without --graph: auto (CS2's for CS2 data, read from awpy's tables "
+    "or a demo, where decoy ships one: de_dust2; else CS:GO's), csgo or cs2."
+)
+
+
+def world_option() -> WorldChoice:
+    """The `--world` option (Typer's parameter default)."""
+    return typer.Option("auto", "--world", help=WORLD_HELP)
 
 
 def mover_option(default: MoverName) -> MoverName:

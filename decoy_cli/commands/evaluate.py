@@ -24,14 +24,12 @@ from rich.text import Text
 from decoy_cli.bench.machine import machine_line, usable_cores
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._groups import with_groups
-from decoy_cli.commands._options import (
-    MAPS_HELP,
-    RunOptions,
-)
+from decoy_cli.commands._options import MAPS_HELP, RunOptions, world_option
 from decoy_cli.damage import parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
+from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
 from decoy_cli.evaluate.markdown import interval, num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
@@ -43,6 +41,7 @@ from decoy_cli.evaluate.report import (
     mechanics,
     protocols,
     table_groups,
+    world_line,
 )
 from decoy_cli.evaluate.runner import (
     DEFAULT_ROUND_TIMEOUT_S,
@@ -54,6 +53,7 @@ from decoy_cli.evaluate.runner import (
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
+from decoy_cli.waypoints.build import WorldChoice
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -81,6 +81,7 @@ def evaluate(
         help="Waypoint graph (.npz from build-waypoints, e.g. with --learn-patches) to replay "
         "on, with the world it was built on; its map must be --map. Default: the shipped one.",
     ),
+    world: WorldChoice = world_option(),
     sample: int | None = typer.Option(
         None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
     ),
@@ -138,7 +139,7 @@ def evaluate(
     """
     console = make_console()
     inputs = inputs or default_inputs()
-    collect_match_files(inputs)  # bad paths fail here, before a damage model is loaded
+    files, _ = collect_match_files(inputs)  # bad paths fail here, before models are loaded
     given = run_options
     settings = make_settings(
         map_name=map_name,
@@ -154,6 +155,8 @@ def evaluate(
         fastdtw=fastdtw,
         graph=graph,
         sight_mesh=given.sight_mesh,
+        world=world,
+        cs2_data=bool(files) and all(is_awpy_source(f) for f in files),
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend
@@ -170,6 +173,7 @@ def evaluate(
         where = f"{count} local worker process{'es' if count > 1 else ''}"
     info = RunInfo(command=command, backend=where, sample=sample, machine=machine_line())
     console.print(f"evaluating with {where}: {mechanics(settings)}", highlight=False)
+    console.print(f"world: {world_line(settings)}", highlight=False)
     if settings.combat:
         for line in map_warnings(settings.models, [settings.map_name]):
             console.print(f"warning: {line}", style="yellow", markup=False)

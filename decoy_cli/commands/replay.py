@@ -11,10 +11,7 @@ from rich.table import Table
 
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._groups import with_groups
-from decoy_cli.commands._options import (
-    MAPS_HELP,
-    RunOptions,
-)
+from decoy_cli.commands._options import MAPS_HELP, RunOptions, world_option
 from decoy_cli.damage import load_damage_model, parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.metrics import METRIC_NAMES_CLOCK, METRIC_NAMES_PAPER
@@ -22,6 +19,7 @@ from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
 from decoy_cli.text import shortened, visible
+from decoy_cli.waypoints.build import WorldChoice
 
 NOTE_LIMIT = 400
 """Most characters of a note printed (the names in it come from the data)."""
@@ -41,6 +39,7 @@ def replay(
         "--graph",
         help="Waypoint graph (.npz from build-waypoints; default: the built-in one of the map).",
     ),
+    world: WorldChoice = world_option(),
     out: Path | None = typer.Option(
         None,
         "--out",
@@ -69,6 +68,7 @@ def replay(
         out=out,
         gif=gif,
         sight_mesh=given.sight_mesh,
+        world=world,
     )
     round_, result, players = run.round_, run.result, run.players
     real = (round_.winning_side, round_.end_reason)
@@ -79,6 +79,7 @@ def replay(
         f"{run.seconds:.2f} s ({options.mover} mover, combat {'on' if options.combat else 'off'}, "
         f"bomb {'on' if options.bomb else 'off'})"
     )
+    console.print(f"world: {run.summary['world']}", highlight=False)
     outcome = Table(title="outcome")
     outcome.add_column("")
     outcome.add_column("winner")

@@ -9,7 +9,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.commands._options import MAPS_HELP, RATE_HELP
+from decoy_cli.commands._options import MAPS_HELP, RATE_HELP, world_option
 from decoy_cli.commands._snap_output import (
     show_actions,
     show_places,
@@ -21,7 +21,14 @@ from decoy_cli.commands._snap_output import (
 )
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.errors import DecoyError, EstaError
-from decoy_cli.esta import Round, iter_match_files, parse_round_address, read_match
+from decoy_cli.esta import (
+    Round,
+    collect_match_files,
+    iter_match_files,
+    parse_round_address,
+    read_match,
+)
+from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.files import write_csv
 from decoy_cli.replay import DEFAULT_MAX_SNAP_M
 from decoy_cli.replay.plot import plot_round_plan
@@ -33,7 +40,7 @@ from decoy_cli.replay.study import (
     study_round,
 )
 from decoy_cli.sim.setup import RoundSetup
-from decoy_cli.waypoints.build import builtin_graph, canonical_map
+from decoy_cli.waypoints.build import WorldChoice, builtin_graph, canonical_map, pick_world
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import load_navmesh
 
@@ -54,6 +61,7 @@ def snap(
     graph_file: Path | None = typer.Option(
         None, "--graph", help="Waypoint graph (.npz from build-waypoints; overrides --map)."
     ),
+    world: WorldChoice = world_option(),
     max_snap: float = typer.Option(
         DEFAULT_MAX_SNAP_M,
         "--max-snap",
@@ -92,8 +100,16 @@ def snap(
     replay can reach). Exits non-zero when a file or round failed."""
     console = make_console()
     map_id = canonical_map(map_name)
-    graph = WaypointGraph.load(graph_file) if graph_file is not None else builtin_graph(map_id)
     path = Path(target)
+    if graph_file is not None and world != "auto":
+        raise DecoyError("--graph brings its own world: leave out --world")
+    if graph_file is not None:
+        graph = WaypointGraph.load(graph_file)
+    else:
+        source = path if path.exists() else Path(target.rsplit(":", 1)[0])
+        files = collect_match_files([source])[0] if source.exists() else []
+        cs2_data = bool(files) and all(is_awpy_source(f) for f in files)
+        graph = builtin_graph(map_id, pick_world(world, cs2_data, map_id))
     if path.exists():
         for option, given in (
             ("--plot", plot is not None),
@@ -114,6 +130,7 @@ def snap(
     round_ = match.round(num)
     chosen = _player_rows(round_, players)
     window = _frame_window(frames, round_.num_frames)
+    console.print(f"world: {graph.world_source}", highlight=False)
     with RoundSetup(graph=graph).open_physics() as physics:  # the replay's in-the-air rule
         study = study_round(round_, graph, metrics=metrics, max_distance=max_snap, physics=physics)
     show_round(console, round_, study, graph, worst)
@@ -181,6 +198,7 @@ def _snap_batch(
     if path.is_file() and study.failures and study.failures[0].round_num is None:
         raise EstaError(study.failures[0].message)
 
+    console.print(f"world: {graph.world_source}", highlight=False)
     console.print(totals_table(study.totals, f"{path}: {len(files)} match files"))
     if worst:
         show_worst(console, study.worst(worst), with_match=True)

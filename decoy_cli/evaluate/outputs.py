@@ -44,6 +44,7 @@ from decoy_cli.evaluate.report import (
     report_markdown,
     run_counts,
     sight_line,
+    world_line,
 )
 from decoy_cli.evaluate.runner import Evaluation
 from decoy_cli.evaluate.tables import Tables
@@ -254,6 +255,7 @@ def summary(evaluation: Evaluation, tables: Tables, info: RunInfo) -> JsonObject
             },
             "mechanics": mechanics(evaluation.settings),
             "models": model_lines(evaluation.settings),
+            "world": world_line(evaluation.settings),
             "line_of_sight_in": sight_line(evaluation.settings),
             "counts": run_counts(evaluation, tables),
             "wall_seconds": evaluation.wall_seconds,

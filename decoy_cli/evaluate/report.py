@@ -89,6 +89,18 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
     return lines
 
 
+def world_line(settings: EvalSettings) -> str:
+    """The world the rounds replay on, in words, and why that one."""
+    from decoy_cli.evaluate.job import run_graph
+
+    source = run_graph(settings).world_source or "unnamed"
+    if settings.graph:
+        return f"{source}, from the graph {settings.graph}"
+    if settings.world == "cs2":
+        return f"{source} (the CS2 world the package ships for {settings.map_name})"
+    return f"{source} (the CS:GO world of {settings.map_name})"
+
+
 def sight_line(settings: EvalSettings) -> str | None:
     """Where line of sight was tested, in words (None without shooting)."""
     if not settings.models_fingerprint:
@@ -108,6 +120,8 @@ def command_line(
     words = ["decoy", "evaluate", *map(str, inputs), "--map", settings.map_name]
     if settings.graph:
         words += ["--graph", settings.graph]
+    else:
+        words += ["--world", settings.world]
     if settings.sight_mesh:
         words += ["--sight-mesh", settings.sight_mesh]
     if sample is not None:
@@ -280,6 +294,7 @@ def report_markdown(
             "(below, and the `inferred` column of `rounds.csv`)",
         ],
         ["mechanics", mechanics(evaluation.settings)],
+        ["world", world_line(settings)],
         *([name, text] for name, text in model_lines(settings).items()),
         *([["line of sight in", sight]] if (sight := sight_line(settings)) else []),
         ["mover, seed", f"{settings.mover}, {settings.seed}"],

@@ -56,6 +56,7 @@ from decoy_cli.evaluate.tables import Accumulator
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING, MoverName
+from decoy_cli.waypoints.build import WorldChoice
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import place_names
 from decoy_cli.world.occlusion import read_sight_scene
@@ -132,15 +133,23 @@ def make_settings(
     fastdtw: bool | None = None,
     graph: Path | None = None,
     sight_mesh: Path | None = None,
+    world: WorldChoice = "auto",
+    cs2_data: bool = False,
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round. `fastdtw` None
-    means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise."""
-    from decoy_cli.waypoints.build import builtin_graph, canonical_map
+    means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise. The world:
+    the graph's, else the one `world` picks (`pick_world`; `cs2_data`: every input is CS2's)."""
+    from decoy_cli.waypoints.build import builtin_graph, canonical_map, pick_world
 
     name = canonical_map(map_name)
     graph_path, graph_sha = "", ""
     graph_of_run = None
+    if graph is not None and world != "auto":
+        raise DecoyError("--graph brings its own world: leave out --world")
+    world_of_run = "" if graph is not None else pick_world(world, cs2_data, name)
+    if world_of_run == "cs2":
+        graph_of_run = builtin_graph(name, "cs2")  # fails now when none ships
     if graph is not None:  # absolute, for workers elsewhere; its map must be the run's
         graph_path = str(graph.expanduser().resolve())
         graph_sha = content_sha256(Path(graph_path))
@@ -178,6 +187,7 @@ def make_settings(
         deaths=deaths,
         missing=missing,
         fastdtw=(not combat and not bomb) if fastdtw is None else fastdtw,
+        world=world_of_run,
         graph=graph_path,
         graph_sha=graph_sha,
         sight_mesh=sight_path,

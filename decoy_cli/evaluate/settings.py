@@ -67,6 +67,9 @@ class EvalSettings(ReplaySpec):
     """Also compute `paper_dtw_fastdtw` (the paper's FastDTW; slow, `metrics.fastdtw_metric`)."""
     hp_bin_s: float = HP_BIN_S
     hp_bins: int = HP_BINS
+    world: str = "csgo"
+    """The shipped world rounds replay on without a user's graph: "csgo" or "cs2" ("": the
+    user's graph brings its own)."""
     graph: str = ""
     """A user's waypoint graph file, absolute ("": the map's shipped graph); rounds are replayed
     on it and on the world it was built on (`graph_world`)."""

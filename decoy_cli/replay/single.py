@@ -25,7 +25,7 @@ from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
 from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING
-from decoy_cli.waypoints.build import builtin_graph, canonical_map
+from decoy_cli.waypoints.build import WorldChoice, builtin_graph, canonical_map, pick_world
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
 from decoy_cli.world.occlusion import read_sight_scene
@@ -56,6 +56,7 @@ def replay_address(
     out: Path | None = None,
     gif: bool = False,
     sight_mesh: Path | None = None,
+    world: WorldChoice = "auto",
 ) -> SingleReplay:
     """Replay the round at "FILE:ROUND" and write its files (see the module docstring).
 
@@ -68,7 +69,12 @@ def replay_address(
         map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
     round_ = load_round(address, implausible=options.implausible, rate=options.rate)
     map_id = round_map(address, round_.map_name, map_name)
-    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id)
+    if graph_file is not None and world != "auto":
+        raise DecoyError("--graph brings its own world: leave out --world")
+    if graph_file is not None:
+        graph = WaypointGraph.load(graph_file)
+    else:
+        graph = builtin_graph(map_id, pick_world(world, round_.source != "ESTA", map_id))
     graph_map = str(graph.meta.get("map", ""))
     if graph_map and graph_map != map_id:
         raise DecoyError(f"{address}: a {map_id} round, but the graph {graph_file} is {graph_map}")
@@ -83,7 +89,9 @@ def replay_address(
     result = replay_round(round_, graph, options)
     seconds = time.perf_counter() - started
     players = player_metrics(round_, result.trace())
-    summary = replay_summary(address, round_, options, models, result, players, seconds, sight)
+    summary = replay_summary(
+        address, round_, options, models, result, players, seconds, sight, graph.world_source
+    )
     folder = out or DEFAULT_REPLAY_OUT / replay_folder_name(round_.path, round_.round_num)
     nav = load_navmesh(map_id)
     shown = "".join(c if c.isprintable() else "?" for c in round_.match_id[:8])
@@ -133,6 +141,7 @@ def replay_summary(
     players: pd.DataFrame,
     seconds: float,
     sight: str = "the graph's world",
+    world: str = "",
 ) -> dict[str, object]:
     """The contents of `summary.json`: the round, the options, both outcomes, counts, the
     fields inferred, the bomb's fidelity (`BOMB_COLUMNS`, None with the bomb off) and the
@@ -152,6 +161,7 @@ def replay_summary(
             "missing_fields": options.missing,
         },
         "damage_models": models if options.combat else None,
+        "world": world,
         "line_of_sight_in": sight if options.combat else None,
         "played_out_s": round(result.played_out_s, 3),
         "outcome_original": {"winner": round_.winning_side, "reason": round_.end_reason},

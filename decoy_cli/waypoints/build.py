@@ -12,6 +12,7 @@ import io
 from dataclasses import asdict
 from functools import cache
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -26,6 +27,10 @@ from decoy_cli.world.physics import PhysicsWorld
 from decoy_cli.world.world import World
 
 GRAPH_FILE = "waypoints.npz"
+CS2_GRAPH_FILE = "cs2_waypoints.npz"
+"""A map's graph on its CS2 world (built with `--nav` from CS2's nav mesh; it carries the world)."""
+GameWorld = Literal["csgo", "cs2"]
+WorldChoice = Literal["auto", "csgo", "cs2"]
 CARRIED_KIND = POLYGON_NAV_KIND
 """Worlds of this kind are not in the package: a graph built on one carries it."""
 
@@ -140,9 +145,29 @@ def build_graph(
 
 
 @cache
-def builtin_graph(map_name: str = BUILTIN_MAP) -> WaypointGraph:
-    """The waypoint graph shipped with the package for a built-in map (cached per process)."""
-    return WaypointGraph.load(asset_dir(canonical_map(map_name)) / GRAPH_FILE)
+def builtin_graph(map_name: str = BUILTIN_MAP, world: GameWorld = "csgo") -> WaypointGraph:
+    """The waypoint graph shipped with the package for a built-in map, on its CS:GO world or
+    on its CS2 world (which the graph carries), cached per process; a GraphError when the
+    package ships no CS2 world of the map."""
+    folder = asset_dir(canonical_map(map_name))
+    if world == "csgo":
+        return WaypointGraph.load(folder / GRAPH_FILE)
+    if not (folder / CS2_GRAPH_FILE).is_file():
+        raise GraphError(
+            f"decoy ships no CS2 world of {map_name}: build one with `decoy build-waypoints "
+            "--nav FILE` and give it with --graph"
+        )
+    return WaypointGraph.load(folder / CS2_GRAPH_FILE)
+
+
+def pick_world(asked: WorldChoice, cs2_data: bool, map_name: str) -> GameWorld:
+    """The world rounds of `map_name` replay on: the one `asked`, or with "auto" CS2's when the
+    data is CS2's (`cs2_data`: read from awpy's tables, which only CS2 demos give) and the
+    package ships a CS2 world of the map, else CS:GO's."""
+    if asked != "auto":
+        return asked
+    shipped = (asset_dir(canonical_map(map_name)) / CS2_GRAPH_FILE).is_file()
+    return "cs2" if cs2_data and shipped else "csgo"
 
 
 def graph_world(graph: WaypointGraph) -> World:

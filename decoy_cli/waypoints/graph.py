@@ -131,6 +131,12 @@ class WaypointGraph:
     # ---- basic properties -------------------------------------------------------------------
 
     @property
+    def world_source(self) -> str:
+        """Where the world the graph was built on comes from, in words."""
+        described = self.meta.get("world", {})
+        return str(described.get("source", "")) if isinstance(described, dict) else ""
+
+    @property
     def num_nodes(self) -> int:
         return len(self.positions)
 
