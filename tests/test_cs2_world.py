@@ -6,6 +6,7 @@ from __future__ import annotations
 import gzip
 import json
 import lzma
+import os
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import cs2_world
 from decoy_cli.world.nav_data import REGIONS, asset_dir, load_navmesh
-from decoy_cli.world.nav_json import read_nav_json
+from decoy_cli.world.nav_json import read_nav, read_nav_json
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -133,6 +134,27 @@ def test_a_compressed_bomb_is_refused_without_unpacking_it(tmp_path: Path) -> No
     (tmp_path / "bomb.json.xz").write_bytes(lzma.compress(b" " * 70_000_000))
     with pytest.raises(WorldError, match="unpacks to more than"):
         read_nav_json(tmp_path / "bomb.json.xz")
+
+
+def test_a_binary_nav_without_awpy_3_says_how_to_read_it(tmp_path: Path) -> None:
+    try:
+        import awpy  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        pytest.skip("awpy 3 is installed: the binary path is tested with DECOY_TEST_NAV")
+    (tmp_path / "de_dust2.nav").write_bytes((0xFEEDFACE).to_bytes(4, "little") + b"\0" * 60)
+    with pytest.raises(WorldError, match=r"read through awpy 3 .*awpy nav FILE\.nav"):
+        read_nav(tmp_path / "de_dust2.nav")
+
+
+@pytest.mark.skipif(
+    not os.environ.get("DECOY_TEST_NAV"),
+    reason="DECOY_TEST_NAV names no CS2 de_dust2 .nav to read through awpy 3",
+)
+def test_a_real_binary_nav_reads_through_awpy3() -> None:
+    world = cs2_world(os.environ["DECOY_TEST_NAV"], "de_dust2")
+    assert world.meta["areas"] > 1000 and world.source.startswith("CS2 de_dust2 nav mesh")
 
 
 # ---- the world --------------------------------------------------------------------------------
@@ -243,6 +265,9 @@ def test_a_graph_built_on_a_cs2_world_carries_it_and_replays_on_it(tmp_path: Pat
 
 def test_build_waypoints_nav_writes_a_graph_with_its_world(tmp_path: Path) -> None:
     path = dust2_piece(tmp_path)
+    document = json.loads(path.read_text())
+    document["areas"]["1"]["ladders_above"] = [7]  # a ladder id: the form holds no position
+    write_nav(path, document)
     seed = ",".join(f"{v:g}" for v in piece_seed(path))
     out = tmp_path / "cs2.npz"
     result = runner.invoke(
@@ -252,6 +277,7 @@ def test_build_waypoints_nav_writes_a_graph_with_its_world(tmp_path: Path) -> No
     )
     assert result.exit_code == 0, result.output
     assert "CS2 de_dust2 nav mesh" in result.output
+    assert "1 ladder links but no ladder positions" in result.output
     assert WaypointGraph.load(out).world_triangles is not None
 
 

@@ -87,8 +87,8 @@ def build_waypoints(
     nav_file: Path | None = typer.Option(
         None,
         "--nav",
-        help="A CS2 nav mesh of the map in awpy's JSON form (plain, .xz or .gz): build the world "
-        "from it; the graph carries that world.",
+        help="A CS2 nav mesh of the map (awpy's JSON form, plain, .xz or .gz; or a binary .nav "
+        "with awpy 3 installed): build the world from it; the graph carries that world.",
     ),
     spacing: float = typer.Option(0.7, "--spacing", help="Lattice spacing in metres.", min=0.2),
     wall_nodes: bool = typer.Option(
@@ -143,6 +143,12 @@ def build_waypoints(
     if nav_file is not None:
         world = cs2_world(nav_file, map_id)
         name = f"{map_id}.cs2"
+        if world.meta.get("ladder_links"):
+            console.print(
+                f"warning: the nav names {world.meta['ladder_links']} ladder links but no ladder "
+                "positions: the world has no ladders to climb",
+                style="yellow",
+            )
     elif user_mesh.mesh is None:
         world = nav_world(map_id)
         name = map_id

@@ -15,7 +15,7 @@ import numpy as np
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import WorldError
 from decoy_cli.world.nav_data import load_navmesh
-from decoy_cli.world.nav_json import PolygonNav, read_nav_json
+from decoy_cli.world.nav_json import PolygonNav, read_nav
 from decoy_cli.world.nav_polygons import polygon_world
 from decoy_cli.world.world import World
 
@@ -27,7 +27,7 @@ SAME_MAP_REACH_M = 1.0
 def cs2_world(path: str | Path, map_name: str) -> World:
     """The world of the CS2 nav file `path` of the built-in map `map_name`; a WorldError for a
     file that is not a nav mesh of that map."""
-    nav = read_nav_json(path)
+    nav = read_nav(path)
     share = on_map_share(nav, map_name)
     if share < SAME_MAP_SHARE:
         raise WorldError(

@@ -1,4 +1,4 @@
-"""A CS2 navigation mesh in awpy's JSON form, read into polygons.
+"""A CS2 navigation mesh, in awpy's JSON form or CS2's binary `.nav`, read into polygons.
 
 CS2 nav areas are convex polygons (triangles and quadrilaterals on de_dust2) with a full height
 at every corner, not CS:GO's axis-aligned rectangles with two corner heights. awpy 2 writes
@@ -11,9 +11,10 @@ them as JSON (`awpy nav FILE.nav`, `awpy get navs`):
 
 `version` is the binary file's (awpy 2 reads 30-35, awpy 3 30-36); the JSON layout is the same
 for each, so those are read and any other is refused. The file may be xz- or gzip-compressed
-(as the copy in awpy's source distribution is). The form carries no place names and no ladder
-positions (only ladder ids): places come from the map's built-in nav (`nav_places.py`), and
-ladder links are counted so the caller can say that climbs are not in the world.
+(as the copy in awpy's source distribution is). A binary `.nav` (a user's `awpy get` files) is
+read through awpy 3's `NavMesh` when awpy 3 is installed and checked as the JSON is. Neither
+carries place names or ladder positions (only ladder ids): places come from the map's built-in
+CS:GO nav (`waypoints/build.py`), and ladder links are counted.
 """
 
 from __future__ import annotations
@@ -61,13 +62,51 @@ class PolygonNav:
         return self.corners[area, : self.sides[area]]
 
 
+def read_nav(path: str | Path) -> PolygonNav:
+    """The polygons of a CS2 nav file: CS2's binary `.nav` (through awpy 3), else awpy's JSON
+    form (plain, .xz or .gz); a WorldError naming the file for anything that is not one."""
+    path = Path(path)
+    limit = int(MAX_FILE_MB * 1e6)
+    data = read_limited(path, limit, WorldError)  # a regular file of at most `limit` bytes
+    if path.suffix.lower() == ".nav":
+        return _polygons(_binary_document(path), path)
+    return _polygons(parse_json(_decompressed(data, limit, path), str(path), WorldError), path)
+
+
 def read_nav_json(path: str | Path) -> PolygonNav:
-    """The polygons of an awpy JSON nav file (plain, .xz or .gz); a WorldError naming the file
-    for anything that is not one."""
+    """The polygons of an awpy JSON nav file (plain, .xz or .gz), as `read_nav` reads it."""
     path = Path(path)
     limit = int(MAX_FILE_MB * 1e6)
     data = _decompressed(read_limited(path, limit, WorldError), limit, path)
-    document = parse_json(data, str(path), WorldError)
+    return _polygons(parse_json(data, str(path), WorldError), path)
+
+
+def _binary_document(path: Path) -> dict[str, object]:
+    """A binary CS2 nav read by awpy 3's `NavMesh`, in the JSON form's shape."""
+    try:
+        from awpy import NavMesh
+    except ImportError:
+        raise WorldError(
+            f"{path}: a binary CS2 nav is read through awpy 3 (pip install -e '.[cs2]'); or "
+            "give its JSON form (awpy 2: `awpy nav FILE.nav`)"
+        ) from None
+    try:
+        mesh = NavMesh(path)
+        areas = {}
+        for area_id in mesh.areas["area_id"].to_list():
+            area = mesh.area(area_id) or {}
+            areas[str(area_id)] = {
+                "area_id": area_id,
+                "corners": [{"x": x, "y": y, "z": z} for x, y, z in area.get("corners", [])],
+                **{name: list(area.get(name, [])) for name in _ID_LISTS},
+            }
+    except (ValueError, OSError, TypeError, KeyError) as error:
+        raise WorldError(f"{path}: not a CS2 nav file awpy 3 reads ({error})") from None
+    return {"version": mesh.version, "areas": areas}
+
+
+def _polygons(document: object, path: Path) -> PolygonNav:
+    """The polygons of a nav in the JSON form's shape, checked."""
     areas = document.get("areas") if isinstance(document, dict) else None
     if not isinstance(document, dict) or not isinstance(areas, dict):
         raise WorldError(f"{path}: not an awpy JSON nav file (no 'areas' object)")

@@ -65,7 +65,7 @@ def polygon_world(nav: PolygonNav, map_name: str) -> World:
         triangles=polygon_triangles(nav) * HAMMER_TO_M,
         name=map_name,
         source=f"CS2 {map_name} nav mesh ({Path(nav.source).name}, nav version {nav.version})",
-        meta={"kind": POLYGON_NAV_KIND, "areas": nav.num_areas},
+        meta={"kind": POLYGON_NAV_KIND, "areas": nav.num_areas, "ladder_links": nav.ladder_links},
     )
 
 
