@@ -139,12 +139,12 @@ def fit_corner_heights(nav: NavMesh, contacts: list[_Contact]) -> tuple[np.ndarr
 # ---- triangles --------------------------------------------------------------------------------
 
 
-def _quad(p0, p1, p2, p3) -> list[list[tuple[float, float, float]]]:
+def quad(p0, p1, p2, p3) -> list[list[tuple[float, float, float]]]:
     """Two triangles of the quad p0-p1-p2-p3 (in order around its boundary)."""
     return [[p0, p1, p2], [p0, p2, p3]]
 
 
-def _subtract(interval: tuple[float, float], covers: list[tuple[float, float]]):
+def subtract(interval: tuple[float, float], covers: list[tuple[float, float]]):
     """Parts of a 1-D interval not covered by any of `covers`."""
     pieces = [interval]
     for lo, hi in covers:
@@ -195,7 +195,7 @@ def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[l
     # floors
     for a in range(nav.num_areas):
         x0, x1, y0, y1 = nav.x_min[a], nav.x_max[a], nav.y_min[a], nav.y_max[a]
-        tris += _quad(
+        tris += quad(
             (x0, y0, height(a, x0, y0)),
             (x1, y0, height(a, x1, y0)),
             (x1, y1, height(a, x1, y1)),
@@ -216,7 +216,7 @@ def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[l
         za0, za1 = height(c.a, *p0), height(c.a, *p1)
         zb0, zb1 = height(c.b, *p0), height(c.b, *p1)
         if max(abs(za0 - zb0), abs(za1 - zb1)) > 1.0:
-            tris.extend(_quad((*p0, za0), (*p1, za1), (*p1, zb1), (*p0, zb0)))
+            tris.extend(quad((*p0, za0), (*p1, za1), (*p1, zb1), (*p0, zb0)))
 
     rise = {}
     level: dict[tuple[int, int], list[tuple[float, float]]] = {}
@@ -235,7 +235,7 @@ def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[l
             continue
         # A high ledge: where the lower floor goes on under the upper one, there is no face.
         lower_side = side_key(c.a, c.axis, True) if rise[c] > 0 else side_key(c.b, c.axis, False)
-        for lo, hi in _subtract((c.lo, c.hi), level.get(lower_side, [])):
+        for lo, hi in subtract((c.lo, c.hi), level.get(lower_side, [])):
             step_face(c, lo, hi)
 
     # bridges across small gaps between connected areas
@@ -260,7 +260,7 @@ def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[l
                 for area, near, far in ((first, c0, mid), (second, c1, mid)):
                     z_lo = height(area, *point(lo, near))
                     z_hi = height(area, *point(hi, near))
-                    tris += _quad(
+                    tris += quad(
                         (*point(lo, near), z_lo),
                         (*point(hi, near), z_hi),
                         (*point(hi, far), z_hi),
@@ -268,7 +268,7 @@ def _floors_and_joins(nav: NavMesh, contacts: list[_Contact], height) -> tuple[l
                     )
                 z_first = [height(first, *point(s, c0)) for s in (lo, hi)]
                 z_second = [height(second, *point(s, c1)) for s in (lo, hi)]
-                tris += _quad(
+                tris += quad(
                     (*point(lo, mid), z_first[0]),
                     (*point(hi, mid), z_first[1]),
                     (*point(hi, mid), z_second[1]),
@@ -287,7 +287,7 @@ def _open_stretches(nav: NavMesh, covered) -> list[tuple[_Side, _OpenPart]]:
         for axis in (0, 1):
             for high in (False, True):
                 side = _Side(nav, a, axis, high, covered)
-                for lo, hi in _subtract((side.lo, side.hi), covered.get((a, axis * 2 + high), [])):
+                for lo, hi in subtract((side.lo, side.hi), covered.get((a, axis * 2 + high), [])):
                     stretches += [(side, part) for part in side.open_parts(lo, hi)]
     return stretches
 
@@ -346,7 +346,7 @@ class _Side:
                 c_lo, c_hi = max(p_lo, span[0]), min(p_hi, span[1])
                 if c_hi - c_lo > TOUCH_TOL_U:
                     parts.append(_OpenPart(c_lo, c_hi, int(b), max(0.0, float(self.gap[b]))))
-            rest = [q for p in rest for q in _subtract(p, [span])]
+            rest = [q for p in rest for q in subtract(p, [span])]
         parts += [_OpenPart(p_lo, p_hi, -1, np.inf) for p_lo, p_hi in rest]
         return sorted(parts, key=lambda q: q.lo)
 
@@ -400,14 +400,14 @@ class _Side:
         inside = across & along & (np.abs(self.centre_z - level_z) <= JUMP_U)
         inside[self.area] = False
         spans = zip(self.t_lo[inside] - clearance, self.t_hi[inside] + clearance, strict=True)
-        return _subtract((lo, hi), list(spans))
+        return subtract((lo, hi), list(spans))
 
     def _strip(self, part: _OpenPart, width: float, z0: float, z1: float) -> list:
         """The area's floor extended outward by `width`."""
         if width <= 0.5:
             return []
         out = self.coord + self.sign * width
-        return _quad(
+        return quad(
             (*self.point(part.lo, self.coord), z0),
             (*self.point(part.hi, self.coord), z1),
             (*self.point(part.hi, out), z1),
@@ -417,7 +417,7 @@ class _Side:
     def _vertical(self, part: _OpenPart, push: float, za, zb) -> list:
         """A vertical face on the pushed line between two height profiles."""
         out = self.coord + self.sign * push
-        return _quad(
+        return quad(
             (*self.point(part.lo, out), za[0]),
             (*self.point(part.hi, out), za[1]),
             (*self.point(part.hi, out), zb[1]),
@@ -457,7 +457,7 @@ class _Side:
         return [
             tri
             for p_lo, p_hi in pieces
-            for tri in _quad(
+            for tri in quad(
                 (*self.point(p_lo, out), z0),
                 (*self.point(p_hi, out), z1),
                 (*self.point(p_hi, out), z1 + top),

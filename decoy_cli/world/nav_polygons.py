@@ -38,6 +38,8 @@ from decoy_cli.world.nav_geometry import (
     STEP_U,
     TOUCH_TOL_U,
     WALL_HEIGHT_U,
+    quad,
+    subtract,
 )
 from decoy_cli.world.nav_json import PolygonNav
 from decoy_cli.world.world import World
@@ -76,7 +78,7 @@ def polygon_triangles(nav: PolygonNav) -> np.ndarray:
     covered, tris = _shared_stretches(edges, floors)
     walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]] = defaultdict(list)
     for e in range(edges.count):
-        for lo, hi in _subtract((0.0, edges.length[e]), covered[e]):
+        for lo, hi in subtract((0.0, edges.length[e]), covered[e]):
             tris += _open_faces(edges, floors, e, lo, hi, walls)
     tris += _corner_walls(walls)
     floor_tris = floors.triangles.reshape(-1, 3, 3)
@@ -208,7 +210,7 @@ def _shared_stretches(edges: _Edges, floors: _Floors) -> tuple[list[list], list]
             if edges.area[e] < edges.area[j] and rise > 1:
                 p0, p1 = edges.point(e, a_lo), edges.point(e, a_hi)
                 low = ((*p0[:2], za[0]), (*p1[:2], za[1]))
-                tris += _quad(*low, (*p1[:2], zb[1]), (*p0[:2], zb[0]))
+                tris += quad(*low, (*p1[:2], zb[1]), (*p0[:2], zb[0]))
     return covered, tris
 
 
@@ -228,18 +230,6 @@ def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
     along = np.dot(point[:2] - edges.start[e, :2], edges.direction[e])
     t = float(np.clip(along, 0, edges.length[e]))
     return float(edges.point(e, t)[2])
-
-
-def _subtract(interval: tuple[float, float], covers: list[tuple[float, float]]) -> list:
-    """Parts of a 1-D interval not covered by any of `covers`, longer than the touch tolerance."""
-    pieces = [interval]
-    for lo, hi in covers:
-        pieces = [
-            part
-            for a, b in pieces
-            for part in (((a, b),) if hi <= a or lo >= b else ((a, min(lo, b)), (max(hi, a), b)))
-        ]
-    return [(a, b) for a, b in pieces if b - a > TOUCH_TOL_U]
 
 
 # ---- open edges ---------------------------------------------------------------------------
@@ -363,7 +353,7 @@ def _corner_walls(
                 if np.hypot(*(pa - pb)[:2]) <= 0.5:
                     continue
                 top = min(top_a, top_b)
-                tris += _quad(
+                tris += quad(
                     (pa[0], pa[1], za), (pb[0], pb[1], zb), (pb[0], pb[1], zb + top),
                     (pa[0], pa[1], za + top),
                 )  # fmt: skip
@@ -376,18 +366,13 @@ def _strip(edges: _Edges, e: int, t0: float, t1: float, width: float, z0: float,
         return []
     a, b = edges.point(e, t0), edges.point(e, t1)
     c, d = edges.point(e, t1, width), edges.point(e, t0, width)
-    return _quad((*a[:2], z0), (*b[:2], z1), (*c[:2], z1), (*d[:2], z0))
+    return quad((*a[:2], z0), (*b[:2], z1), (*c[:2], z1), (*d[:2], z0))
 
 
 def _face(edges: _Edges, e: int, t0: float, t1: float, push: float, low, high):
     """A vertical face on the line `push` beyond edge e, between two height profiles."""
     a, b = edges.point(e, t0, push), edges.point(e, t1, push)
-    return _quad((*a[:2], low[0]), (*b[:2], low[1]), (*b[:2], high[1]), (*a[:2], high[0]))
-
-
-def _quad(p0, p1, p2, p3) -> list:
-    """Two triangles of the quad p0-p1-p2-p3 (in order around its boundary)."""
-    return [[p0, p1, p2], [p0, p2, p3]]
+    return quad((*a[:2], low[0]), (*b[:2], low[1]), (*b[:2], high[1]), (*a[:2], high[0]))
 
 
 def open_edge_rays(
@@ -401,7 +386,7 @@ def open_edge_rays(
     covered, _ = _shared_stretches(edges, floors)
     starts, ends = [], []
     for e in range(edges.count):
-        for lo, hi in _subtract((0.0, edges.length[e]), covered[e]):
+        for lo, hi in subtract((0.0, edges.length[e]), covered[e]):
             for t in np.arange(lo + PIECE_U / 2, hi - PIECE_U / 2, PIECE_U):
                 z = float(edges.point(e, t)[2])
                 if _beyond(edges, floors, e, t, z) is not None:
