@@ -15,7 +15,7 @@
    reads them): the share of damaging and other steps DIP says "hit" for, as recorded and with
    every victim's view turned 45, 90 and 180 degrees away (de_dust2's views are real;
    de_ancient's, filled by its export as facing each other, are redrawn by
-   `decoy_cli/damage/filled_views.py`).
+   `decoy_cli/modeling/filled_views.py`).
 3. The real hits' view deviations behind that redraw (de_dust2's events), and how the DIP scores
    de_dust2's real damaging steps with their real views and with views filled as facing.
 """
@@ -29,12 +29,12 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.damage import resolve_models
-from decoy_cli.damage.evaluation import dip_probabilities
-from decoy_cli.damage.filled_views import QUANTILES, hit_view_deviations
 from decoy_cli.damage.model_folder import load_dip
-from decoy_cli.damage.samples import build_samples
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
-from decoy_cli.evaluate.fight_threshold import EYE
+from decoy_cli.modeling.fight_threshold import EYE
+from decoy_cli.modeling.filled_views import QUANTILES, hit_view_deviations
+from decoy_cli.modeling.network_evaluation import dip_probabilities
+from decoy_cli.modeling.samples import build_samples
 from decoy_cli.waypoints.build import builtin_graph, graph_world
 from decoy_cli.world.physics import PhysicsWorld
 

@@ -45,7 +45,7 @@ from decoy_cli.damage.model_folder import (
     save_dog,
 )
 from decoy_cli.damage.networks import DipNet, DogNet
-from decoy_cli.damage.paper import import_paper
+from decoy_cli.modeling.paper_import import import_paper
 from decoy_cli.sim.combat import CombatStep, LineOfSight, VisiblePairs, make_batch
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.world.navmesh import nav_world

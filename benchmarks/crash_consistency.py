@@ -524,7 +524,7 @@ def downloads(work: Path, results: Results) -> None:
     if not PAPER_CHECKPOINTS.is_dir():
         results.add("models download-decoy", True, f"skipped: no {PAPER_CHECKPOINTS}")
         return
-    from decoy_cli.damage.download_paper import PAPER_FILES
+    from decoy_cli.modeling.paper_download import PAPER_FILES
 
     files = {
         f"/{f.path}": (PAPER_CHECKPOINTS / name).read_bytes() for name, f in PAPER_FILES.items()

@@ -41,8 +41,8 @@ import numpy as np
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.damage import load_damage_model
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
-from decoy_cli.evaluate.fight_threshold import EYE, enemies_in_sight
 from decoy_cli.metrics.kills import DEATH_WINDOW_S
+from decoy_cli.modeling.fight_threshold import EYE, enemies_in_sight
 from decoy_cli.replay.deaths import replay_deaths
 from decoy_cli.replay.missing import fill_missing
 from decoy_cli.replay.replayer import ReplayOptions, replay_round

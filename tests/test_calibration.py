@@ -5,15 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from decoy_cli.damage.calibration import (
-    Calibration,
+from decoy_cli.damage.calibration import Calibration
+from decoy_cli.modeling.calibration_fit import (
     brier_score,
     ece_floor,
     expected_calibration_error,
     fit_calibration,
     reliability_curve,
 )
-from decoy_cli.damage.scores import roc_auc
+from decoy_cli.modeling.scores import roc_auc
 
 
 def test_measures_on_hand_cases() -> None:

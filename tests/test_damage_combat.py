@@ -408,7 +408,7 @@ def test_rules_damage_is_the_rules_per_bullet(firing: Path) -> None:
     from decoy_cli.damage.bullet_counts import BulletCounts
     from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
     from decoy_cli.damage.rules import shot_damage
-    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
+    from decoy_cli.damage.rules_damage import RulesDamage, RulesFile
 
     rng = np.random.default_rng(61)
     groups = [GROUPS[i] for i in rng.integers(0, 6, 600)]
@@ -436,7 +436,7 @@ def test_rules_damage_is_the_rules_per_bullet(firing: Path) -> None:
 
 def test_penetration_learned_from_hits_below_the_rules() -> None:
     from decoy_cli.damage.rules import shot_damage
-    from decoy_cli.damage.rules_model import Penetration
+    from decoy_cli.damage.rules_damage import Penetration
 
     least = shot_damage("AK-47", "Chest", 800.0, armor=100, helmet=True).health
     bare = shot_damage("AK-47", "Chest", 800.0, armor=0, helmet=False).health
@@ -460,7 +460,7 @@ def test_penetration_learned_from_hits_below_the_rules() -> None:
 
 
 def test_the_shipped_rules_are_a_models_choice() -> None:
-    from decoy_cli.damage.rules_model import RulesDamage
+    from decoy_cli.damage.rules_damage import RulesDamage
 
     if not shipped_models_installed():
         pytest.skip("no shipped models")
@@ -472,7 +472,7 @@ def test_the_shipped_rules_are_a_models_choice() -> None:
 def test_rules_bullets_wear_armour_down_one_after_another() -> None:
     from decoy_cli.damage.bullet_counts import BulletCounts
     from decoy_cli.damage.hit_groups import HitGroupModel
-    from decoy_cli.damage.rules_model import RulesFile, pair_outcome
+    from decoy_cli.damage.rules_damage import RulesFile, pair_outcome
 
     three = BulletCounts()
     three.add("AK-47", 800.0, 3)
@@ -490,7 +490,7 @@ def test_bernoulli_hits_and_rules_outcomes_draw_from_separate_streams(firing: Pa
 
     from decoy_cli.damage.calibration import Calibration
     from decoy_cli.damage.model_folder import save_calibration
-    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
+    from decoy_cli.damage.rules_damage import RulesDamage, RulesFile
 
     if not shipped_models_installed():
         pytest.skip("no shipped models")

@@ -1,4 +1,4 @@
-"""Metrics and figures of the damage models (decoy_cli/damage/scores.py, evaluation.py,
+"""Metrics and figures of the damage models (decoy_cli/modeling/scores.py, network_evaluation.py,
 evaluation_figures.py): numbers checked by hand, the network runners on untrained networks
 (shapes, ranges, determinism under a seed)."""
 
@@ -13,12 +13,12 @@ import torch
 from scipy.stats import wasserstein_distance
 from test_damage_training import planted
 
-from decoy_cli.damage.evaluation import dog_generate, evaluate_dip, evaluate_dog
-from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
 from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import DipNet, DogNet
-from decoy_cli.damage.scores import (
+from decoy_cli.modeling.evaluation_figures import write_dip_figures, write_dog_figures
+from decoy_cli.modeling.network_evaluation import dog_generate, evaluate_dip, evaluate_dog
+from decoy_cli.modeling.scores import (
     Cell,
     average_precision,
     best_f1_threshold,

@@ -18,10 +18,10 @@ from typer.testing import CliRunner
 
 from decoy_cli.cli import app
 from decoy_cli.damage.bullet_counts import BulletCounts
-from decoy_cli.damage.hp_lost import band_labels, drawn_hp_lost, score_hp_lost
 from decoy_cli.damage.model_maps import map_warnings, trained_maps
-from decoy_cli.damage.samples import build_samples
-from decoy_cli.damage.split import leave_matches_out
+from decoy_cli.modeling.hp_lost import band_labels, drawn_hp_lost, score_hp_lost
+from decoy_cli.modeling.samples import build_samples
+from decoy_cli.modeling.split import leave_matches_out
 
 ROOT = Path(__file__).resolve().parents[1]
 ANCIENT = ROOT.parent / "shared" / "data" / "events_ancient"
@@ -216,10 +216,10 @@ def test_models_evaluate_rules_on_hp_lost_only_data(tmp_path: Path) -> None:
 def test_fold_comparison_labels_what_the_model_saw() -> None:
     """A model trained on rounds g0, g1 and validated on g2 has seen 3 of 7 rounds; on rounds it
     never saw it says so, naming its maps."""
+    from studies import study
     from test_damage_samples import synthetic
 
-    from decoy_cli.damage.fold_comparison import training_overlap
-
+    training_overlap = study("_damage_folds").training_overlap
     samples = synthetic(groups=7, per_group=2)
     groups = sorted(set(samples.group.tolist()))
     metadata = {"split": {"by": "round", "units": {"train": groups[:2], "val": groups[2:3]}}}
@@ -235,7 +235,8 @@ def test_hit_group_from_hp_lost_by_the_rules() -> None:
     of 36 HP a neck, chest or arm hit in the prior's proportions; a kill of a 30-HP victim any
     group doing at least 30 (all but the leg); 10 HP no group (a shot through something); 33 HP,
     which no group gives within 1 HP, the groups by how close they come."""
-    from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
+    from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
+    from decoy_cli.modeling.rules_fit import group_posterior
 
     prior = HitGroupModel.fit(["AK-47"] * 4, [0.0] * 4, ["Head", "Chest", "Chest", "Leg"])
     p = prior.probabilities("AK-47", 0.0)
@@ -267,7 +268,7 @@ def test_hit_group_from_hp_lost_by_the_rules() -> None:
 def test_rules_file_keeps_bullets_of_hurt_victims(tmp_path: Path) -> None:
     """Steps on hurt victims draw from their own counts; a file without them uses `bullets`."""
     from decoy_cli.damage.hit_groups import HitGroupModel
-    from decoy_cli.damage.rules_model import RulesFile
+    from decoy_cli.damage.rules_damage import RulesFile
 
     unhurt, hurt = BulletCounts(), BulletCounts()
     unhurt.add("AK-47", 300.0, 3)

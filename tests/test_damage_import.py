@@ -21,13 +21,13 @@ from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.features import HIT_GROUPS, PAPER_SPEC, encode
 from decoy_cli.damage.model_folder import load_dip, load_dog
 from decoy_cli.damage.networks import DipNet, DogNet, tensors
-from decoy_cli.damage.paper import (
+from decoy_cli.errors import ModelError
+from decoy_cli.modeling.paper_import import (
     HIT_GROUP_PERMUTATION,
     PAPER_HIT_GROUPS,
     import_paper,
     permute_hit_groups,
 )
-from decoy_cli.errors import ModelError
 from decoy_cli.sim.combat import CombatBatch
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -205,7 +205,7 @@ def test_imported_models_equal_a_functional_forward(checkpoints: Path, tmp_path:
 def test_published_models_give_plausible_outcomes() -> None:
     if not (PUBLISHED / "dip_best_model.pth").is_file():
         pytest.skip(f"the paper's published checkpoints are not at {PUBLISHED}")
-    from decoy_cli.damage.paper import import_dip, import_dog
+    from decoy_cli.modeling.paper_import import import_dip, import_dog
 
     dip, _ = import_dip(PUBLISHED / "dip_best_model.pth")
     dog, _ = import_dog(PUBLISHED / "dog_best_model.pth")

@@ -21,7 +21,7 @@ from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model, model_roles
 from decoy_cli.damage.combat import LearnedDamage
 from decoy_cli.damage.model_maps import dip_of, map_warnings
-from decoy_cli.damage.rules_model import RULES_FILE, RulesDamage
+from decoy_cli.damage.rules_damage import RULES_FILE, RulesDamage
 
 ROOT = Path(__file__).resolve().parents[1]
 WIDE = {"COLUMNS": "240"}

@@ -19,8 +19,10 @@ from decoy_cli.damage.model_folder import (
     save_dip,
     save_dog,
 )
-from decoy_cli.damage.networks import DipNet, DogLossWeights, DogNet, DogOutput, dog_loss, tensors
+from decoy_cli.damage.networks import DipNet, DogNet, DogOutput, tensors
 from decoy_cli.errors import ModelError
+from decoy_cli.modeling.losses import dog_loss
+from decoy_cli.modeling.train_options import DogLossWeights
 
 
 def random_features(k: int, seed: int = 0) -> Features:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from studies import study
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.features import WEAPONS as MODEL_WEAPONS
@@ -17,7 +18,6 @@ from decoy_cli.damage.rules import (
     implied_base_damage,
     shot_damage,
 )
-from decoy_cli.damage.rules_check import check_rules
 from decoy_cli.esta import read_match
 
 EVENTS = (
@@ -86,7 +86,7 @@ def test_unknown_weapons_and_groups_are_named() -> None:
 @pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
 def test_the_checked_weapons_explain_the_real_hits() -> None:
     damages = pd.concat([r.damages for r in read_match(EVENTS).rounds], ignore_index=True)
-    table, left_out = check_rules(damages)
+    table, left_out = study("_damage_rules").check_rules(damages)
     assert left_out["grenade, fire or bomb"] > 0  # the reason the samples count it under
     for row in table.itertuples():
         # each weapon the real hits test is marked checked, and its hits cluster just below

@@ -1,4 +1,4 @@
-"""Training samples of the damage models (decoy_cli/damage/samples.py), checked by hand on the
+"""Training samples of the damage models (decoy_cli/modeling/samples.py), checked by hand on the
 generated ESTA fixture (tests/esta_fixtures.py), plus the split, the balancing and the flash
 events the reader gained for the events-only mode."""
 
@@ -23,7 +23,9 @@ from esta_fixtures import (
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.damage.features import FeatureSpec, map_index
-from decoy_cli.damage.filled_views import (
+from decoy_cli.errors import DecoyError
+from decoy_cli.esta import Round, read_match
+from decoy_cli.modeling.filled_views import (
     ATTACKER_DEVIATION_DEG,
     FILLED_NOTE,
     QUANTILES,
@@ -31,15 +33,13 @@ from decoy_cli.damage.filled_views import (
     filled_views,
     hit_view_deviations,
 )
-from decoy_cli.damage.samples import (
+from decoy_cli.modeling.samples import (
     Samples,
     SampleStats,
     balance,
     build_samples,
     split_samples,
 )
-from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Round, read_match
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 EVENTS = DATA / "esta_dust2_events"
@@ -413,7 +413,7 @@ def test_a_round_whose_samples_fail_is_recorded(
 ) -> None:
     """A round whose sample building raises is one failure (a bug: "internal error", named
     with where it was raised), its counts are left out, and the other rounds are used."""
-    import decoy_cli.damage.samples as module
+    import decoy_cli.modeling.samples as module
 
     real = module.frame_samples
 

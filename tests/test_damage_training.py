@@ -1,4 +1,4 @@
-"""Training DIP and DOG (decoy_cli/damage/training.py) on small generated datasets with a
+"""Training DIP and DOG (decoy_cli/modeling/training.py) on small generated datasets with a
 planted signal: the models must learn it, deterministically under a seed, keeping the best
 epoch."""
 
@@ -9,13 +9,14 @@ import pytest
 import torch
 import torch.nn.functional as F
 
-from decoy_cli.damage.evaluation import dip_probabilities, evaluate_dog
 from decoy_cli.damage.features import FeatureSpec
 from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
 from decoy_cli.damage.networks import tensors
-from decoy_cli.damage.samples import Samples, split_samples
-from decoy_cli.damage.scores import roc_auc
-from decoy_cli.damage.training import (
+from decoy_cli.errors import DecoyError
+from decoy_cli.modeling.network_evaluation import dip_probabilities, evaluate_dog
+from decoy_cli.modeling.samples import Samples, split_samples
+from decoy_cli.modeling.scores import roc_auc
+from decoy_cli.modeling.training import (
     TrainOptions,
     dip_parts,
     fit_dip,
@@ -23,7 +24,6 @@ from decoy_cli.damage.training import (
     train_dip,
     train_dog,
 )
-from decoy_cli.errors import DecoyError
 
 SPEC = FeatureSpec()
 

@@ -15,11 +15,11 @@ from test_damage_import import PUBLISHED, random_state, write_paper_folder
 from test_download import Site, _handler
 from typer.testing import CliRunner
 
-import decoy_cli.damage.download_paper as download_paper
+import decoy_cli.modeling.paper_download as download_paper
 from decoy_cli.cli import app
-from decoy_cli.damage.download_paper import PAPER_FILES, PaperFile
 from decoy_cli.damage.model_folder import load_dip, load_dog
 from decoy_cli.damage.networks import DipNet, DogNet
+from decoy_cli.modeling.paper_download import PAPER_FILES, PaperFile
 
 runner = CliRunner()
 WIDE = {"COLUMNS": "200"}

@@ -1,4 +1,4 @@
-"""The fight's operating point (decoy_cli/evaluate/fight_threshold.py, `decoy models
+"""The fight's operating point (decoy_cli/modeling/fight_threshold.py, `decoy models
 fight-threshold`): the pairs of a hand-made round of both teams, the choice by hand, the command
 end to end, and the shipped choice on the shared real rounds."""
 
@@ -19,7 +19,7 @@ from decoy_cli.cli import app
 from decoy_cli.damage.combat import DipDecision
 from decoy_cli.damage.model_folder import load_dip, save_dip
 from decoy_cli.esta import read_match
-from decoy_cli.evaluate.fight_threshold import choose_fight_threshold, fight_pairs
+from decoy_cli.modeling.fight_threshold import choose_fight_threshold, fight_pairs
 from decoy_cli.waypoints.build import builtin_graph
 
 runner = CliRunner()
@@ -96,8 +96,8 @@ def test_recall_is_held_on_the_steps_dip_did_not_train_on() -> None:
 
     from test_damage_samples import synthetic
 
-    from decoy_cli.damage.provenance import seen_in
-    from decoy_cli.evaluate.fight_threshold import _damaging_by_map
+    from decoy_cli.modeling.fight_threshold import _damaging_by_map
+    from decoy_cli.modeling.provenance import seen_in
 
     base = synthetic(groups=6, per_group=2, matches=1)
     maps = np.array(["de_a"] * 8 + ["de_b"] * 4, dtype=object)

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from decoy_cli.cli import app
 from decoy_cli.damage import load_damage_model
 from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS
-from decoy_cli.damage.rules_model import RulesDamage
+from decoy_cli.damage.rules_damage import RulesDamage
 from decoy_cli.errors import ModelError
 
 runner = CliRunner()
@@ -60,8 +60,8 @@ def test_a_step_another_attacker_ends_counts_as_cut_short(tmp_path: Path) -> Non
     lands the rest (70 HP, on a hurt victim: censored too)."""
     from esta_fixtures import _damage, make_match, write_match
 
-    from decoy_cli.damage.rules_model import fit_rules
     from decoy_cli.esta import read_match
+    from decoy_cli.modeling.rules_fit import fit_rules
 
     match = make_match()
     match["gameRounds"][1]["damages"] = [
@@ -83,8 +83,8 @@ def test_damage_without_a_tick_ends_no_step(tmp_path: Path) -> None:
     takes t1's other 73 HP."""
     from esta_fixtures import _damage, make_match, write_match
 
-    from decoy_cli.damage.rules_model import fit_rules
     from decoy_cli.esta import read_match
+    from decoy_cli.modeling.rules_fit import fit_rules
 
     match = make_match()
     no_tick = _damage(5075, None, "t1", "World", 73) | {"tick": None}

@@ -8,10 +8,10 @@ from types import SimpleNamespace
 import numpy as np
 import pandas as pd
 import pytest
+from studies import study
 
 from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import shot_damage
-from decoy_cli.damage.rules_evaluation import _victim_state, evaluate_rules
 from decoy_cli.esta import read_match
 
 EVENTS = (
@@ -21,6 +21,9 @@ EVENTS = (
     / "esta_dust2_events"
     / "og-navi-blast2020-r01-18.json.xz"
 )
+RULES = study("_damage_rules")
+evaluate_rules = RULES.evaluate_rules
+_victim_state = RULES._victim_state
 PLANTED = np.array([0.2, 0.0, 0.5, 0.15, 0.1, 0.05])
 
 
@@ -134,18 +137,18 @@ def test_what_a_real_hit_says_of_the_victims_armour() -> None:
 @pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
 def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
     from decoy_cli.damage import SHIPPED_MODELS
-    from decoy_cli.damage.fold_comparison import FOLDS, CvaeTraining, compare_on_folds
     from decoy_cli.damage.model_folder import load_dog
-    from decoy_cli.damage.samples import build_samples
-    from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
+    from decoy_cli.modeling.samples import build_samples
+    from decoy_cli.modeling.train_options import DogLossWeights, TrainOptions
 
+    folds = study("_damage_folds")
     samples, _ = build_samples([EVENTS])
-    quick = CvaeTraining(
+    quick = folds.CvaeTraining(
         TrainOptions(epochs=3, batch_size=32, patience=2),
         DogLossWeights(),
         load_dog(SHIPPED_MODELS).spec,
     )
-    rules, cvae, shipped = compare_on_folds(
+    rules, cvae, shipped = folds.compare_on_folds(
         read_match(EVENTS).rounds,
         samples,
         {"shipped": SHIPPED_MODELS},
@@ -157,7 +160,7 @@ def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
     assert cvae.name == "project CVAE (trained per fold)"
     for scores in (rules, cvae, shipped):
         assert scores.cells > 0 and np.isfinite(scores.mean_wasserstein_hp)
-        assert len(scores.fold_means) == FOLDS
+        assert len(scores.fold_means) == folds.FOLDS
         assert set(scores.group_tv) == {"AK-47", "M4A4", "USP-S"}
         assert 0 <= scores.mean_floor_hp < scores.mean_wasserstein_hp
     # the game's rules beat the DOG trained on most of these very rounds
@@ -165,7 +168,7 @@ def test_models_on_the_same_folds_of_real_damaging_steps() -> None:
 
 
 def test_hit_group_tv_on_hand_cases() -> None:
-    from decoy_cli.damage.scores import hit_group_tv
+    from decoy_cli.modeling.scores import hit_group_tv
 
     weapons = np.array(["AK-47"] * 40 + ["AWP"] * 5, dtype=object)
     real = np.array([0] * 20 + [2] * 20 + [2] * 5)
@@ -177,10 +180,10 @@ def test_hit_group_tv_on_hand_cases() -> None:
 
 @pytest.mark.skipif(not EVENTS.is_file(), reason="needs ../shared/data/esta_dust2_events")
 def test_the_rules_of_each_fold_never_see_its_test_rounds(monkeypatch: pytest.MonkeyPatch) -> None:
-    import decoy_cli.damage.fold_comparison as comparison
-    from decoy_cli.damage.damage_rows import group_id
-    from decoy_cli.damage.samples import build_samples
+    from decoy_cli.modeling.damage_rows import group_id
+    from decoy_cli.modeling.samples import build_samples
 
+    comparison = study("_damage_folds")
     seen: list[set[str]] = []
     real_fit = comparison.fit_rules
 

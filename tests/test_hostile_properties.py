@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 from decoy_cli.cli import app
 from decoy_cli.damage.calibration import CALIBRATION_FILE
 from decoy_cli.damage.model_folder import load_calibration, load_dip
-from decoy_cli.damage.rules_model import RULES_FILE, RulesFile
+from decoy_cli.damage.rules_damage import RULES_FILE, RulesFile
 from decoy_cli.errors import DecoyError, ModelError
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.run_tables import (

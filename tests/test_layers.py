@@ -33,6 +33,7 @@ LAYERS = {
     "env": 5,
     "view": 5,  # the view page: reads what replay and evaluate write
     "evaluate": 6,
+    "modeling": 6,  # the model tooling of `decoy train` and `decoy models`: above damage
     "bench": 6,
     "rl": 6,
     "commands": 7,

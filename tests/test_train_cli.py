@@ -145,7 +145,7 @@ def test_evaluate_with_an_unreadable_file_fails_after_writing(
     reason="../shared/data/decoy_checkpoints (the paper's weights) is absent",
 )
 def test_evaluate_the_paper_models(data: Path, tmp_path: Path) -> None:
-    from decoy_cli.damage.paper import import_paper
+    from decoy_cli.modeling.paper_import import import_paper
 
     paper = import_paper(CHECKPOINTS, tmp_path / "paper").folder
     out = tmp_path / "evaluation"

@@ -142,7 +142,7 @@ def check_damage_model(choice: ModelChoice) -> ModelStatus:
         )
     if model is None:
         return ModelStatus(choice, False, "none: line of sight only, no inference")
-    from decoy_cli.damage.rules_model import RulesDamage
+    from decoy_cli.damage.rules_damage import RulesDamage
 
     outcome = "the game's damage rules" if isinstance(model, RulesDamage) else "DOG"
     return ModelStatus(choice, True, f"learned DIP + {outcome} ({choice})")

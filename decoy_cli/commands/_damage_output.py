@@ -21,13 +21,13 @@ from rich.progress import (
 from rich.table import Table
 
 from decoy_cli.commands._console import make_console
-from decoy_cli.damage.evaluation import PAPER_DIP, PAPER_DOG, DogMetrics
-from decoy_cli.damage.hp_lost import HpLostScores
-from decoy_cli.damage.sample_set import SampleStats
-from decoy_cli.damage.scores import CellRecord
+from decoy_cli.modeling.hp_lost import HpLostScores
+from decoy_cli.modeling.network_evaluation import PAPER_DIP, PAPER_DOG, DogMetrics
+from decoy_cli.modeling.sample_set import SampleStats
+from decoy_cli.modeling.scores import CellRecord
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.training import Progress as TrainingProgress
+    from decoy_cli.modeling.training import Progress as TrainingProgress
 
 DATA_HELP = "ESTA match files (.json.xz or .json) or folders of them."
 

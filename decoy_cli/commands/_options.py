@@ -16,16 +16,16 @@ import typer
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.damage import CHOICES_HELP, DEFAULT_MODELS
 from decoy_cli.damage.choice import MODELS_METAVAR, ModelName
-from decoy_cli.damage.provenance import SampleChoice
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode
-from decoy_cli.damage.split import (
+from decoy_cli.esta.plausibility import Implausible
+from decoy_cli.modeling.provenance import SampleChoice
+from decoy_cli.modeling.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode
+from decoy_cli.modeling.split import (
     DEFAULT_SEED,
     DEFAULT_SPLIT,
     DEFAULT_TEST_FRACTION,
     DEFAULT_VAL_FRACTION,
     SplitUnit,
 )
-from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplaySpec

@@ -1,5 +1,5 @@
 """`decoy models ...`: damage models (DIP and DOG). `import-decoy` imports the paper's,
-`evaluate` scores a model folder on ESTA data (decoy_cli/damage/folder_evaluation.py)."""
+`evaluate` scores a model folder on ESTA data (decoy_cli/modeling/folder_evaluation.py)."""
 
 from __future__ import annotations
 
@@ -25,15 +25,16 @@ from decoy_cli.commands._damage_output import (
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
-from decoy_cli.damage.calibration import MIN_RECALL, Calibration, CalibrationKind, Decision
+from decoy_cli.damage.calibration import Calibration, CalibrationKind, Decision
 from decoy_cli.damage.choice import MODELS_METAVAR
-from decoy_cli.damage.download_paper import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
-from decoy_cli.damage.evaluation import DRAWS
-from decoy_cli.damage.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
-from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import SplitPart
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import check_folder_writable
+from decoy_cli.modeling.calibration_fit import MIN_RECALL
+from decoy_cli.modeling.folder_evaluation import BALANCED, DEFAULT_SUBSET, evaluate_model_folder
+from decoy_cli.modeling.network_evaluation import DRAWS
+from decoy_cli.modeling.paper_download import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
+from decoy_cli.modeling.scores import MIN_CELL
+from decoy_cli.modeling.split import SplitPart
 
 DEFAULT_IMPORT_OUT = PAPER_FOLDER
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
@@ -61,7 +62,7 @@ def import_decoy(
     from the paper's order (Head, Neck, Stomach, Chest, Arm, Leg) to the project's (Head, Neck,
     Chest, Stomach, Arm, Leg). Features are the paper's raw Hammer units; DIP threshold 0.444.
     """
-    from decoy_cli.damage.paper import import_paper
+    from decoy_cli.modeling.paper_import import import_paper
 
     check_folder_writable(out)  # before the checkpoints are read and converted
     result = import_paper(path, out)
@@ -97,8 +98,8 @@ def download_decoy(
     """Download the DECOY paper's published DIP and DOG (HATS-ICT/decoy at a fixed commit),
     check every file's SHA-256, and import them into a model folder for --models (as
     import-decoy does). The downloaded files are kept in OUT/checkpoints."""
-    from decoy_cli.damage.download_paper import download_paper_files
-    from decoy_cli.damage.paper import import_paper
+    from decoy_cli.modeling.paper_download import download_paper_files
+    from decoy_cli.modeling.paper_import import import_paper
 
     check_folder_writable(out)
     files = download_paper_files(out / "checkpoints", base_url, timeout)
@@ -120,8 +121,8 @@ def fit_rules_command(
     weapon and distance; how many land in one 0.5 s step, by weapon) and write rules.json
     into a folder that holds a DIP and no DOG: `--models FOLDER` then damages by the game's
     rules. (A folder with a DOG keeps damaging by its DOG: copy its dip.* to a new folder.)"""
-    from decoy_cli.damage.rules_model import fit_rules
     from decoy_cli.esta import collect_match_files, read_match
+    from decoy_cli.modeling.rules_fit import fit_rules
 
     if not (model_folder / "dip.json").is_file():
         raise DecoyError(f"{model_folder}: holds no dip.json to pair the rules with")
@@ -171,9 +172,9 @@ def fight_threshold_command(
     DIP still calls --min-recall of every map's real damaging steps hits (those it did not
     train on, where the map has any). Written as the
     folder's dip_calibration.json (kind none); prints every candidate and the choice on each
-    half of the rounds (decoy_cli/evaluate/fight_threshold.py)."""
+    half of the rounds (decoy_cli/modeling/fight_threshold.py)."""
     from decoy_cli.damage.model_folder import load_dip, save_calibration
-    from decoy_cli.evaluate.fight_threshold import choose_for_files
+    from decoy_cli.modeling.fight_threshold import choose_for_files
     from decoy_cli.waypoints.build import builtin_graph
 
     if not (model_folder / "dip.json").is_file():
@@ -235,7 +236,7 @@ def calibrate(
     scaling) and write dip_calibration.json into the folder; prints the Brier score and the
     expected calibration error before and after on the validation and test parts (the same
     split options as training give the same parts)."""
-    from decoy_cli.damage.folder_calibration import calibrate_dip_folder
+    from decoy_cli.modeling.folder_calibration import calibrate_dip_folder
 
     if (model_folder / "dip.json").is_file():
         check_folder_writable(model_folder)

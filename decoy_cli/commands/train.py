@@ -1,6 +1,6 @@
 """`decoy train dip|dog DATA...`: train the damage models on ESTA data.
 
-Parses the options, runs one training (decoy_cli/damage/training_run.py: read the samples,
+Parses the options, runs one training (decoy_cli/modeling/training_run.py: read the samples,
 split them by match or round, train with early stopping, evaluate on the test part, write the
 model folder and the report) and prints what it gave.
 """
@@ -28,10 +28,11 @@ from decoy_cli.commands._damage_output import (
 from decoy_cli.commands._groups import with_groups
 from decoy_cli.commands._options import SampleOptions
 from decoy_cli.damage.calibration import CALIBRATION_FILE
-from decoy_cli.damage.evaluation import DRAWS
-from decoy_cli.damage.provenance import SampleChoice
-from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.train_options import (
+from decoy_cli.files import check_folder_writable
+from decoy_cli.modeling.network_evaluation import DRAWS
+from decoy_cli.modeling.provenance import SampleChoice
+from decoy_cli.modeling.scores import MIN_CELL
+from decoy_cli.modeling.train_options import (
     BATCH_SIZE,
     DAMAGE_WEIGHT,
     DEFAULT_BALANCE,
@@ -47,8 +48,7 @@ from decoy_cli.damage.train_options import (
     DogLossWeights,
     TrainOptions,
 )
-from decoy_cli.damage.training_run import TrainingResult, train_dip_model, train_dog_model
-from decoy_cli.files import check_folder_writable
+from decoy_cli.modeling.training_run import TrainingResult, train_dip_model, train_dog_model
 
 DEFAULT_OUT = Path("decoy-out") / "models" / "trained"
 

@@ -1,22 +1,17 @@
-"""Learned damage models, DIP and DOG (the paper's combat), with torch imported lazily.
+"""The damage models the simulator loads (`--models`), with torch imported lazily: what run time
+needs and nothing of the tooling that makes the models (decoy_cli/modeling/).
 
 * choice.py: the `--models` choice (`ModelName`, `ModelFolder`, `parse_models`);
 * features.py: the model inputs, built in one place for training and simulation (numpy only);
-* networks.py: DipNet and DogNet (torch);
+* networks.py: DipNet and DogNet (torch), without their losses;
 * model_folder.py: the saved-model format (a folder of dip/dog .pt + .json);
 * model_maps.py: the maps a model knows, the DIP of a choice, and the warnings;
-* paper.py, download_paper.py: import of the paper's published checkpoints, and their download;
+* calibration.py: DIP's calibration as the fight applies it (`dip_calibration.json`);
 * combat.py: `DipDecision` (who hits) and `LearnedDamage`, the simulator's `DamageModel` over a
   DIP and a DOG;
-* rules.py, rules_check.py: CS:GO's damage rules and their check against real hits;
-  hit_groups.py, rules_model.py: `RulesDamage`, the DIP with damage by the rules (`rules.json`);
-  rules_evaluation.py, fold_comparison.py: the models on leave-rounds-out folds of real hits;
-* calibration.py, folder_calibration.py: how calibrated DIP is, and its recalibration;
-* samples.py: training samples from ESTA rounds (with sample_set.py, damage_rows.py,
-  frames_mode.py, events_mode.py, split.py);
-* train_options.py, training.py, training_run.py, provenance.py: training a model and writing
-  it with where it came from;
-* scores.py, evaluation.py, evaluation_figures.py, folder_evaluation.py: scoring a model.
+* rules.py: CS:GO's damage rules (damage per bullet by weapon, hit group, range and armour);
+  hit_groups.py, bullet_counts.py, rules_damage.py: `RulesDamage`, the DIP with damage by the
+  rules and the learned parts of a folder's `rules.json`.
 
 Importing this package does not import torch; `load_damage_model` does, when it loads a model.
 """
@@ -89,7 +84,7 @@ def resolve_models(choice: ModelChoice) -> Path:
 def damages_by_rules(choice: ModelChoice, folder: Path) -> bool:
     """True when the choice's damage comes from the game's rules (`rules.json`), False when
     from the folder's DOG: "rules", or a folder with a rules.json and no DOG."""
-    from decoy_cli.damage.rules_model import RULES_FILE
+    from decoy_cli.damage.rules_damage import RULES_FILE
 
     return choice == ModelName.RULES or (
         # exists, not is_file: a rules.json that is no regular file is refused when loaded
@@ -131,7 +126,7 @@ def load_damage_model(choice: ModelChoice | str) -> DamageModel | None:
     folder = resolve_models(choice)
     from decoy_cli.damage.combat import LearnedDamage
     from decoy_cli.damage.model_folder import load_dip, load_dog
-    from decoy_cli.damage.rules_model import RulesDamage, RulesFile
+    from decoy_cli.damage.rules_damage import RulesDamage, RulesFile
 
     if damages_by_rules(choice, folder):
         return RulesDamage(load_dip(folder), RulesFile.load(folder))

@@ -1,5 +1,5 @@
 """How many bullets of one pair land in one damaging 0.5 s step: `BulletCounts`, learned from
-real steps (`rules_model.fit_rules`).
+real steps (`decoy_cli.modeling.rules_fit.fit_rules`).
 
 Steps are counted by the bullets that landed, at four levels, each pulled toward the one above
 with `PRIOR_STEPS` pseudo-steps: all steps, the weapon's class, the weapon, and the weapon at

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from decoy_cli.damage.rules import rule_group, shot_damage
+from decoy_cli.damage.rules import rule_group
 from decoy_cli.sim.combat import HIT_GROUPS
 from decoy_cli.weapons import WEAPONS
 
@@ -150,51 +150,3 @@ class HitGroupModel:
     def from_json(cls, text: str) -> HitGroupModel:
         """`from_dict` of JSON text."""
         return cls.from_dict(json.loads(text))
-
-
-HP_LOST_SPREAD = 0.15
-"""Relative spread of a hit's HP lost around what the rules give for its group when no group
-gives it exactly (the rules know neither the armour left nor a shot through thin cover, and a
-map's version may deal a little less; chosen a priori)."""
-
-MAX_MISS_SPREADS = 3.0
-"""A non-lethal hit further than this many spreads from every group's rule damage is left
-unexplained (a shot through something; chosen a priori)."""
-
-
-def group_posterior(
-    prior: HitGroupModel,
-    weapon: str,
-    distance_u: float,
-    hp_lost: float,
-    hp_before: float,
-    armored: bool,
-) -> np.ndarray | None:
-    """(6,) P(group | a hit's HP lost) for a hit whose data records no hit group: the prior's
-    P(group | weapon, distance) times the likelihood of the HP lost under each group's rule
-    damage (decoy_cli/damage/rules.py). A hit that killed lost the victim's HP: any group the
-    rules give at least that much explains it. A hit that left the victim alive is explained
-    by the groups the rules give within 1 HP; when none does, by how close each comes (a normal
-    of `HP_LOST_SPREAD` relative width, up to `MAX_MISS_SPREADS`): keeping only exact matches
-    kept the kills, which any head shot explains, and dropped body hits the rules miss by a few
-    HP, leaning the groups toward the head. None when no group explains it."""
-    value = np.array(
-        [
-            shot_damage(
-                weapon, name, distance_u, armor=100 if armored else 0, helmet=armored
-            ).health
-            for name in GROUPS
-        ],
-        dtype=np.float64,
-    )
-    if hp_lost >= hp_before - 0.5:  # killed
-        likelihood = (value >= hp_lost - 0.5).astype(np.float64)
-    elif (np.abs(value - hp_lost) <= 1.0).any():
-        likelihood = (np.abs(value - hp_lost) <= 1.0).astype(np.float64)
-    else:
-        z = (value - hp_lost) / np.maximum(1.0, HP_LOST_SPREAD * value)
-        likelihood = np.where(np.abs(z) <= MAX_MISS_SPREADS, np.exp(-0.5 * z * z), 0.0)
-    weights = prior.probabilities(weapon, distance_u) * likelihood
-    if weights.sum() <= 0:
-        return None
-    return weights / weights.sum()

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from decoy_cli.damage.choice import ModelChoice, ModelName
-from decoy_cli.damage.rules_model import RULES_FILE
+from decoy_cli.damage.rules_damage import RULES_FILE
 from decoy_cli.errors import DecoyError
 from decoy_cli.reading import load_json
 

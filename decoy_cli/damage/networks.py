@@ -16,7 +16,7 @@ armor 2), concatenated to 128: DIP's branches have no BatchNorm, DOG's have.
 
 Layer names and shapes are those of the published checkpoints (HATS-ICT/decoy), so their state
 dicts load as they are, except that their hit-group order is Head, Neck, Stomach, Chest, Arm,
-Leg: decoy_cli/damage/paper.py permutes those rows and columns on import.
+Leg: decoy_cli/modeling/paper_import.py permutes those rows and columns on import.
 """
 
 from __future__ import annotations
@@ -26,11 +26,9 @@ from itertools import pairwise
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 from torch import Tensor, nn
 
 from decoy_cli.damage.features import COORDS, HIT_GROUPS, MAPS, WEAPONS, Features
-from decoy_cli.damage.train_options import DogLossWeights
 
 BRANCH_WIDTH = 32
 CONDITION_WIDTH = 4 * BRANCH_WIDTH
@@ -187,25 +185,6 @@ class DogNet(nn.Module):
         z = torch.randn((len(condition), LATENT), generator=generator, dtype=condition.dtype)
         damage, hit_logits = self.vae_decoder(z, condition)
         return 100.0 * damage.squeeze(1), hit_logits
-
-
-def dog_loss(
-    output: DogOutput, damage: Tensor, hit_group_index: Tensor, weights: DogLossWeights
-) -> tuple[Tensor, dict[str, float]]:
-    """Weighted sum of the damage MSE (HP / 100, `damage` (K, 1)), the hit-group cross-entropy
-    (`hit_group_index` (K,) int64 in HIT_GROUPS order) and the KL divergence of the posterior
-    from N(0, I) (summed over the latent, averaged over the batch); also each term as a float."""
-    mse = F.mse_loss(output.damage, damage)
-    cross_entropy = F.cross_entropy(output.hit_logits, hit_group_index)
-    kl = (-0.5 * (1 + output.logvar - output.mu.pow(2) - output.logvar.exp()).sum(1)).mean()
-    total = weights.damage * mse + weights.hit_group * cross_entropy + weights.kl * kl
-    parts = {
-        "total": float(total.detach()),
-        "damage": float(mse.detach()),
-        "hit_group": float(cross_entropy.detach()),
-        "kl": float(kl.detach()),
-    }
-    return total, parts
 
 
 def tensors(features: Features) -> tuple[Tensor, Tensor, Tensor, Tensor]:

@@ -17,8 +17,9 @@ Sources:
 * weapon values (`WEAPON_RULES`): the weapon attributes of CS:GO's `items_game.txt` ("damage",
   "armor ratio", "range modifier", "bullets"; "headshot multiplier" 4 unless the weapon sets it)
   of the 2020 game version, the version of the real events in `../shared/data`; each value is
-  checked against those events by `implied_base_damage` (`python benchmarks/damage_rules_check.py
-  DATA` prints the check; the README gives its result). `checked` says which ones were;
+  checked against those events by `implied_base_damage` (`python
+  benchmarks/studies/damage_rules_check.py DATA` prints the check; docs/damage-models.md gives
+  its result). `checked` says which ones were;
 * hit-group multipliers and the armour rule: CS:GO's `CCSPlayer::TraceAttack` and
   `CCSPlayer::OnTakeDamage` (head ×4 by the weapon's multiplier, stomach ×1.25, legs ×0.75,
   chest, arms and neck ×1; armour bonus ratio 0.5), confirmed by the same events (an AK-47 chest

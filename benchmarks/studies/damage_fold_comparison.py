@@ -1,5 +1,5 @@
 """Damage outcome models on the same leave-rounds-out folds of real damaging steps:
-python benchmarks/damage_fold_comparison.py [EVENTS...] [--paper CHECKPOINTS] [--seed N]
+python benchmarks/studies/damage_fold_comparison.py [EVENTS...] [--paper CHECKPOINTS] [--seed N]
 
 The rules-grounded model (its parts fitted per fold), the paper's DOG (imported from its
 published checkpoints, trained on other matches) and the shipped DOG (its label says how many
@@ -16,16 +16,16 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from _damage_folds import CvaeTraining, compare_on_folds, training_overlap
 
 from decoy_cli.damage import SHIPPED_MODELS
-from decoy_cli.damage.fold_comparison import CvaeTraining, compare_on_folds, training_overlap
 from decoy_cli.damage.model_folder import load_dog
-from decoy_cli.damage.paper import import_paper
-from decoy_cli.damage.samples import build_samples
-from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import collect_match_files, read_match
+from decoy_cli.modeling.paper_import import import_paper
+from decoy_cli.modeling.samples import build_samples
+from decoy_cli.modeling.train_options import DogLossWeights, TrainOptions
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+SHARED = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
 
 def main() -> None:

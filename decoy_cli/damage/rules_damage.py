@@ -16,9 +16,10 @@ Per combat step, over every visible ordered pair at once:
    the bullet that did the most.
 
 The learned parts (`RulesFile`: hit groups, bullet counts, penetration) live in a model folder's
-`rules.json` beside the DIP (`decoy models fit-rules`). Only an attacker with a firearm of the
-models' vocabulary hits (`DipDecision`), as with the learned DOG; the rule table covers exactly
-that vocabulary (a test checks), so a knife, grenade, Zeus or C4 never hits here.
+`rules.json` beside the DIP (`decoy models fit-rules`: decoy_cli/modeling/rules_fit.py). Only an
+attacker with a firearm of the models' vocabulary hits (`DipDecision`), as with the learned DOG;
+the rule table covers exactly that vocabulary (a test checks), so a knife, grenade, Zeus or C4
+never hits here.
 """
 
 from __future__ import annotations
@@ -31,17 +32,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.damage.bullet_counts import ALL, BulletCounts
-from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel, group_posterior
+from decoy_cli.damage.bullet_counts import BulletCounts
+from decoy_cli.damage.hit_groups import GROUPS, HitGroupModel
 from decoy_cli.damage.rules import rule_group, shot_damage
 from decoy_cli.errors import ModelError
-from decoy_cli.esta import Round
 from decoy_cli.files import write_json
 from decoy_cli.reading import load_json
 from decoy_cli.sim.combat import NO_HIT, CombatBatch, DamageResult
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.damage_rows import DamageRows
     from decoy_cli.damage.model_folder import LoadedDip
 
 RULES_FILE = "rules.json"
@@ -52,7 +51,7 @@ FULL_HP = 100
 PENETRATED_BELOW = 0.9
 """A real hit whose health damage is below this share of the least the rules give at its range
 and hit group (armour and helmet on) went through something first (measured on the real hits:
-`benchmarks/damage_rules_check.py` finds the rules exact on nearly all others)."""
+`benchmarks/studies/damage_rules_check.py` finds the rules exact on nearly all others)."""
 
 
 @dataclass
@@ -149,95 +148,6 @@ class RulesFile:
         return cls(hit_groups, bullets, provenance, penetration, bullets_hurt)
 
 
-def fit_rules(rounds: Sequence[Round]) -> RulesFile:
-    """Learn the hit groups, the penetration and the bullets per step from the rounds' firearm
-    hits: the damage rows the DOG's samples use (`damage_rows`). Bullets are counted per
-    (attacker, victim) and virtual 2 Hz step exactly as the events mode aggregates them, so a
-    step here is a sample's step, from every hit (also those whose data records only the HP
-    lost); hit groups and penetration from the hits whose raw damage and hit group are known."""
-    from decoy_cli.damage.damage_rows import aggregate, damage_rows, step_clock
-    from decoy_cli.damage.sample_set import SampleStats
-
-    stats = SampleStats()
-    weapons: list[str] = []
-    distances: list[float] = []
-    groups: list[str] = []
-    health: list[float] = []
-    bullets, bullets_hurt = BulletCounts(censored=True), BulletCounts(censored=True)
-    unknown: list[tuple[str, float, float, float, bool]] = []
-    used_rounds = 0
-    maps: set[str] = set()
-    for round_ in rounds:
-        rows = damage_rows(round_, stats)
-        distance = round_.damages["distance"].to_numpy(np.float64, na_value=np.nan)
-        usable = rows.usable & np.isfinite(distance)
-        if not usable.any():
-            continue
-        used_rounds += 1
-        maps.add(round_.map_name)
-        known = np.flatnonzero(usable & rows.outcome_known)
-        unknown += _hp_lost_hits(round_, rows, usable & ~rows.outcome_known, distance)
-        table = round_.damages.iloc[known]
-        weapons += [str(w) for w in table["weapon"]]
-        distances += [float(d) for d in table["distance"]]
-        groups += [str(g) for g in table["hitGroup"]]
-        health += [float(h) for h in table["hpDamage"]]
-        origin, step_ticks = step_clock(round_)
-        # a row without a tick (never usable) says nothing of when its HP was lost: no step
-        step = np.where(np.isfinite(rows.tick), np.rint((rows.tick - origin) / step_ticks), np.inf)
-        steps = aggregate(step, rows.attacker, rows.victim, rows, np.flatnonzero(usable))
-        for (at, _, _), hit in steps.items():
-            victim = rows.victim == rows.victim[hit.first]
-            lost = float(rows.hp_taken[victim & (rows.tick < rows.tick[hit.first])].sum())
-            # died in the step, by this attacker's bullets or another's: its count was cut short
-            killed = float(rows.hp_taken[victim & (step <= at)].sum()) >= FULL_HP - 0.5
-            counts = bullets_hurt if lost > 0 else bullets
-            counts.add(str(rows.weapon[hit.first]), float(distance[hit.first]), hit.hits, killed)
-    total = sum(sum(c.counts.get(ALL, [])) for c in (bullets, bullets_hurt))
-    if not total:
-        raise ModelError("no firearm hits between enemies in the data: nothing to learn from")
-    if not weapons:
-        raise ModelError(
-            "no firearm hit in the data records its hit group and raw damage: the hit groups "
-            "and penetration cannot be learned"
-        )
-    model = HitGroupModel.fit(weapons, distances, groups)
-    prior = HitGroupModel.from_dict(model.to_dict())
-    explained = 0
-    for weapon, distance, lost, before, armored in unknown:
-        weights = group_posterior(prior, weapon, distance, lost, before, armored)
-        if weights is not None:
-            model.add(weapon, distance, weights)
-            explained += 1
-    penetration = Penetration.learn(weapons, groups, distances, health)
-    provenance = {
-        "hits": len(weapons),
-        "hits_by_hp_lost": explained,
-        "hits_unexplained": len(unknown) - explained,
-        "steps": int(total),
-        "rounds": used_rounds,
-        "maps": sorted(maps),
-        "left_out": dict(stats.excluded),
-        "hp_lost_only": dict(stats.partial),
-    }
-    return RulesFile(model, bullets, provenance, penetration, bullets_hurt)
-
-
-def _hp_lost_hits(
-    round_: Round, rows: DamageRows, chosen: np.ndarray, distance: np.ndarray
-) -> list[tuple[str, float, float, float, bool]]:
-    """(weapon, distance, HP lost, victim's HP before, armour took part) of the `chosen` rows,
-    hits whose data records only the HP lost."""
-    out = []
-    for r in np.flatnonzero(chosen):
-        earlier = (rows.victim == rows.victim[r]) & (rows.tick < rows.tick[r])
-        before = 100.0 - float(rows.hp_taken[earlier].sum())
-        armored = bool(rows.armor_damage[r] > 0)
-        lost = float(rows.hp_taken[r])
-        out.append((str(rows.weapon[r]), float(distance[r]), lost, before, armored))
-    return out
-
-
 def pair_outcome(
     rules: RulesFile,
     weapon: str,
@@ -263,39 +173,6 @@ def pair_outcome(
         if done > largest:
             largest, largest_group = done, name
     return health, taken, largest_group
-
-
-def rules_generate(
-    rules: RulesFile,
-    weapons: Sequence[str],
-    distances_m: np.ndarray,
-    armor: np.ndarray,
-    helmet: np.ndarray,
-    victim_hp: np.ndarray,
-    seed: int,
-    draws: int,
-) -> tuple[np.ndarray, np.ndarray]:
-    """`draws` outcomes of K damaging pair-steps (victims with `victim_hp` at its start), as
-    the DOG's generative mode gives them:
-    (draws, K) damage in HP (summed, in [1, 100]) and hit-group codes. A weapon the rules lack
-    raises `UnknownWeaponError`."""
-    draw = np.random.default_rng(seed)
-    damage = np.zeros((draws, len(weapons)))
-    group = np.zeros((draws, len(weapons)), dtype=np.int64)
-    for d in range(draws):
-        for k, weapon in enumerate(weapons):
-            health, _, name = pair_outcome(
-                rules,
-                weapon,
-                float(distances_m[k]) / HAMMER_TO_M,
-                int(armor[k]),
-                bool(helmet[k]),
-                draw,
-                int(victim_hp[k]),
-            )
-            damage[d, k] = min(max(health, 1), 100)
-            group[d, k] = GROUPS.index(name)
-    return damage, group
 
 
 class RulesDamage:

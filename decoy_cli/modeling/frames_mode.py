@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from decoy_cli.damage.damage_rows import VOCABULARY, aggregate, damage_rows, group_id
-from decoy_cli.damage.sample_set import Samples, SampleStats
 from decoy_cli.esta import Round
+from decoy_cli.modeling.damage_rows import VOCABULARY, aggregate, damage_rows, group_id
+from decoy_cli.modeling.sample_set import Samples, SampleStats
 from decoy_cli.sim.combat import NO_HIT
 
 

@@ -14,9 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli import __version__, files
-from decoy_cli.damage.sample_set import Samples, SampleStats
-from decoy_cli.damage.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode, build_samples
-from decoy_cli.damage.split import (
+from decoy_cli.files import JsonObject, object_at
+from decoy_cli.modeling.sample_set import Samples, SampleStats
+from decoy_cli.modeling.samples import DEFAULT_MODE, DEFAULT_WINDOW_S, SampleMode, build_samples
+from decoy_cli.modeling.split import (
     DEFAULT_SEED,
     DEFAULT_SPLIT,
     DEFAULT_TEST_FRACTION,
@@ -25,8 +26,7 @@ from decoy_cli.damage.split import (
     SplitUnit,
     split_samples,
 )
-from decoy_cli.damage.train_options import TrainOptions
-from decoy_cli.files import JsonObject, object_at
+from decoy_cli.modeling.train_options import TrainOptions
 
 FileCallback = Callable[[Path, int, int], None]
 """Called after each data file is read: (path, files done, files in all)."""

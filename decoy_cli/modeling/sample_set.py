@@ -2,7 +2,7 @@
 
 `Samples` holds K (attacker, victim, step) samples as parallel arrays; it turns them into the
 simulator's `CombatBatch` and into model inputs (`features`) in the one place that encoding
-happens for training and evaluation. How rounds become samples: decoy_cli/damage/samples.py.
+happens for training and evaluation. How rounds become samples: decoy_cli/modeling/samples.py.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from decoy_cli.esta import RoundFailure
 from decoy_cli.sim.combat import CombatBatch
 
 MAX_DAMAGE_HP = 100.0
-"""DOG's damage target is capped here (decoy_cli/damage/damage_rows.py says why)."""
+"""DOG's damage target is capped here (decoy_cli/modeling/damage_rows.py says why)."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -13,8 +13,8 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from decoy_cli.damage.sample_set import Samples
 from decoy_cli.errors import DecoyError
+from decoy_cli.modeling.sample_set import Samples
 
 SplitUnit = Literal["match", "round"]
 """What a split never cuts in two."""

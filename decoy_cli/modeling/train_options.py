@@ -14,8 +14,8 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Literal, get_args
 
-from decoy_cli.damage.split import DEFAULT_SEED
 from decoy_cli.errors import DecoyError
+from decoy_cli.modeling.split import DEFAULT_SEED
 
 DIP_EPOCHS = 20
 DOG_EPOCHS = 50
@@ -68,7 +68,7 @@ class TrainOptions:
 
 @dataclass(frozen=True, kw_only=True)
 class DogLossWeights:
-    """Weights of DOG's loss terms (`networks.dog_loss`); none may be negative."""
+    """Weights of DOG's loss terms (`losses.dog_loss`); none may be negative."""
 
     damage: float = DAMAGE_WEIGHT
     hit_group: float = HIT_GROUP_WEIGHT

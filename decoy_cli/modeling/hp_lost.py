@@ -10,25 +10,27 @@ group: it is marginalised over them. Beside each cell its sampling floor
 (`scores.sampling_floor`), and the mean drawn HP lost against the real.
 
 `draw_outcomes` is the one way a model's damage is drawn for samples: a DOG's generative mode or
-the rules-grounded model (`rules_model.rules_generate`).
+the rules-grounded model (`rules_generate`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
-from decoy_cli.damage.hit_groups import DISTANCE_BANDS_U
-from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.scores import MIN_CELL, CellRecord, keyed_cells, sampling_floor
+from decoy_cli.damage.hit_groups import DISTANCE_BANDS_U, GROUPS
+from decoy_cli.damage.rules_damage import pair_outcome
+from decoy_cli.modeling.sample_set import Samples
+from decoy_cli.modeling.scores import MIN_CELL, CellRecord, keyed_cells, sampling_floor
 
 if TYPE_CHECKING:
     from decoy_cli.damage.model_folder import LoadedDog
-    from decoy_cli.damage.rules_model import RulesFile
+    from decoy_cli.damage.rules_damage import RulesFile
 
 MIN_STEPS = MIN_CELL
 """Fewest real steps of a (weapon, distance band) cell in the mean (`scores.MIN_CELL`)."""
@@ -57,7 +59,7 @@ def draw_outcomes(
 ) -> tuple[np.ndarray, np.ndarray]:
     """`draws` outcomes of each damaging sample: (draws, K) damage in HP, in [1, 100], and
     hit-group codes, from a DOG or the rules."""
-    from decoy_cli.damage.rules_model import RulesFile, rules_generate
+    from decoy_cli.damage.rules_damage import RulesFile
 
     if isinstance(model, RulesFile):
         return rules_generate(
@@ -70,9 +72,42 @@ def draw_outcomes(
             seed,
             draws,
         )
-    from decoy_cli.damage.evaluation import dog_generate
+    from decoy_cli.modeling.network_evaluation import dog_generate
 
     return dog_generate(model, samples, seed, draws)
+
+
+def rules_generate(
+    rules: RulesFile,
+    weapons: Sequence[str],
+    distances_m: np.ndarray,
+    armor: np.ndarray,
+    helmet: np.ndarray,
+    victim_hp: np.ndarray,
+    seed: int,
+    draws: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`draws` outcomes of K damaging pair-steps (victims with `victim_hp` at its start), as
+    the DOG's generative mode gives them:
+    (draws, K) damage in HP (summed, in [1, 100]) and hit-group codes. A weapon the rules lack
+    raises `UnknownWeaponError`."""
+    draw = np.random.default_rng(seed)
+    damage = np.zeros((draws, len(weapons)))
+    group = np.zeros((draws, len(weapons)), dtype=np.int64)
+    for d in range(draws):
+        for k, weapon in enumerate(weapons):
+            health, _, name = pair_outcome(
+                rules,
+                weapon,
+                float(distances_m[k]) / HAMMER_TO_M,
+                int(armor[k]),
+                bool(helmet[k]),
+                draw,
+                int(victim_hp[k]),
+            )
+            damage[d, k] = min(max(health, 1), 100)
+            group[d, k] = GROUPS.index(name)
+    return damage, group
 
 
 def drawn_hp_lost(damage: np.ndarray, victim_hp: np.ndarray) -> np.ndarray:

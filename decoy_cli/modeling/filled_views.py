@@ -23,8 +23,8 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
-from decoy_cli.damage.sample_set import SampleStats
 from decoy_cli.esta import Round
+from decoy_cli.modeling.sample_set import SampleStats
 from decoy_cli.weapons import FIREARMS
 
 FILLED_WITHIN_DEG = 0.01

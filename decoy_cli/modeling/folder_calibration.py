@@ -13,17 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.calibration import (
-    Calibration,
-    CalibrationKind,
-    Decision,
-    calibration_scores,
-    fit_calibration,
-)
-from decoy_cli.damage.provenance import FileCallback, SampleChoice
-from decoy_cli.damage.sample_set import SampleStats
-from decoy_cli.damage.split import SplitPart
+from decoy_cli.damage.calibration import Calibration, CalibrationKind, Decision
 from decoy_cli.errors import ModelError
+from decoy_cli.modeling.calibration_fit import calibration_scores, fit_calibration
+from decoy_cli.modeling.provenance import FileCallback, SampleChoice
+from decoy_cli.modeling.sample_set import SampleStats
+from decoy_cli.modeling.split import SplitPart
 
 PARTS: tuple[SplitPart, ...] = ("val", "test")
 
@@ -54,8 +49,8 @@ def calibrate_dip_folder(
     A folder without a DIP or a part without both classes is one ModelError line."""
     if not (folder / "dip.json").is_file():
         raise ModelError(f"{folder}: holds no dip.json to calibrate")
-    from decoy_cli.damage.evaluation import dip_probabilities
     from decoy_cli.damage.model_folder import load_dip, save_calibration
+    from decoy_cli.modeling.network_evaluation import dip_probabilities
 
     samples, stats = choice.read(on_file)
     split = choice.split(samples)

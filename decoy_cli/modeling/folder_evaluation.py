@@ -1,7 +1,7 @@
 """Scoring any `--models` choice ("rules", "shipped", "paper" or a folder) on ESTA data, as
 `decoy models evaluate` does: DIP's metrics, DOG's (on the hits whose raw damage and hit group
 the data records), and the HP lost drawn against real by whatever decides the damage (DOG or
-rules) per 0.5 s step and, for the rules, per hit, per map (decoy_cli/damage/hp_lost.py); on all
+rules) per 0.5 s step and, for the rules, per hit, per map (decoy_cli/modeling/hp_lost.py); on all
 samples or on one part of a split, written with the figures to an output folder (metrics.json).
 
 DIP is scored on a 1:1 balanced set by default (the paper's). torch is imported when the models
@@ -18,14 +18,14 @@ import numpy as np
 
 from decoy_cli.damage.bullet_counts import ALL, MAX_BULLETS, BulletCounts
 from decoy_cli.damage.choice import ModelChoice, ModelName
-from decoy_cli.damage.damage_rows import group_id
-from decoy_cli.damage.evaluation import DRAWS, DipEvaluation, DogEvaluation
-from decoy_cli.damage.hp_lost import HpLostScores
-from decoy_cli.damage.provenance import FileCallback, SampleChoice, write_json
-from decoy_cli.damage.sample_set import Samples, SampleStats
-from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import SplitPart, balance
 from decoy_cli.errors import ModelError
+from decoy_cli.modeling.damage_rows import group_id
+from decoy_cli.modeling.hp_lost import HpLostScores
+from decoy_cli.modeling.network_evaluation import DRAWS, DipEvaluation, DogEvaluation
+from decoy_cli.modeling.provenance import FileCallback, SampleChoice, write_json
+from decoy_cli.modeling.sample_set import Samples, SampleStats
+from decoy_cli.modeling.scores import MIN_CELL
+from decoy_cli.modeling.split import SplitPart, balance
 
 if TYPE_CHECKING:
     from decoy_cli.damage.model_folder import LoadedDip
@@ -97,12 +97,12 @@ def evaluate_model_folder(
     samples, stats = choice.read(on_file)
     index = np.arange(len(samples)) if subset == "all" else choice.split(samples).part(subset)
 
-    from decoy_cli.damage.evaluation import evaluate_dog
-    from decoy_cli.damage.evaluation_figures import write_dip_figures, write_dog_figures
-    from decoy_cli.damage.hp_lost import draw_outcomes, score_by_map
     from decoy_cli.damage.model_folder import load_dip, load_dog
     from decoy_cli.damage.model_maps import dip_of, map_warnings
-    from decoy_cli.damage.rules_model import RulesFile
+    from decoy_cli.damage.rules_damage import RulesFile
+    from decoy_cli.modeling.evaluation_figures import write_dip_figures, write_dog_figures
+    from decoy_cli.modeling.hp_lost import draw_outcomes, score_by_map
+    from decoy_cli.modeling.network_evaluation import evaluate_dog
 
     report: dict[str, object] = {
         "models": str(models),
@@ -195,7 +195,7 @@ def evaluate_dip_by_map(
     """The `chosen` samples scored by `dip` at the threshold the fight decides by (or
     `threshold`): the evaluation
     of them all, and each map's metrics."""
-    from decoy_cli.damage.evaluation import evaluate_dip
+    from decoy_cli.modeling.network_evaluation import evaluate_dip
 
     maps = np.array([str(m) for m in samples.map_name[chosen]], dtype=object)
     by_map: dict[str, dict[str, float]] = {}
@@ -210,8 +210,8 @@ def _hit_samples(
 ) -> Samples:
     """One sample per firearm hit of the data's rounds (`events_mode.hit_samples`), of the
     rounds of `subset`'s samples only."""
-    from decoy_cli.damage.events_mode import hit_samples
     from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+    from decoy_cli.modeling.events_mode import hit_samples
 
     groups = set(samples.group[index].tolist())
     parts = []

@@ -5,7 +5,7 @@ damage summed over the step's hits (capped at 100 HP) and its hit group that of 
 The rounds are dealt into `FOLDS` folds; each fold's samples are generated (`DRAWS` draws each)
 by each model:
 
-* "rules": the rules-grounded model (decoy_cli/damage/rules_model.py) with its learned parts
+* "rules": the rules-grounded model (decoy_cli/damage/rules_damage.py) with its learned parts
   fitted on the other folds' rounds only;
 * a model folder's DOG (e.g. the paper's checkpoint, trained on other matches): the same network
   for every fold, honest on rounds it never saw;
@@ -15,7 +15,7 @@ by each model:
 
 Pooled over the folds (every sample a test sample once): the mean Wasserstein distance per
 (weapon, hit group) cell with at least `MIN_CELL` real samples (the paper's generative protocol,
-`decoy_cli/damage/scores.wasserstein_cells`) and its largest cell, the hit-group total variation
+`decoy_cli/modeling/scores.wasserstein_cells`) and its largest cell, the hit-group total variation
 per weapon with at least 30 samples (`scores.hit_group_tv`), and the spread of the per-fold means.
 """
 
@@ -27,16 +27,16 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.evaluation import DRAWS
 from decoy_cli.damage.features import FeatureSpec
-from decoy_cli.damage.provenance import seen_in
-from decoy_cli.damage.rules_model import fit_rules
-from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.scores import hit_group_tv, sampling_floor, wasserstein_cells
-from decoy_cli.damage.split import FOLDS, deal_folds
-from decoy_cli.damage.train_options import DogLossWeights, TrainOptions
 from decoy_cli.esta import Round
 from decoy_cli.files import JsonObject
+from decoy_cli.modeling.network_evaluation import DRAWS
+from decoy_cli.modeling.provenance import seen_in
+from decoy_cli.modeling.rules_fit import fit_rules
+from decoy_cli.modeling.sample_set import Samples
+from decoy_cli.modeling.scores import hit_group_tv, sampling_floor, wasserstein_cells
+from decoy_cli.modeling.split import FOLDS, deal_folds
+from decoy_cli.modeling.train_options import DogLossWeights, TrainOptions
 
 MIN_CELL = 5
 """Fewest real samples of a cell in the Wasserstein mean (issue 13's protocol)."""
@@ -56,10 +56,10 @@ def _cvae_per_fold(
 ) -> tuple[np.ndarray, np.ndarray]:
     from typing import cast
 
-    from decoy_cli.damage.evaluation import dog_generate
     from decoy_cli.damage.model_folder import LoadedDog
     from decoy_cli.damage.networks import DogNet
-    from decoy_cli.damage.training import train_dog
+    from decoy_cli.modeling.network_evaluation import dog_generate
+    from decoy_cli.modeling.training import train_dog
 
     damage = np.zeros((draws, len(positives)))
     group = np.zeros((draws, len(positives)), dtype=np.int64)
@@ -148,8 +148,8 @@ def rules_out_of_fold(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(draws, K) damage and hit-group codes of the K damaging samples, each fold's drawn by
     rules fitted on the rounds of the other folds only (`fold`: each sample's fold)."""
-    from decoy_cli.damage.damage_rows import group_id
-    from decoy_cli.damage.hp_lost import draw_outcomes
+    from decoy_cli.modeling.damage_rows import group_id
+    from decoy_cli.modeling.hp_lost import draw_outcomes
 
     fold_of_group = {str(g): int(f) for g, f in zip(positives.group, fold, strict=True)}
     damage = np.zeros((draws, len(positives)))
@@ -188,8 +188,8 @@ def compare_on_folds(
     cvae: CvaeTraining | None = None,
 ) -> list[ModelScores]:
     """Every model's scores on the same folds of the damaging samples (module doc)."""
-    from decoy_cli.damage.evaluation import dog_generate
     from decoy_cli.damage.model_folder import load_dog
+    from decoy_cli.modeling.network_evaluation import dog_generate
 
     positives = samples.take(np.flatnonzero(samples.outcome_known))
     fold_of_group = deal_folds(positives.group.tolist(), np.random.default_rng(seed))

@@ -1,4 +1,4 @@
-"""The figures of a DIP or DOG evaluation (decoy_cli/damage/evaluation.py): ROC and
+"""The figures of a DIP or DOG evaluation (decoy_cli/modeling/network_evaluation.py): ROC and
 precision-recall curves; reconstructed vs real damage, the error histogram, the hit-group
 confusion matrix and generated vs real damage per cell. matplotlib is imported when drawing.
 """
@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.damage.evaluation import DipEvaluation, DogEvaluation
 from decoy_cli.damage.features import HIT_GROUPS
-from decoy_cli.damage.sample_set import MAX_DAMAGE_HP
-from decoy_cli.damage.scores import confusion_matrix, precision_recall_curve, roc_curve
 from decoy_cli.figures import save_figure
+from decoy_cli.modeling.network_evaluation import DipEvaluation, DogEvaluation
+from decoy_cli.modeling.sample_set import MAX_DAMAGE_HP
+from decoy_cli.modeling.scores import confusion_matrix, precision_recall_curve, roc_curve
 
 
 def write_dip_figures(evaluation: DipEvaluation, folder: Path, title: str = "DIP") -> list[Path]:

@@ -33,20 +33,20 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.csgo import EYE_HEIGHT_M
-from decoy_cli.damage.calibration import MIN_RECALL
 from decoy_cli.damage.combat import DipDecision, armed
-from decoy_cli.damage.evaluation import dip_probabilities
 from decoy_cli.damage.model_folder import LoadedDip
-from decoy_cli.damage.provenance import seen_in
-from decoy_cli.damage.sample_set import Samples, SampleStats
-from decoy_cli.damage.samples import (
+from decoy_cli.errors import DecoyError
+from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
+from decoy_cli.modeling.calibration_fit import MIN_RECALL
+from decoy_cli.modeling.network_evaluation import dip_probabilities
+from decoy_cli.modeling.provenance import seen_in
+from decoy_cli.modeling.sample_set import Samples, SampleStats
+from decoy_cli.modeling.samples import (
     DEFAULT_MODE,
     DEFAULT_WINDOW_S,
     SAMPLE_ERROR,
     round_samples,
 )
-from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
 from decoy_cli.replay.missing import fill_missing
 from decoy_cli.sim.combat import CombatBatch
 from decoy_cli.sim.rules import RulesConfig

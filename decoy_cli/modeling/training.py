@@ -6,7 +6,7 @@ are kept and returned, and training stops when `patience` epochs in a row did no
 The options and their defaults (the paper's) are in train_options.py, without torch.
 
 * DIP: binary cross-entropy on "the attacker damaged the victim in this step".
-* DOG: `networks.dog_loss` on the damaging pairs: damage in HP/100, hit-group code.
+* DOG: `losses.dog_loss` on the damaging pairs: damage in HP/100, hit-group code.
 
 Determinism: everything random (initial weights, shuffling, dropout, the VAE's noise) comes from
 torch generators seeded with `TrainOptions.seed`, inside `torch.random.fork_rng`, so the same
@@ -33,7 +33,12 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor, nn
 
-from decoy_cli.damage.evaluation import (
+from decoy_cli.damage.features import HIT_GROUPS, Features, FeatureSpec
+from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
+from decoy_cli.damage.networks import DipNet, DogNet, tensors
+from decoy_cli.errors import DecoyError
+from decoy_cli.modeling.losses import dog_loss
+from decoy_cli.modeling.network_evaluation import (
     DRAWS,
     DipEvaluation,
     DogEvaluation,
@@ -41,20 +46,16 @@ from decoy_cli.damage.evaluation import (
     evaluate_dip,
     evaluate_dog,
 )
-from decoy_cli.damage.features import HIT_GROUPS, Features, FeatureSpec
-from decoy_cli.damage.model_folder import LoadedDip, LoadedDog
-from decoy_cli.damage.networks import DipNet, DogNet, dog_loss, tensors
-from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.scores import MIN_CELL, best_f1_threshold
-from decoy_cli.damage.split import Split, balance
-from decoy_cli.damage.train_options import (
+from decoy_cli.modeling.sample_set import Samples
+from decoy_cli.modeling.scores import MIN_CELL, best_f1_threshold
+from decoy_cli.modeling.split import Split, balance
+from decoy_cli.modeling.train_options import (
     BALANCE,
     DEFAULT_BALANCE,
     Balance,
     DogLossWeights,
     TrainOptions,
 )
-from decoy_cli.errors import DecoyError
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,11 @@
 """The rules-grounded damage model on real damaging steps of every map with damage events,
-fitted leave-matches-out: python benchmarks/damage_rules_maps.py [EVENTS...] [--seed N]
+fitted leave-matches-out: python benchmarks/studies/damage_rules_maps.py [EVENTS...] [--seed N]
 
 Each match of a map with several matches is left out in turn, the rounds of a map with one
-match are dealt into 5 folds (decoy_cli/damage/split.leave_matches_out); each fold's steps are
+match are dealt into 5 folds (decoy_cli/modeling/split.leave_matches_out); each fold's steps are
 drawn by rules fitted on all the other folds' rounds, of every map. Scored per map on the HP
 lost per step by (weapon, distance band) cell with at least 10 real steps
-(decoy_cli/damage/hp_lost.py), with the sampling floor; beside it the shipped rules.json
+(decoy_cli/modeling/hp_lost.py), with the sampling floor; beside it the shipped rules.json
 (fitted on all of these rounds of de_dust2, so flattered there).
 """
 
@@ -15,11 +15,12 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from _damage_folds import rules_out_of_fold
 
 from decoy_cli.damage import SHIPPED_MODELS
-from decoy_cli.damage.evaluation import DRAWS
-from decoy_cli.damage.fold_comparison import rules_out_of_fold
-from decoy_cli.damage.hp_lost import (
+from decoy_cli.damage.rules_damage import RulesFile
+from decoy_cli.esta import collect_match_files, read_match
+from decoy_cli.modeling.hp_lost import (
     HpLostScores,
     band_labels,
     distance_u,
@@ -27,13 +28,12 @@ from decoy_cli.damage.hp_lost import (
     drawn_hp_lost,
     score_by_map,
 )
-from decoy_cli.damage.rules_model import RulesFile
-from decoy_cli.damage.sample_set import Samples
-from decoy_cli.damage.samples import build_samples
-from decoy_cli.damage.split import leave_matches_out
-from decoy_cli.esta import collect_match_files, read_match
+from decoy_cli.modeling.network_evaluation import DRAWS
+from decoy_cli.modeling.sample_set import Samples
+from decoy_cli.modeling.samples import build_samples
+from decoy_cli.modeling.split import leave_matches_out
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+SHARED = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
 
 def _line(name: str, where: str, s: HpLostScores) -> str:

@@ -1,5 +1,5 @@
 """The rules-grounded damage outcome model on real hits, leave-rounds-out:
-python benchmarks/damage_rules_evaluation.py [EVENTS...] [--seed N]
+python benchmarks/studies/damage_rules_evaluation.py [EVENTS...] [--seed N]
 
 Hit group drawn from a model learned on the other folds' rounds, damage by the game's rules
 (decoy_cli/damage/rules_evaluation.py). Prints the mean Wasserstein distance per (weapon, hit
@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from _damage_rules import evaluate_rules
 
-from decoy_cli.damage.rules_evaluation import evaluate_rules
 from decoy_cli.esta import collect_match_files, read_match
 
-DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "esta_dust2_events"
+DEFAULT = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "esta_dust2_events"
 
 
 def main() -> None:

@@ -2,9 +2,9 @@
 
 `decoy models download-decoy` fetches the four files at a fixed commit of HATS-ICT/decoy (MIT)
 from `PAPER_BASE_URL`, checks each against the SHA-256 and size recorded here, and imports them
-(`decoy_cli.damage.paper.import_paper`) into a model folder for `--models`. A file that arrives
-short, or with another checksum, is refused before anything is imported; the files are written
-under temporary names and renamed only when verified.
+(`decoy_cli.modeling.paper_import.import_paper`) into a model folder for `--models`. A file that
+arrives short, or with another checksum, is refused before anything is imported; the files are
+written under temporary names and renamed only when verified.
 """
 
 from __future__ import annotations

@@ -27,10 +27,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Literal, get_args
 
-from decoy_cli.damage.events_mode import event_samples
-from decoy_cli.damage.frames_mode import frame_samples, has_both_teams
-from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples, SampleStats
-from decoy_cli.damage.split import (
+from decoy_cli.errors import DecoyError
+from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
+from decoy_cli.modeling.events_mode import event_samples
+from decoy_cli.modeling.frames_mode import frame_samples, has_both_teams
+from decoy_cli.modeling.sample_set import MAX_DAMAGE_HP, Samples, SampleStats
+from decoy_cli.modeling.split import (
     DEFAULT_SPLIT,
     DEFAULT_TEST_FRACTION,
     DEFAULT_VAL_FRACTION,
@@ -39,8 +41,6 @@ from decoy_cli.damage.split import (
     balance,
     split_samples,
 )
-from decoy_cli.errors import DecoyError
-from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
 
 SampleMode = Literal["auto", "frames", "events"]
 """How rounds become samples (`build_samples`)."""

@@ -33,7 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M, is_pistol_round
-from decoy_cli.damage.damage_rows import (
+from decoy_cli.damage.rules import ARMORED_GROUPS, WEAPON_RULES, shot_damage
+from decoy_cli.esta import Round
+from decoy_cli.modeling.damage_rows import (
     VOCABULARY,
     DamageRows,
     aggregate,
@@ -44,10 +46,8 @@ from decoy_cli.damage.damage_rows import (
     step_clock,
     strings,
 )
-from decoy_cli.damage.filled_views import redraw_filled_views
-from decoy_cli.damage.rules import ARMORED_GROUPS, WEAPON_RULES, shot_damage
-from decoy_cli.damage.sample_set import Samples, SampleStats, samples_from_rows
-from decoy_cli.esta import Round
+from decoy_cli.modeling.filled_views import redraw_filled_views
+from decoy_cli.modeling.sample_set import Samples, SampleStats, samples_from_rows
 from decoy_cli.sim.combat import NO_HIT
 
 

@@ -1,4 +1,5 @@
-"""CS:GO's damage rules against real hits: python benchmarks/damage_rules_check.py [EVENTS...]
+"""CS:GO's damage rules against real hits:
+python benchmarks/studies/damage_rules_check.py [EVENTS...]
 
 For every firearm hit in the ESTA files' `damages` (default: ../shared/data/esta_dust2_events),
 the rules of decoy_cli/damage/rules.py predict the health damage from weapon, hit group, distance
@@ -12,11 +13,11 @@ import sys
 from pathlib import Path
 
 import pandas as pd
+from _damage_rules import check_rules
 
-from decoy_cli.damage.rules_check import check_rules
 from decoy_cli.esta import collect_match_files, read_match
 
-DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "esta_dust2_events"
+DEFAULT = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "esta_dust2_events"
 
 
 def main() -> None:

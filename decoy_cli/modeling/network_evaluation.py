@@ -34,10 +34,10 @@ from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
 
-from decoy_cli.damage.calibration import calibration_scores
 from decoy_cli.damage.features import HIT_GROUPS
-from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, Samples
-from decoy_cli.damage.scores import (
+from decoy_cli.modeling.calibration_fit import calibration_scores
+from decoy_cli.modeling.sample_set import MAX_DAMAGE_HP, Samples
+from decoy_cli.modeling.scores import (
     MIN_CELL,
     Cell,
     CellRecord,

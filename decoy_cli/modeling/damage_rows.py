@@ -29,8 +29,8 @@ import pandas as pd
 
 from decoy_cli.damage.features import WEAPONS
 from decoy_cli.damage.rules import HIT_GROUP_ALIASES
-from decoy_cli.damage.sample_set import MAX_DAMAGE_HP, SampleStats
 from decoy_cli.esta import Round
+from decoy_cli.modeling.sample_set import MAX_DAMAGE_HP, SampleStats
 from decoy_cli.sim.combat import HIT_GROUPS
 
 _HIT_GROUP_CODE = {

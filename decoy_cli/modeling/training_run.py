@@ -15,28 +15,28 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Generic, TypeVar
 
-from decoy_cli.damage.evaluation import DRAWS
-from decoy_cli.damage.provenance import (
+from decoy_cli.errors import DecoyError
+from decoy_cli.files import json_object, write_atomic
+from decoy_cli.modeling.network_evaluation import DRAWS
+from decoy_cli.modeling.provenance import (
     FileCallback,
     SampleChoice,
     provenance,
     write_json,
 )
-from decoy_cli.damage.sample_set import SampleStats
-from decoy_cli.damage.scores import MIN_CELL
-from decoy_cli.damage.split import Split
-from decoy_cli.damage.train_options import (
+from decoy_cli.modeling.sample_set import SampleStats
+from decoy_cli.modeling.scores import MIN_CELL
+from decoy_cli.modeling.split import Split
+from decoy_cli.modeling.train_options import (
     BALANCE,
     DEFAULT_BALANCE,
     Balance,
     DogLossWeights,
     TrainOptions,
 )
-from decoy_cli.errors import DecoyError
-from decoy_cli.files import json_object, write_atomic
 
 if TYPE_CHECKING:
-    from decoy_cli.damage.training import DipRun, DogRun, EpochRecord, Progress
+    from decoy_cli.modeling.training import DipRun, DogRun, EpochRecord, Progress
 
 ProgressCallback = Callable[["Progress"], None]
 """Called after every batch and every epoch of training (`training.Progress`)."""
@@ -82,10 +82,10 @@ def train_dip_model(
     samples, stats = choice.read(on_file)
     split = choice.split(samples)
 
-    from decoy_cli.damage.evaluation_figures import write_dip_figures
     from decoy_cli.damage.features import FeatureSpec
     from decoy_cli.damage.model_folder import save_dip
-    from decoy_cli.damage.training import fit_dip
+    from decoy_cli.modeling.evaluation_figures import write_dip_figures
+    from decoy_cli.modeling.training import fit_dip
 
     run = fit_dip(samples, split, options, FeatureSpec(units=units), balanced, progress)
     metadata: dict[str, object] = {
@@ -130,10 +130,10 @@ def train_dog_model(
     samples, stats = choice.read(on_file)
     split = choice.split(samples)
 
-    from decoy_cli.damage.evaluation_figures import write_dog_figures
     from decoy_cli.damage.features import FeatureSpec
     from decoy_cli.damage.model_folder import save_dog
-    from decoy_cli.damage.training import fit_dog
+    from decoy_cli.modeling.evaluation_figures import write_dog_figures
+    from decoy_cli.modeling.training import fit_dog
 
     run = fit_dog(samples, split, options, FeatureSpec(), weights, draws, min_cell, progress)
     metadata: dict[str, object] = {
