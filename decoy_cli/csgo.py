@@ -74,7 +74,7 @@ FATAL_FALL_SPEED_U_S = 1000.0
 """Landing speed at which a fall does 100 damage (CS_PLAYER_FATAL_FALL_SPEED in CS:GO's
 cs_gamerules.cpp; the Source SDK's 1024 and Counter-Strike: Source's 1100 x 1.25 are other
 games'). The damage is linear in between. On the real T-side rounds, health lost at falls of
-200-310 u follows it (`python benchmarks/fall_damage_check.py`)."""
+200-310 u follows it (`python benchmarks/studies/fall_damage_check.py`)."""
 
 SAFE_DROP_M = SAFE_FALL_SPEED_U_S**2 / (2 * GRAVITY_U_S2) * HAMMER_TO_M
 """The deepest fall that does no damage (210 u)."""

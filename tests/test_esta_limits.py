@@ -1,6 +1,6 @@
 """The reader's limits: a match file's JSON is read and decompressed in bounded steps, and the
 rounds, frames and players it may hold are bounded, so a huge or hostile file is one clear error
-instead of exhausted memory (benchmarks/hostile_memory.py measures the memory)."""
+instead of exhausted memory (benchmarks/faults/hostile_memory.py measures the memory)."""
 
 from __future__ import annotations
 

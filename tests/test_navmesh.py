@@ -323,7 +323,8 @@ def hand_nav(*areas: tuple[float, float, float, float, float]) -> NavMesh:
 def test_open_stretches_wall_a_side_over_a_lower_floor_reaching_under_it() -> None:
     """A platform (area 0) with a lower floor reaching under its east side (area 1) and another
     lower floor 64 u beyond its north side (area 2): the north side is a ledge onto area 2, the
-    east side a full wall (what benchmarks/ledge_candidates.py measures: issue 34's rule)."""
+    east side a full wall (what benchmarks/studies/ledge_candidates.py measures: issue 34's
+    rule)."""
     nav = hand_nav(
         (0.0, 0.0, 200.0, 200.0, 200.0),
         (150.0, 0.0, 400.0, 200.0, 0.0),

@@ -22,12 +22,12 @@ few matrix products: every BatchNorm into the Linear before it
 Linear over the concatenated features, DOG's two heads into one, Dropout dropped (the identity in
 eval mode). The result equals the modules' forward up to float rounding (tested); it is a
 snapshot: later changes to the networks' weights are not seen. The folding makes a small
-step's inference several times faster (benchmarks/bench_damage.py measures it).
+step's inference several times faster (benchmarks/bench/bench_damage.py measures it).
 
 Threads: by default the inference runs on one torch thread (the previous count is restored
 after each call): on machines shared with other jobs, torch's default of one thread per core
 made small products many times slower, while on an idle machine it saved little, and only on
-the largest batches (benchmarks/bench_damage.py). `threads=None` keeps torch's setting.
+the largest batches (benchmarks/bench/bench_damage.py). `threads=None` keeps torch's setting.
 """
 
 from __future__ import annotations

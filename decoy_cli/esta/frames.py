@@ -12,7 +12,7 @@ coordinate (beyond the engine's ±16,384 Hammer units) is an error, and so is an
 The round's clock is the game's: seconds since freeze-time end counted in ticks at the file's
 `tickRate` (`round_clock_zero`). A file's own `seconds` only place the zero: some awpy 1.x
 exports wrote them at 127 per second on 128-tick demos, a clock 0.8% slow against the game's
-115 s round time (benchmarks/clock_study.py measures it).
+115 s round time (benchmarks/studies/clock_study.py measures it).
 """
 
 from __future__ import annotations
@@ -201,7 +201,8 @@ def check_clock(seconds: np.ndarray, ticks: np.ndarray) -> None:
 CLOCK_TOLERANCE = (0.02, 1.0)
 """How far a frame's written `seconds` may lie from the game clock's reading at its tick:
 2% of the reading plus 1 s. The real files' `seconds` run 0.8% slow in some matches (127 per
-second on 128-tick demos, benchmarks/clock_study.py); farther off, the file contradicts itself."""
+second on 128-tick demos, benchmarks/studies/clock_study.py); farther off, the file contradicts
+itself."""
 
 
 def _check_written_seconds(written: np.ndarray, seconds: np.ndarray, ticks: np.ndarray) -> None:

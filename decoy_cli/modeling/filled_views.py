@@ -11,8 +11,8 @@ So a round whose every row between two enemies at different spots faces exactly 
 self-damage, such as a player in his own fire, has no facing to fill) has its views redrawn:
 the facing bearing plus a deviation drawn from the real firearm hits' deviations
 (`ATTACKER_DEVIATION_DEG`, `VICTIM_DEVIATION_DEG`: their quantiles over `hit_view_deviations`
-of the de_dust2 events with real views, printed by `python benchmarks/aim_study.py`), seeded by
-the match and round so the samples are the same on every build.
+of the de_dust2 events with real views, printed by `python benchmarks/studies/aim_study.py`),
+seeded by the match and round so the samples are the same on every build.
 """
 
 from __future__ import annotations

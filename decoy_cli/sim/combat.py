@@ -51,8 +51,8 @@ NO_HIT = -1
 
 REACTION_S = 0.25
 """How long an agent has an enemy in sight before he aims at him: a human's visual reaction
-time, about a quarter of a second (chosen from that; `benchmarks/aim_study.py` measures how long
-real pairs were in sight before the first damage, README). Until then he
+time, about a quarter of a second (chosen from that; `benchmarks/studies/aim_study.py` measures
+how long real pairs were in sight before the first damage, README). Until then he
 looks where he was going, as the movers turn him. Sight is tested at combat steps only, so at
 the paper's cadence (0.5 s) he aims from the second step in a row that finds the enemy in sight.
 The damage models learned from real shots, taken by players aiming at their victims: a replay

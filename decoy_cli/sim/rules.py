@@ -88,14 +88,14 @@ class RulesConfig:
     plant_s: float = 3.0
     """CS:GO's C4 arm time; the 9 real plants with a `plant_begin` in
     ../shared/data/esta_dust2_events take 3.04 to 3.06 s from `plant_begin` to `plant`
-    (benchmarks/bomb_timing_study.py)."""
+    (benchmarks/studies/bomb_timing_study.py)."""
     bomb_timer_s: float = 40.0
     """CS:GO's C4 timer (mp_c4timer, 40 s in competitive play)."""
     defuse_s: float = 10.0
     """CS:GO's defuse time without a kit."""
     defuse_kit_s: float = 5.0
     """CS:GO's defuse time with a kit; the one real defuse in ../shared/data/esta_dust2_events
-    took 5.02 s from `defuse_start` to `defuse` (benchmarks/bomb_timing_study.py)."""
+    took 5.02 s from `defuse_start` to `defuse` (benchmarks/studies/bomb_timing_study.py)."""
     defuse_range_m: float = 1.5  # horizontal; CS:GO's use range is about 62 u (1.2 m)
     defuse_vertical_m: float = 1.0
     pickup_range_m: float = 0.8  # horizontal

@@ -11,7 +11,7 @@ replay), each with its real window. Three rules, from the game:
 * A fire burns a player whose feet are within 150 u of its centre horizontally (the game's
   `inferno_max_range`, the farthest its flames spread) and within a standing player's height of
   it vertically, at 40 HP a second (measured: the real events' fire damage comes every 0.203 s
-  at most 8 HP, og-navi-blast2020 and de_ancient; `benchmarks/utility_constants.py`).
+  at most 8 HP, og-navi-blast2020 and de_ancient; `benchmarks/studies/utility_constants.py`).
   Fire does not block sight.
 * A flashed player does not shoot while blind: from the blind's tick for its duration (awpy's
   blinds, in seconds).

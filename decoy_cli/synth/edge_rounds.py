@@ -14,7 +14,7 @@ measures how well the movers and the planner follow real motion over that kind o
 
 Frames are sampled from that motion at a fixed rate, in the ESTA shape (`decoy_cli.esta.writer`),
 so `decoy evaluate` and `replay_round` read them like any match file. Drops with fall damage
-are left out (the player would lose HP the frames do not show). `benchmarks/edge_kinds.py`
+are left out (the player would lose HP the frames do not show). `benchmarks/studies/edge_kinds.py`
 reports every map; the tests replay a sample.
 """
 

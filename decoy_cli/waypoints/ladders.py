@@ -36,14 +36,14 @@ from decoy_cli.world.physics import PhysicsWorld
 
 LADDER_REACH = 2
 """How far from a ladder's end (horizontally, in lattice spacings) its floor node may lie: the
-top's floor starts beyond the lip (`python benchmarks/ladder_ends.py` lists each shipped
+top's floor starts beyond the lip (`python benchmarks/studies/ladder_ends.py` lists each shipped
 ladder's)."""
 TOP_BAND_M = (-JUMP_HEIGHT_M, STEP_HEIGHT_M)
 """Heights of a top's floor relative to the ladder's top: down to a crouch-jump below (the brush
 rising past the lip), up to a step above."""
 BOTTOM_BAND_M = (-0.9, STEP_HEIGHT_M)
 """Heights of a bottom's floor relative to the ladder's bottom: chosen by hand just beyond the
-deepest of the shipped ladders' (`python benchmarks/ladder_ends.py`)."""
+deepest of the shipped ladders' (`python benchmarks/studies/ladder_ends.py`)."""
 _ANGLES = np.arange(8) * (math.pi / 4)
 
 

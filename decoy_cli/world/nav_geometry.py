@@ -180,7 +180,7 @@ def build_nav_triangles(nav: NavMesh) -> np.ndarray:
 def open_stretches(nav: NavMesh) -> list[tuple[_Side, _OpenPart]]:
     """Every open stretch of an area side (touching no area) with its side and the nearest area
     beyond it (`other` -1: none near, a full wall): what a study of the walls and ledges
-    (benchmarks/ledge_candidates.py) looks at."""
+    (benchmarks/studies/ledge_candidates.py) looks at."""
     contacts = _find_contacts(nav)
     zx, zy = fit_corner_heights(nav, contacts)
     height = lambda area, x, y: _height(nav, zx, zy, area, x, y)  # noqa: E731

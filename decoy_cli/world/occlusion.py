@@ -10,7 +10,7 @@ engine for everything that needs contacts, hit fractions or normals (`PhysicsWor
 Embree works in single precision, so the scene is stored relative to the centre of the world's
 bounding box: coordinates then stay within the map's half-size, where float32 resolves a few
 micrometres. The two answers agree except for rays that graze a triangle edge within that
-precision (`benchmarks/occlusion_agreement.py` measures how often).
+precision (`benchmarks/studies/occlusion_agreement.py` measures how often).
 """
 
 from __future__ import annotations
