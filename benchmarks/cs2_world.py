@@ -89,7 +89,7 @@ def movement(graph_file: Path | None, out: Path) -> dict[str, object]:
         row[f"{side} mean_dist median"] = round(float(part.mean_dist.median()), 3)
         row[f"{side} max_dist p90"] = round(float(part.max_dist.quantile(0.9)), 2)
         row[f"{side} relocations"] = int(part.relocations.sum())
-    row["targets a frame late"] = f"{int(players.late_over_frame.sum())} of {players.targets.sum()}"
+    row["targets > 0.5 s late"] = f"{int(players.late_over_frame.sum())} of {players.targets.sum()}"
     return row
 
 

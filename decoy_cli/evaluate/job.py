@@ -32,7 +32,7 @@ from decoy_cli.esta.batch import UNREADABLE_FILE
 from decoy_cli.esta.content import content_sha256
 from decoy_cli.esta.plausibility import Implausible
 from decoy_cli.evaluate.record import RoundRecord, build_record
-from decoy_cli.evaluate.settings import EvalSettings, round_seed
+from decoy_cli.evaluate.settings import EvalSettings, round_seed, seed_source
 from decoy_cli.files import JsonValue
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import PlaceFinder
@@ -259,6 +259,6 @@ def _replay(
 ) -> ReplayResult:
     from decoy_cli.replay.replayer import ReplayOptions, replay_round
 
-    seed = round_seed(settings, task.file_sha, task.round_num)
+    seed = round_seed(settings, seed_source(round_, task.file_sha), task.round_num)
     options = ReplayOptions.of(settings, model, seed=seed, sight=state.sight)
     return replay_round(round_, state.graph, options, physics=state.physics)

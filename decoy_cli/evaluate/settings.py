@@ -15,6 +15,7 @@ from functools import cache
 from pathlib import Path
 
 from decoy_cli.damage.choice import ModelChoice
+from decoy_cli.esta import Round
 from decoy_cli.esta.content import content_sha256
 from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.replay.replayer import ReplaySpec
@@ -101,9 +102,21 @@ def index_key(settings: EvalSettings, file_sha: str) -> str:
 
 
 def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
-    """The simulator seed of one round: fixed by the run's seed, the file and the round."""
+    """The simulator seed of one round: fixed by the run's seed, the file (or `seed_source`)
+    and the round."""
     digest = hashlib.sha256(f"{settings.seed}|{file_sha}|{round_num}".encode()).digest()
     return int.from_bytes(digest[:8], "little") & (2**63 - 1)
+
+
+def seed_source(round_: Round, file_sha: str) -> str:
+    """What a round's random numbers are drawn from beside the run's seed: an ESTA round's file
+    content, a CS2 round's place in its demo (map, round, ticks, players), so that every form
+    of one demo's tables (an awpy 2 zip, a folder of awpy 3 tables, the demo) draws the same."""
+    if round_.source == "ESTA":
+        return file_sha
+    players = sorted((p.steam_id or "", p.name, p.side) for p in round_.players)
+    place = [round_.map_name, round_.round_num, round_.start_tick, round_.end_tick, players]
+    return hashlib.sha256(json.dumps(place, default=str).encode()).hexdigest()
 
 
 @cache
