@@ -51,7 +51,7 @@ PROBES_U = (1.0, 4.0, 8.0, 16.0, 24.0, 32.0, 40.0, 48.0, 64.0, 80.0, 96.0, 112.0
 POLYGON_WALL_PUSH_U = 24.0
 """How far walls stand beyond an open edge: measured, the median distance from the CS2
 de_dust2 nav's open edges to the walls of the brush mesh of ../shared/data/meshes
-(benchmarks/cs2_world.py), where CS:GO's nav stops `WALL_PUSH_U` short."""
+(benchmarks/studies/cs2_world.py), where CS:GO's nav stops `WALL_PUSH_U` short."""
 GRID_U = 64.0
 """Cell size of the index that finds the areas under a point."""
 OVERHEAD_U = 72.0
@@ -381,7 +381,7 @@ def open_edge_rays(
     """Horizontal rays out of the open edges that have no floor beyond them (where this world
     puts a wall): one per piece and height above its floor, from `back` inside the edge to
     `reach` beyond it. (starts, ends) in Hammer units and `back`: what a study of how far the
-    real walls stand casts against a map's geometry (benchmarks/cs2_world.py)."""
+    real walls stand casts against a map's geometry (benchmarks/studies/cs2_world.py)."""
     floors, edges = _Floors(nav), _Edges(nav)
     covered, _ = _shared_stretches(edges, floors)
     starts, ends = [], []

@@ -14,7 +14,7 @@ the graph given with --graph), then measures on both:
 * with --seeds N: the whole round over seeds 0..N-1 under both death protocols (winner
   agreement and plants, medians over the seeds).
 
-    python benchmarks/cs2_world.py [--graph G.npz] [--seeds 20] [--out decoy-out/cs2_world]
+    python benchmarks/studies/cs2_world.py [--graph G.npz] [--seeds 20] [--out decoy-out/cs2_world]
 
 Without ../shared/data it says so and exits.
 """
@@ -43,7 +43,7 @@ from decoy_cli.world.nav_polygons import open_edge_rays
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 NAV = DATA / "cs2_maps" / "de_dust2.nav.json.xz"
 MESH = DATA / "meshes" / "de_dust2_moh-maps.tri"
 ROUNDS = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-r01-12.json.xz"

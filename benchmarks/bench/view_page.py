@@ -1,7 +1,7 @@
 """The view page of a large run in headless Chromium: its size, its first draw and a seek.
 
     decoy evaluate ../shared/data/esta_dust2_tside --no-combat --no-bomb --out RUN
-    python benchmarks/view_page.py RUN [--baseline-bytes N]
+    python benchmarks/bench/view_page.py RUN [--baseline-bytes N]
 
 Prints the page's size (whole, per round, gzipped; with `--baseline-bytes`, the size of another
 page of the same rounds, the ratio per round), the time from navigation until the page's
@@ -21,7 +21,7 @@ import statistics
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests"))
 
 from browser import Browser, find_chromium  # noqa: E402
