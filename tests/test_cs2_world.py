@@ -167,6 +167,14 @@ def test_an_open_edge_gets_a_wall_and_a_shared_edge_none(tmp_path: Path) -> None
     assert len(outer) and outer[:, :, 2].max() > 150  # a full wall beyond the open edge
 
 
+def test_a_floor_of_the_same_level_beyond_a_wall_leaves_the_wall(tmp_path: Path) -> None:
+    """Two rooms at one height 80 u apart (a wall between, each nav stopping short of it): a
+    full wall stands between them, not an opening."""
+    tris = triangles_of(tmp_path, [square(0, 0, 100, 0), square(180, 0, 100, 0)])
+    wall = faces_on_line(tris, 0, 100 + POLYGON_WALL_PUSH_U)
+    assert len(wall) and wall[:, :, 2].max() > 150
+
+
 def test_a_shared_edge_between_heights_gets_a_step_face(tmp_path: Path) -> None:
     tris = triangles_of(tmp_path, [square(0, 0, 100, 0), square(100, 0, 100, 40)])
     step = faces_on_line(tris, 0, 100)

@@ -14,8 +14,9 @@ The same rules as the CS:GO rectangle world (`nav_geometry.py`, whose constants 
   edge (where the nav stops short of the real walls), full height, capped below any floor
   overhead, left out where it would stand on another floor of the same level; an area within
   a jump in height across a gap of at most `BRIDGE_MAX_GAP_U`: floor to the gap's middle (a
-  hole in the mesh), closed by a face from the higher side; any other area near (higher or
-  lower): floor to the push, then a face between the two heights (a ledge to drop from, the
+  hole in the mesh), closed by a face from the higher side; one of that level farther than
+  `SAME_LEVEL_REACH_U`: a wall, as for nothing near; any other area near (higher or lower):
+  floor to the push, then a face between the two heights (a ledge to drop from, the
   foot of a box to jump onto), none where that face would hang into a passage under a
   walkway. Every open piece's floor runs on under its push.
 * **Corners.** Where two walls meet at a corner of the open boundary, a wall joins their ends
@@ -52,6 +53,9 @@ POLYGON_WALL_PUSH_U = 24.0
 """How far walls stand beyond an open edge: measured, the median distance from the CS2
 de_dust2 nav's open edges to the walls of the brush mesh of ../shared/data/meshes
 (benchmarks/studies/cs2_world.py), where CS:GO's nav stops `WALL_PUSH_U` short."""
+SAME_LEVEL_REACH_U = 2 * POLYGON_WALL_PUSH_U
+"""A floor of the same level (within a jump) farther beyond an open edge than this has a wall
+between: both stop that far short of it (CS:GO's world counts three of its pushes)."""
 GRID_U = 64.0
 """Cell size of the index that finds the areas under a point."""
 OVERHEAD_U = 72.0
@@ -278,6 +282,8 @@ def _open_faces(
         mid = (t0 + t1) / 2
         z0, z1, zm = (float(edges.point(e, t)[2]) for t in (t0, t1, mid))
         found = _beyond(edges, floors, e, mid, zm)
+        if found is not None and abs(found[1] - zm) <= JUMP_U and found[0] > SAME_LEVEL_REACH_U:
+            found = None  # a floor of this level so far off has a wall between
         if found is None:
             top = _wall_top(edges, floors, e, mid, zm)
             tris += _strip(edges, e, t0, t1, POLYGON_WALL_PUSH_U, z0, z1)
