@@ -71,8 +71,6 @@ def batch(k: int, seed: int = 0, weapons: list[str] | None = None) -> CombatBatc
         attacker_weapon=np.array(weapons or rng.choice(WEAPONS, k).tolist(), dtype=object),
         victim_armor=rng.integers(0, 101, k).astype(np.int16),
         victim_helmet=rng.integers(0, 2, k).astype(bool),
-        distance=np.linalg.norm(v - a, axis=1),
-        bearing=np.zeros(k),
         map_name="de_dust2",
     )
 
@@ -250,8 +248,6 @@ def test_simulator_and_training_batches_encode_alike() -> None:
         attacker_weapon=np.array(["AK-47", "M4A4"], dtype=object),
         victim_armor=np.array([0, 100], np.int16),
         victim_helmet=np.array([False, True]),
-        distance=np.zeros(2),  # encode derives distance and bearing from the positions
-        bearing=np.zeros(2),
         map_name="de_dust2",
     )
     for spec in (FeatureSpec(), PAPER_SPEC):

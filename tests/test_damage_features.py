@@ -54,8 +54,6 @@ def batch_of(
         attacker_weapon=np.asarray(weapons, dtype=object),
         victim_armor=np.asarray(armor if armor is not None else [0] * k, np.int16),
         victim_helmet=np.asarray(helmet if helmet is not None else [False] * k, bool),
-        distance=np.linalg.norm(v - a, axis=1),
-        bearing=np.zeros(k),
         map_name=map_name,
     )
 

@@ -158,8 +158,6 @@ def hand_built_batch() -> CombatBatch:
         attacker_weapon=np.array(["AK-47", "AWP", "Glock-18", "USP-S", "M4A1"], dtype=object),
         victim_armor=np.array([100, 0, 100, 50, 0], np.int16),
         victim_helmet=np.array([True, False, False, True, False]),
-        distance=np.linalg.norm(v - a, axis=1),
-        bearing=np.zeros(5),
         map_name="de_dust2",
     )
 

@@ -11,6 +11,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "decoy_cli"
 LAYERS = {
     # shared facts and helpers
     "csgo": 0,
+    "geometry": 0,  # facing, bearings, the eye point: on csgo's eye height
     "compiled": 0,
     "errors": 0,
     "files": 0,

@@ -10,8 +10,10 @@ import pytest
 from worlds import box, floor, wall
 
 from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M, TICK_RATE
+from decoy_cli.geometry import bearing
 from decoy_cli.sim.combat import (
     HIT_GROUPS,
+    PAIR_FIELDS,
     REACTION_S,
     CombatBatch,
     CombatStep,
@@ -283,7 +285,7 @@ def _batch(agents: Agents, pairs: list[tuple[int, int]], map_name: str = "de_dus
     return make_batch(agents, VisiblePairs(a, v), map_name)
 
 
-def test_batch_fields_and_bearing_convention() -> None:
+def test_batch_fields_and_distance() -> None:
     agents = _agents(
         ["T", "CT", "CT", "CT", "CT"],
         [(0, 0, 0), (0, 5, 0), (0, -5, 1), (-5, 0, 0), (0, 0, 3)],
@@ -297,10 +299,6 @@ def test_batch_fields_and_bearing_convention() -> None:
     assert isinstance(batch, CombatBatch) and len(batch) == 5
     assert batch.map_name == "de_dust2"
     np.testing.assert_allclose(batch.distance, [5.0, np.hypot(5, 1), 5.0, 3.0, 5.0])
-    # yaw 0 looks east: north is to the left (+), south to the right (-), west behind (-pi)
-    np.testing.assert_allclose(batch.bearing[:4], [np.pi / 2, -np.pi / 2, -np.pi, 0.0])
-    # agent 1 looks 10 degrees north of east; agent 0 lies due south of it: -100 degrees
-    np.testing.assert_allclose(batch.bearing[4], np.radians(-100.0))
     assert batch.attacker_weapon.tolist() == ["AK-47"] * 4 + ["M4A4"]
     assert batch.attacker_hp.tolist() == [90, 90, 90, 90, 80]
     assert batch.victim_hp.tolist() == [80, 70, 60, 50, 90]
@@ -316,13 +314,17 @@ def test_batch_fields_and_bearing_convention() -> None:
     assert batch.attacker_hp[0] == 90
 
 
-def test_bearing_wraps_into_minus_pi_to_pi() -> None:
-    yaws = np.array([350.0, 10.0, 180.0, -170.0, 720.0])
-    victims = [(np.cos(np.radians(d)), np.sin(np.radians(d)), 0.0) for d in (10, 350, 170, 170, 0)]
-    agents = _agents(["T"] * 5 + ["CT"] * 5, [(0, 0, 0)] * 5 + victims, yaw=np.r_[yaws, [0] * 5])
-    batch = _batch(agents, [(k, 5 + k) for k in range(5)])
-    np.testing.assert_allclose(np.degrees(batch.bearing), [20, -20, -10, -20, 0], atol=1e-9)
-    assert np.all((batch.bearing >= -np.pi) & (batch.bearing < np.pi))
+def test_batches_join_in_order_and_keep_their_map() -> None:
+    agents = _agents(["T", "CT", "CT"], [(0, 0, 0), (0, 5, 0), (3, 0, 4)])
+    first, second = _batch(agents, [(0, 1)]), _batch(agents, [(0, 2), (1, 0)])
+    joined = CombatBatch.concat([first, second])
+    assert joined.attacker.tolist() == [0, 0, 1] and joined.victim.tolist() == [1, 2, 0]
+    np.testing.assert_allclose(joined.distance, [5.0, 5.0, 5.0])
+    assert joined.map_name == "de_dust2"
+    for name in PAIR_FIELDS:
+        assert len(getattr(joined, name)) == 3
+    with pytest.raises(ValueError, match="one map"):
+        CombatBatch.concat([first, _batch(agents, [(0, 1)], "de_nuke")])
 
 
 # ---- damage -----------------------------------------------------------------------------------
@@ -498,7 +500,9 @@ class Bearings:
 
     def __call__(self, batch: CombatBatch, rng: np.random.Generator) -> DamageResult:
         pairs = zip(batch.attacker.tolist(), batch.victim.tolist(), strict=True)
-        self.steps.append(dict(zip(pairs, np.degrees(batch.bearing).tolist(), strict=True)))
+        delta = batch.victim_position - batch.attacker_position
+        seen = np.degrees(bearing(delta[:, 0], delta[:, 1], batch.attacker_yaw))
+        self.steps.append(dict(zip(pairs, seen.tolist(), strict=True)))
         k = len(batch)
         return DamageResult(np.zeros(k, np.int64), np.full(k, -1), np.zeros(k, bool))
 

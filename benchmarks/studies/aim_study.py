@@ -31,7 +31,7 @@ import numpy as np
 from decoy_cli.damage import resolve_models
 from decoy_cli.damage.model_folder import load_dip
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
-from decoy_cli.modeling.fight_threshold import EYE
+from decoy_cli.geometry import eye_point
 from decoy_cli.modeling.filled_views import QUANTILES, hit_view_deviations
 from decoy_cli.modeling.network_evaluation import dip_probabilities
 from decoy_cli.modeling.samples import build_samples
@@ -82,7 +82,7 @@ def sight_to_damage() -> None:
     with PhysicsWorld(graph_world(builtin_graph())) as world:
         for kill in round_.kills.itertuples():
             a, v = names.index(kill.attackerName), names.index(kill.victimName)
-            sight = world.line_of_sight(position[a] + EYE, position[v] + EYE)
+            sight = world.line_of_sight(eye_point(position[a]), eye_point(position[v]))
             lost = [
                 f
                 for f in range(1, len(seconds))

@@ -30,8 +30,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.esta import read_match
+from decoy_cli.geometry import eye_point
 from decoy_cli.waypoints.build import build_graph, builtin_graph, graph_world
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.los_pairs import eye_pairs, random_node_pairs
@@ -70,7 +71,7 @@ def kill_eyes() -> np.ndarray:
             a, v = names.index(kill.attackerName), names.index(kill.victimName)
             pair = [round_.position[a, frame], round_.position[v, frame]]
             if np.all(np.isfinite(pair)):
-                eyes.append(np.array(pair) + np.array([0.0, 0.0, EYE_HEIGHT_M]))
+                eyes.append(eye_point(np.array(pair)))
     return np.asarray(eyes)
 
 

@@ -41,8 +41,9 @@ import numpy as np
 from decoy_cli.csgo import TICK_RATE
 from decoy_cli.damage import load_damage_model
 from decoy_cli.esta import RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.geometry import eye_point, facing_yaw
 from decoy_cli.metrics.kills import DEATH_WINDOW_S
-from decoy_cli.modeling.fight_threshold import EYE, enemies_in_sight
+from decoy_cli.modeling.fight_threshold import enemies_in_sight
 from decoy_cli.replay.deaths import replay_deaths
 from decoy_cli.replay.missing import fill_missing
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
@@ -57,8 +58,6 @@ from decoy_cli.world.physics import PhysicsWorld
 
 
 def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:
-    delta = v_pos - a_pos
-    bearing = (np.arctan2(delta[1], delta[0]) - np.radians(yaw) + np.pi) % (2 * np.pi) - np.pi
     batch = CombatBatch(
         np.array([attacker]),
         np.array([victim]),
@@ -71,8 +70,6 @@ def dip_hits(model, attacker, victim, a_pos, v_pos, yaw, weapon) -> bool:
         np.array([weapon], dtype=object),
         np.array([100], np.int16),
         np.array([True]),
-        np.array([np.linalg.norm(delta)]),
-        np.array([bearing]),
         "de_dust2",
     )
     return bool(model.decision.hit_probability(batch)[0] >= model.decision.threshold)
@@ -214,15 +211,17 @@ def main() -> None:
                 (round_.frame_seconds >= kill.seconds - DEATH_WINDOW_S)
                 & (round_.frame_seconds <= kill.seconds)
             )
-            a_eyes, v_eyes = (round_.position[i, before_kill] + EYE for i in (a, v))
+            a_eyes, v_eyes = (eye_point(round_.position[i, before_kill]) for i in (a, v))
             known = np.isfinite(a_eyes).all(axis=1) & np.isfinite(v_eyes).all(axis=1)
             for name, world in worlds.items():
-                seen[name] += bool(world.line_of_sight((a_pos + EYE)[None], (v_pos + EYE)[None])[0])
+                seen[name] += bool(
+                    world.line_of_sight(eye_point(a_pos)[None], eye_point(v_pos)[None])[0]
+                )
                 seen_frames[name] += bool(world.line_of_sight(a_eyes[known], v_eyes[known]).any())
             before = round_.position[a, max(j - 1, 0)]
             step = round_.position[a, j] - before
-            motion = float(np.degrees(np.arctan2(step[1], step[0])))
-            aimed = float(np.degrees(np.arctan2(*(v_pos - a_pos)[[1, 0]])))
+            motion = float(facing_yaw(step[0], step[1]))
+            aimed = float(facing_yaw(*(v_pos - a_pos)[[0, 1]]))
             weapon = str(filled.weapon[a, j])
             dip["along the motion"] += dip_hits(model, a, v, a_pos, v_pos, motion, weapon)
             dip["aimed at the victim"] += dip_hits(model, a, v, a_pos, v_pos, aimed, weapon)
@@ -246,7 +245,10 @@ def main() -> None:
             a, v, at = event.agent, int(event.other), event.tick / TICK_RATE
             right = bool(abs(truth.seconds[v] - at) <= DEATH_WINDOW_S)  # NaN (survived): False
             near = np.flatnonzero(np.abs(round_.frame_seconds - at) <= 1.0)
-            a_eyes, v_eyes = round_.position[a, near] + EYE, round_.position[v, near] + EYE
+            a_eyes, v_eyes = (
+                eye_point(round_.position[a, near]),
+                eye_point(round_.position[v, near]),
+            )
             known = np.isfinite(a_eyes).all(axis=1) & np.isfinite(v_eyes).all(axis=1)
             fight_kills[("reproducing a real death" if right else "wrong", "all")] += 1
             for name, world in worlds.items():

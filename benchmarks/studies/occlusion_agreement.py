@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from decoy_cli.bench.machine import machine_line
-from decoy_cli.csgo import EYE_HEIGHT_M
+from decoy_cli.geometry import eye_point
 from decoy_cli.waypoints.build import builtin_graph
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
@@ -25,7 +25,7 @@ def main() -> None:
     pairs = int(sys.argv[1]) if len(sys.argv) > 1 else 200_000
     graph = builtin_graph()
     rng = np.random.default_rng(0)
-    eyes = graph.positions + np.array([0.0, 0.0, EYE_HEIGHT_M])
+    eyes = eye_point(graph.positions)
     half = pairs // 2
     far_a, far_b = (eyes[rng.integers(len(eyes), size=half)] for _ in range(2))
     near_a = eyes[rng.integers(len(eyes), size=pairs - half)]

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.esta import Round, RoundFailure, collect_match_files, iter_rounds
+from decoy_cli.geometry import eye_point
 from decoy_cli.waypoints.build import canonical_map
 from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.meshfile import read_mesh
@@ -81,13 +81,12 @@ def main() -> None:
     scenes = {"built-in world": OcclusionScene(nav_world(map_name))}
     if args.mesh is not None:
         scenes[f"mesh {args.mesh.name}"] = OcclusionScene(read_mesh(args.mesh))
-    eye = np.array([0.0, 0.0, EYE_HEIGHT_M])
     width = max(len(source) for source in by_source) + 2 if by_source else 10
     print(f"{'source':<{width}}{'lines':>7}" + "".join(f"  {name:>28}" for name in scenes))
     for source, parts in by_source.items():
         ends = np.concatenate(parts)
         ends = ends[np.isfinite(ends).all(axis=1)]
-        starts, stops = ends[:, :3] + eye, ends[:, 3:] + eye
+        starts, stops = eye_point(ends[:, :3]), eye_point(ends[:, 3:])
         shares = [scene.clear(starts, stops).mean() for scene in scenes.values()]
         print(f"{source:<{width}}{len(ends):>7}" + "".join(f"  {share:>28.3f}" for share in shares))
 

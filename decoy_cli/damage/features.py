@@ -31,11 +31,11 @@ slot   "hammer" (the paper's, for its checkpoints)     "normalised" (the project
 
 A bearing is the direction from one player to the other (atan2 of the position difference)
 minus the first player's view yaw, in radians wrapped to [-pi, pi): 0 straight ahead, positive
-to the left. Distance and bearings are computed here from the positions and yaws with exactly
-the paper's formulas (the batch's own `distance` and `bearing` fields are not read), so no
-caller can feed a model a distance that disagrees with its positions. Yaws follow awpy's viewX:
-degrees, 0 = +x, counter-clockwise; "mod 360" only matters for yaws outside [0, 360), which
-awpy never writes.
+to the left (`decoy_cli.geometry.bearing`, the paper's formula). Distance and bearings are
+computed here from the positions and yaws (the batch's own `distance`, in metres, is not
+read), so no caller can feed a model a distance that disagrees with its positions. Yaws follow
+awpy's viewX: degrees, 0 = +x, counter-clockwise; "mod 360" only matters for yaws outside
+[0, 360), which awpy never writes.
 
 Why the project normalises: raw Hammer coordinates of several thousand units and distances in
 the thousands dominate the first Linear layer of each branch and make training slow and
@@ -60,6 +60,7 @@ import numpy as np
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import ModelError
 from decoy_cli.files import JsonObject
+from decoy_cli.geometry import bearing, wrap_pi
 from decoy_cli.sim.combat import HIT_GROUPS, CombatBatch
 
 MAPS: tuple[str, ...] = (
@@ -278,11 +279,6 @@ def weapon_index(names: np.ndarray | Sequence[str]) -> np.ndarray:
     return np.fromiter((_WEAPON_INDEX.get(str(n), -1) for n in names), np.int64, len(names))
 
 
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    """Radians wrapped to [-pi, pi), as the paper does it (floored remainder)."""
-    return np.mod(angle + np.pi, 2 * np.pi) - np.pi
-
-
 def encode(batch: CombatBatch, spec: FeatureSpec) -> Features:
     """The features of every pair of the batch (see the module docstring).
 
@@ -297,7 +293,7 @@ def encode(batch: CombatBatch, spec: FeatureSpec) -> Features:
     victim_yaw = np.asarray(batch.victim_yaw, dtype=np.float64).reshape(k)
     hp = np.asarray(batch.attacker_hp, dtype=np.float64).reshape(k)
     delta = victim - attacker
-    bearing = _wrap(np.arctan2(delta[:, 1], delta[:, 0]) - np.radians(attacker_yaw))
+    seen_by_attacker = bearing(delta[:, 0], delta[:, 1], attacker_yaw)
 
     coords = np.empty((k, COORDS), dtype=np.float64)
     if spec.units == "hammer":
@@ -310,16 +306,15 @@ def encode(batch: CombatBatch, spec: FeatureSpec) -> Features:
         centre = np.asarray(spec.centre_m)
         half = np.asarray(spec.half_extent_m)
         coords[:, 0:3] = (attacker - centre) / half
-        coords[:, 3] = _wrap(np.radians(attacker_yaw)) / np.pi
+        coords[:, 3] = wrap_pi(np.radians(attacker_yaw)) / np.pi
         coords[:, 4:7] = (victim - centre) / half
         if spec.units == "relative":  # nothing that names a place on one map
             coords[:, 0:7] = 0.0
             coords[:, 2] = delta[:, 2] / half[2]
-        seen_by_victim = np.arctan2(-delta[:, 1], -delta[:, 0]) - np.radians(victim_yaw)
-        coords[:, 7] = _wrap(seen_by_victim) / np.pi
+        coords[:, 7] = bearing(-delta[:, 0], -delta[:, 1], victim_yaw) / np.pi
         coords[:, 9] = np.linalg.norm(delta, axis=1) / spec.distance_scale_m
     coords[:, 8] = hp / 100.0
-    coords[:, 10] = bearing / np.pi
+    coords[:, 10] = seen_by_attacker / np.pi
     bad = ~np.all(np.isfinite(coords), axis=1)
     if np.any(bad):
         raise ModelError(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M, HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.esta.records import (
     BOMB_TIMER_S,
     ROUND_TIME_S,
@@ -18,6 +18,7 @@ from decoy_cli.esta.records import (
     player_key,
 )
 from decoy_cli.files import JsonObject, JsonValue
+from decoy_cli.geometry import eye_point
 from decoy_cli.weapons import WEAPONS
 
 _BUY_TYPES = ((5_000, "Full Eco"), (10_000, "Semi Eco"), (20_000, "Semi Buy"))
@@ -79,7 +80,7 @@ def frame_documents(
         step = moved / np.where(dt > 0, dt, np.inf)[:, None]
         moving = present[:, 1:] & present[:, :-1] & np.asarray(r.alive)[:, 1:]
         velocity[:, 1:] = np.where(moving[..., None], step, 0.0).astype(np.float32)
-    eye_z = to_hammer(position[..., 2] + EYE_HEIGHT_M)
+    eye_z = to_hammer(eye_point(position)[..., 2])
     columns = {
         "x": floats(hammer[..., 0]),
         "y": floats(hammer[..., 1]),

@@ -32,11 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
-from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.damage.combat import DipDecision, armed
 from decoy_cli.damage.model_folder import LoadedDip
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import Round, RoundFailure, collect_match_files, each_round, iter_rounds
+from decoy_cli.geometry import eye_point, facing_yaw
 from decoy_cli.modeling.calibration_fit import MIN_RECALL
 from decoy_cli.modeling.network_evaluation import dip_probabilities
 from decoy_cli.modeling.provenance import seen_in
@@ -60,7 +60,6 @@ GRID = tuple(round(0.05 * k, 2) for k in range(1, 20))
 HORIZON_S = 1.0
 """How long after a frame a lost HP counts (the 1 s frame interval of the real CS2 rounds; the
 label means the same at any frame rate)."""
-EYE = np.array([0.0, 0.0, EYE_HEIGHT_M])
 
 
 @dataclass(frozen=True)
@@ -97,7 +96,7 @@ def enemies_in_sight(
     marks whose eye position is known: the enemies alive at the frame with a known position,
     eye to eye in `world` at the real positions, in index order (none when none is)."""
     alive = np.asarray(round_.alive, bool) & np.asarray(round_.present, bool)
-    eyes = np.asarray(round_.position, dtype=np.float64) + EYE
+    eyes = eye_point(np.asarray(round_.position, dtype=np.float64))
     side = np.array([p.side for p in round_.players])
     known = alive & np.isfinite(eyes).all(axis=2)
     for frame in range(known.shape[1]):
@@ -138,7 +137,7 @@ def _pairs(parts: list[tuple[Round, np.ndarray]], map_name: str) -> FightPairs:
         attacker, victim, frame = rows[:, 0], rows[:, 1], rows[:, 2]
         position = np.asarray(round_.position, dtype=np.float64)
         at, to = position[attacker, frame], position[victim, frame]
-        facing = np.degrees(np.arctan2(to[:, 1] - at[:, 1], to[:, 0] - at[:, 0]))
+        facing = facing_yaw(to[:, 0] - at[:, 0], to[:, 1] - at[:, 1])
         hp = np.clip(np.asarray(round_.hp)[:, frame], 1, 100).astype(np.int16)
         weapon = np.asarray(round_.weapon, dtype=object)[attacker, frame].astype(str)
         batches.append(
@@ -154,8 +153,6 @@ def _pairs(parts: list[tuple[Round, np.ndarray]], map_name: str) -> FightPairs:
                 attacker_weapon=weapon,
                 victim_armor=np.asarray(round_.armor)[victim, frame].clip(0, 100).astype(np.int16),
                 victim_helmet=np.asarray(round_.helmet, bool)[victim, frame],
-                distance=np.linalg.norm(to - at, axis=1),
-                bearing=np.zeros(len(rows)),
                 map_name=map_name,
             )
         )
@@ -166,13 +163,8 @@ def _pairs(parts: list[tuple[Round, np.ndarray]], map_name: str) -> FightPairs:
             f"no round of {map_name or 'the map'} whose frames hold both teams has a frame with a "
             "player and exactly one enemy in sight: nothing to choose the fight's threshold on"
         )
-    fields = {
-        name: np.concatenate([getattr(b, name) for b in batches])
-        for name in CombatBatch.__dataclass_fields__
-        if name != "map_name"
-    }
     return FightPairs(
-        CombatBatch(**fields, map_name=map_name),
+        CombatBatch.concat(batches),
         np.concatenate(lost),
         np.concatenate(numbers),
         len(parts),

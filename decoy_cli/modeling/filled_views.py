@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from decoy_cli.esta import Round
+from decoy_cli.geometry import facing_yaw, wrap_180
 from decoy_cli.modeling.sample_set import SampleStats
 from decoy_cli.weapons import FIREARMS
 
@@ -54,8 +55,8 @@ def _deviations(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     """(attacker, victim) view minus the facing bearing per row, degrees in [-180, 180)."""
     dx = (table["victimX_m"] - table["attackerX_m"]).to_numpy(np.float64)
     dy = (table["victimY_m"] - table["attackerY_m"]).to_numpy(np.float64)
-    facing = np.degrees(np.arctan2(dy, dx))
-    attacker = (table["attackerViewX"].to_numpy(np.float64) - facing + 180.0) % 360.0 - 180.0
+    facing = facing_yaw(dx, dy)
+    attacker = wrap_180(table["attackerViewX"].to_numpy(np.float64) - facing)
     victim = (table["victimViewX"].to_numpy(np.float64) - facing) % 360.0 - 180.0
     return attacker, victim
 

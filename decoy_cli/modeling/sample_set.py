@@ -16,7 +16,7 @@ import numpy as np
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage.features import Features, FeatureSpec, encode
 from decoy_cli.esta import RoundFailure
-from decoy_cli.sim.combat import CombatBatch
+from decoy_cli.sim.combat import PAIR_FIELDS, CombatBatch
 
 MAX_DAMAGE_HP = 100.0
 """DOG's damage target is capped here (decoy_cli/modeling/damage_rows.py says why)."""
@@ -81,26 +81,10 @@ class Samples:
         maps = np.unique(self.map_name[rows])
         if len(maps) > 1:
             raise ValueError(f"a CombatBatch holds one map, these samples hold {len(maps)}")
-        a, v = self.attacker_position[rows], self.victim_position[rows]
-        delta = v - a
-        ahead = np.arctan2(delta[:, 1], delta[:, 0]) - np.radians(self.attacker_yaw[rows])
-        bearing = np.where(
-            np.hypot(delta[:, 0], delta[:, 1]) > 0, (ahead + np.pi) % (2 * np.pi) - np.pi, 0.0
-        )
         return CombatBatch(
             attacker=rows.astype(np.int64),
             victim=rows.astype(np.int64),
-            attacker_position=a,
-            victim_position=v,
-            attacker_yaw=self.attacker_yaw[rows],
-            victim_yaw=self.victim_yaw[rows],
-            attacker_hp=self.attacker_hp[rows],
-            victim_hp=self.victim_hp[rows],
-            attacker_weapon=self.attacker_weapon[rows],
-            victim_armor=self.victim_armor[rows],
-            victim_helmet=self.victim_helmet[rows],
-            distance=np.linalg.norm(delta, axis=1),
-            bearing=bearing,
+            **{name: getattr(self, name)[rows] for name in PAIR_FIELDS},
             map_name=str(maps[0]) if len(maps) else BUILTIN_MAP,
         )
 

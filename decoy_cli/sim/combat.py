@@ -18,12 +18,15 @@ from here too.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Protocol
 
 import numpy as np
 
 from decoy_cli.csgo import seconds_to_ticks
+from decoy_cli.geometry import eye_point, facing_yaw
 from decoy_cli.sim.sight import LOS_GROUP, LineOfSight, VisiblePairs
 from decoy_cli.sim.state import Agents, SimEvent
 from decoy_cli.sim.utility import FIRE_HP_PER_S, Utility
@@ -32,6 +35,7 @@ __all__ = [
     "HIT_GROUPS",
     "LOS_GROUP",
     "NO_HIT",
+    "PAIR_FIELDS",
     "REACTION_S",
     "CombatBatch",
     "CombatStep",
@@ -66,11 +70,10 @@ whose agents never aim hits far less."""
 class CombatBatch:
     """What a damage model sees of K visible ordered (attacker, victim) pairs.
 
-    Positions are the feet in metres; yaws are degrees (0 = +x, counter-clockwise). `distance`
-    is the 3-D distance between the feet. `bearing` is the horizontal direction of the victim
-    seen from the attacker, relative to the attacker's view yaw, radians in [-pi, pi): 0 straight
-    ahead, positive to the attacker's left (counter-clockwise), negative to the right; 0 for a
-    victim straight above or below.
+    Positions are the feet in metres; yaws are degrees (0 = +x, counter-clockwise). It holds
+    the pairs' state only (`PAIR_FIELDS`, with the indices and the map): `distance` is derived
+    from it, `concat` joins batches, and a damage model that wants bearings computes them from
+    the positions and yaws (`decoy_cli.geometry.bearing`).
     """
 
     attacker: np.ndarray  # (K,) int64 agent index
@@ -84,12 +87,39 @@ class CombatBatch:
     attacker_weapon: np.ndarray  # (K,) str (awpy display names)
     victim_armor: np.ndarray  # (K,) int16
     victim_helmet: np.ndarray  # (K,) bool
-    distance: np.ndarray  # (K,) float64 metres
-    bearing: np.ndarray  # (K,) float64 radians
     map_name: str
 
     def __len__(self) -> int:
         return len(self.attacker)
+
+    @cached_property
+    def distance(self) -> np.ndarray:
+        """(K,) float64 the 3-D distance between the feet, metres."""
+        victim = np.asarray(self.victim_position, dtype=np.float64)
+        return np.linalg.norm(victim - np.asarray(self.attacker_position, dtype=np.float64), axis=1)
+
+    @staticmethod
+    def concat(parts: Sequence[CombatBatch]) -> CombatBatch:
+        """The pairs of all the batches, in order (one map: theirs)."""
+        maps = {part.map_name for part in parts}
+        if len(maps) != 1:
+            raise ValueError(f"batches of one map are joined, got maps {sorted(maps)}")
+        return CombatBatch(
+            **{
+                name: np.concatenate([getattr(part, name) for part in parts])
+                for name in ("attacker", "victim", *PAIR_FIELDS)
+            },
+            map_name=maps.pop(),
+        )
+
+
+PAIR_FIELDS = tuple(
+    name
+    for name in CombatBatch.__dataclass_fields__
+    if name not in ("attacker", "victim", "map_name")
+)
+"""The state of each pair a `CombatBatch` holds: its attacker's and victim's positions, yaws,
+HP, the attacker's weapon, the victim's armour and helmet (one array each)."""
 
 
 def make_batch(
@@ -105,9 +135,6 @@ def make_batch(
         raise ValueError(f"pair indices outside 0..{agents.count - 1}")
     position = np.asarray(agents.position, dtype=np.float64)
     yaw = np.asarray(agents.yaw if yaw is None else yaw, dtype=np.float64)
-    delta = position[v] - position[a]
-    ahead = np.arctan2(delta[:, 1], delta[:, 0]) - np.radians(yaw[a])
-    bearing = np.where(np.hypot(delta[:, 0], delta[:, 1]) > 0, _wrap(ahead), 0.0)
     return CombatBatch(
         attacker=a,
         victim=v,
@@ -120,8 +147,6 @@ def make_batch(
         attacker_weapon=np.asarray(agents.weapon)[a],
         victim_armor=np.asarray(agents.armor)[v],
         victim_helmet=np.asarray(agents.helmet, dtype=bool)[v],
-        distance=np.linalg.norm(delta, axis=1),
-        bearing=bearing,
         map_name=map_name,
     )
 
@@ -137,13 +162,8 @@ def aimed_yaw(agents: Agents, pairs: VisiblePairs, aims: np.ndarray) -> np.ndarr
     delta = position[victim, :2] - position[attacker, :2]
     order = np.lexsort((np.hypot(delta[:, 0], delta[:, 1]), attacker))  # nearest first
     nearest = order[np.r_[True, attacker[order][1:] != attacker[order][:-1]]]
-    yaw[attacker[nearest]] = np.degrees(np.arctan2(delta[nearest, 1], delta[nearest, 0]))
+    yaw[attacker[nearest]] = facing_yaw(delta[nearest, 0], delta[nearest, 1])
     return yaw
-
-
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    """Angles in radians wrapped to [-pi, pi)."""
-    return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
 @dataclass(frozen=True)
@@ -318,9 +338,7 @@ class CombatStep:
         """The pairs smoke does not hide, less those whose attacker is blind (he does not
         shoot; a blind victim is still seen)."""
         assert self.utility is not None
-        eyes = np.asarray(agents.position, dtype=np.float64) + np.array(
-            [0.0, 0.0, self.los.eye_height]
-        )
+        eyes = eye_point(np.asarray(agents.position, dtype=np.float64), self.los.eye_height)
         keep = ~self.utility.sight_blocked(eyes[pairs.attacker], eyes[pairs.victim], tick)
         keep &= ~self.utility.blinded(agents.count, tick)[pairs.attacker]
         return VisiblePairs(pairs.attacker[keep], pairs.victim[keep])

@@ -33,6 +33,7 @@ import numpy as np
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import EYE_HEIGHT_M, PLAYER_HEIGHT_M, PLAYER_RADIUS_M
+from decoy_cli.geometry import eye_point
 from decoy_cli.sim.state import Agents
 from decoy_cli.world.occlusion import OcclusionScene
 from decoy_cli.world.physics import WORLD_GROUP, PhysicsWorld
@@ -137,7 +138,7 @@ class LineOfSight:
         if not clear.any():
             return _no_pairs()
         if np.count_nonzero(alive) > 2:
-            eyes = feet + np.array([0.0, 0.0, self.eye_height])
+            eyes = eye_point(feet, self.eye_height)
             self._place(feet, alive)
             ray = np.flatnonzero(clear)
             clear[ray] = self._bodies_clear(eyes, first[ray], second[ray])

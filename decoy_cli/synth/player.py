@@ -18,6 +18,7 @@ import numpy as np
 
 from decoy_cli.esta.frames import Side
 from decoy_cli.esta.records import EstaRoundRecord, PlayerRecord
+from decoy_cli.geometry import facing_yaw
 from decoy_cli.sim.combat import DamageModel
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import SiteZones
@@ -93,11 +94,9 @@ def scripted_agents(graph: WaypointGraph, script: RoundScript) -> Agents:
     start_nodes = np.array([route[0].node for route in plan.routes], dtype=np.int64)
     positions = graph.positions[start_nodes]
     first_moves = [route[1].node if len(route) > 1 else route[0].node for route in plan.routes]
-    yaw = np.degrees(
-        np.arctan2(
-            graph.positions[first_moves, 1] - positions[:, 1],
-            graph.positions[first_moves, 0] - positions[:, 0],
-        )
+    yaw = facing_yaw(
+        graph.positions[first_moves, 0] - positions[:, 0],
+        graph.positions[first_moves, 1] - positions[:, 1],
     )
     return Agents.create(
         names=list(team.names),

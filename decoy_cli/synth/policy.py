@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from decoy_cli.geometry import facing_yaw
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.state import BombStatus
 from decoy_cli.synth.routes import SITE_PLACES, Leg, Places, RoutePlan
@@ -103,7 +104,7 @@ class ScriptedPolicy:
             np.argmin(np.linalg.norm(agents.position[enemies] - agents.position[agent], axis=1))
         ]
         delta = agents.position[nearest] - agents.position[agent]
-        agents.yaw[agent] = float(np.degrees(np.arctan2(delta[1], delta[0])))
+        agents.yaw[agent] = float(facing_yaw(delta[0], delta[1]))
         return self._hold()
 
     # ---- legs, paths, holds -------------------------------------------------------------------

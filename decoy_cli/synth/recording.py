@@ -21,6 +21,7 @@ from decoy_cli.esta.records import (
     DamageRecord,
     KillRecord,
 )
+from decoy_cli.geometry import facing_yaw, wrap_180
 from decoy_cli.sim.combat import HIT_GROUPS
 from decoy_cli.sim.engine import Simulator
 from decoy_cli.sim.rules import SiteZones
@@ -231,6 +232,6 @@ def _awpy_hit_group(
     name = HIT_GROUPS[code]
     if name not in ("Arm", "Leg"):
         return name
-    bearing = np.degrees(np.arctan2(attacker[1] - victim[1], attacker[0] - victim[0])) - victim_yaw
-    left = (bearing + 180.0) % 360.0 - 180.0 >= 0.0
+    seen = facing_yaw(attacker[0] - victim[0], attacker[1] - victim[1]) - victim_yaw
+    left = wrap_180(seen) >= 0.0
     return f"{'Left' if left else 'Right'}{name}"

@@ -29,6 +29,7 @@ import numpy as np
 
 from decoy_cli.csgo import tick_at
 from decoy_cli.errors import GraphError
+from decoy_cli.geometry import facing_yaw
 from decoy_cli.sim.rules import SiteZones
 from decoy_cli.waypoints.graph import WaypointGraph
 
@@ -214,7 +215,7 @@ class Places:
     def yaw_towards(self, position: np.ndarray, place: str) -> float:
         """View yaw (degrees, 0 = +x, counter-clockwise) from a position to a place's centre."""
         delta = self.centre(place) - np.asarray(position, dtype=np.float64)
-        return float(np.degrees(np.arctan2(delta[1], delta[0])))
+        return float(facing_yaw(delta[0], delta[1]))
 
 
 @dataclass(frozen=True)

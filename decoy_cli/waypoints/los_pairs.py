@@ -14,6 +14,7 @@ import numpy as np
 
 from decoy_cli.csgo import EYE_HEIGHT_M
 from decoy_cli.errors import GraphError
+from decoy_cli.geometry import eye_point
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.los import LosComparison
 
@@ -62,7 +63,7 @@ def eye_pairs(
     nodes = np.asarray(nodes, dtype=np.int64).reshape(-1, 2)
     if len(nodes) and (nodes.min() < 0 or nodes.max() >= graph.num_nodes):
         raise GraphError(f"node pairs refer to waypoints outside 0..{graph.num_nodes - 1}")
-    return graph.positions[nodes] + np.array([0.0, 0.0, eye_height])
+    return eye_point(graph.positions[nodes], eye_height)
 
 
 @dataclass(frozen=True)
