@@ -22,7 +22,6 @@ from decoy_cli.waypoints.build import (
     build_graph,
     builtin_graph,
     graph_world,
-    pick_world,
 )
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
@@ -339,16 +338,12 @@ def test_the_shipped_cs2_graph_carries_a_cs2_world() -> None:
     assert all(len(nodes) > 50 for nodes in graph.regions.values())
 
 
-def test_auto_picks_the_cs2_world_for_cs2_data_of_a_map_that_has_one() -> None:
-    assert pick_world("auto", cs2_data=True, map_name="de_dust2") == "cs2"
-    assert pick_world("auto", cs2_data=False, map_name="de_dust2") == "csgo"
-    assert pick_world("auto", cs2_data=True, map_name="de_nuke") == "csgo"  # none shipped
-    assert pick_world("cs2", cs2_data=False, map_name="de_dust2") == "cs2"
+def test_a_map_without_a_cs2_world_says_so() -> None:
     with pytest.raises(GraphError, match="ships no CS2 world of de_nuke"):
         builtin_graph("de_nuke", "cs2")
 
 
-def test_evaluate_names_the_world_it_picked_for_cs2_data(tmp_path: Path) -> None:
+def test_evaluate_names_the_world_it_replays_on(tmp_path: Path) -> None:
     from decoy_cli.esta import read_match
     from decoy_cli.esta.awpy.writer import write_awpy2_zip
     from decoy_cli.synth.sample import SAMPLE_DIR
@@ -356,7 +351,7 @@ def test_evaluate_names_the_world_it_picked_for_cs2_data(tmp_path: Path) -> None
     sample = read_match(sorted(SAMPLE_DIR.glob("*.json*"))[0])
     zipped = write_awpy2_zip(sample, tmp_path / "m.zip")
     out = tmp_path / "run"
-    args = ["evaluate", str(zipped), "--sample", "1", "--no-combat", "--no-bomb"]
+    args = ["evaluate", str(zipped), "--sample", "1", "--no-combat", "--no-bomb", "--world", "cs2"]
     result = runner.invoke(app, [*args, "--workers", "1", "--no-view", "--out", str(out)])
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "summary.json").read_text())
@@ -365,13 +360,13 @@ def test_evaluate_names_the_world_it_picked_for_cs2_data(tmp_path: Path) -> None
     assert "| world | CS2 de_dust2 nav mesh" in (out / "report.md").read_text()
 
 
-def test_snap_snaps_cs2_data_to_the_cs2_world_unless_told_otherwise(tmp_path: Path) -> None:
+def test_snap_snaps_to_the_world_asked_for(tmp_path: Path) -> None:
     from decoy_cli.esta import read_match
     from decoy_cli.esta.awpy.writer import write_awpy2_zip
     from decoy_cli.synth.sample import SAMPLE_DIR
 
     zipped = write_awpy2_zip(read_match(sorted(SAMPLE_DIR.glob("*.json*"))[0]), tmp_path / "m.zip")
-    for world, expected in (([], "world: CS2 de_dust2"), (["--world", "csgo"], "world: built-in")):
+    for world, expected in ((["--world", "cs2"], "world: CS2 de_dust2"), ([], "world: built-in")):
         result = runner.invoke(app, ["snap", f"{zipped}:1", *world], env={"COLUMNS": "200"})
         assert result.exit_code == 0, result.output
         assert expected in result.output

@@ -30,7 +30,7 @@ from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.sim.setup import MoverName
-from decoy_cli.waypoints.build import WorldChoice
+from decoy_cli.waypoints.build import GameWorld
 
 MAPS_HELP = "one of " + ", ".join(m.removeprefix("de_") for m in MAP_NAMES) + " (de_ optional)"
 """The built-in maps, for the help of every `--map`."""
@@ -63,14 +63,14 @@ MOVER_HELP = (
 
 
 WORLD_HELP = (
-    "The world to replay on without --graph: auto (CS2's for CS2 data, read from awpy's tables "
-    "or a demo, where decoy ships one: de_dust2; else CS:GO's), csgo or cs2."
+    "The world to replay on without --graph: CS:GO's (csgo), or CS2's (cs2, shipped for "
+    "de_dust2: movement closer to CS2 data, the fight calibrated on CS:GO's; docs/cs2.md)."
 )
 
 
-def world_option() -> WorldChoice:
+def world_option() -> GameWorld:
     """The `--world` option (Typer's parameter default)."""
-    return typer.Option("auto", "--world", help=WORLD_HELP)
+    return typer.Option("csgo", "--world", help=WORLD_HELP)
 
 
 def mover_option(default: MoverName) -> MoverName:

@@ -29,7 +29,6 @@ from decoy_cli.damage import parse_models
 from decoy_cli.damage.model_maps import map_warnings
 from decoy_cli.errors import DecoyError
 from decoy_cli.esta import collect_match_files
-from decoy_cli.esta.awpy.tables import is_awpy_source
 from decoy_cli.evaluate.bomb_report import BOMB_HEADER, bomb_rows
 from decoy_cli.evaluate.markdown import interval, num
 from decoy_cli.evaluate.outputs import output_lock, write_outputs
@@ -53,7 +52,7 @@ from decoy_cli.evaluate.runner import (
 )
 from decoy_cli.evaluate.tables import Tables, build_tables
 from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
-from decoy_cli.waypoints.build import WorldChoice
+from decoy_cli.waypoints.build import GameWorld
 
 if TYPE_CHECKING:
     from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
@@ -81,7 +80,7 @@ def evaluate(
         help="Waypoint graph (.npz from build-waypoints, e.g. with --learn-patches) to replay "
         "on, with the world it was built on; its map must be --map. Default: the shipped one.",
     ),
-    world: WorldChoice = world_option(),
+    world: GameWorld = world_option(),
     sample: int | None = typer.Option(
         None, "--sample", min=1, help="Evaluate a random sample of N rounds (see --seed)."
     ),
@@ -139,7 +138,7 @@ def evaluate(
     """
     console = make_console()
     inputs = inputs or default_inputs()
-    files, _ = collect_match_files(inputs)  # bad paths fail here, before models are loaded
+    collect_match_files(inputs)  # bad paths fail here, before a damage model is loaded
     given = run_options
     settings = make_settings(
         map_name=map_name,
@@ -156,7 +155,6 @@ def evaluate(
         graph=graph,
         sight_mesh=given.sight_mesh,
         world=world,
-        cs2_data=bool(files) and all(is_awpy_source(f) for f in files),
     )
     command = command_line(inputs, settings, sample, out)
     backend: DaskBackend | LocalBackend

@@ -19,7 +19,7 @@ from decoy_cli.replay.bomb_fidelity import BombRow
 from decoy_cli.replay.replayer import ReplayOptions
 from decoy_cli.replay.single import replay_address
 from decoy_cli.text import shortened, visible
-from decoy_cli.waypoints.build import WorldChoice
+from decoy_cli.waypoints.build import GameWorld
 
 NOTE_LIMIT = 400
 """Most characters of a note printed (the names in it come from the data)."""
@@ -39,7 +39,7 @@ def replay(
         "--graph",
         help="Waypoint graph (.npz from build-waypoints; default: the built-in one of the map).",
     ),
-    world: WorldChoice = world_option(),
+    world: GameWorld = world_option(),
     out: Path | None = typer.Option(
         None,
         "--out",

@@ -21,14 +21,7 @@ from decoy_cli.commands._snap_output import (
 )
 from decoy_cli.csgo import MAP_NAMES
 from decoy_cli.errors import DecoyError, EstaError
-from decoy_cli.esta import (
-    Round,
-    collect_match_files,
-    iter_match_files,
-    parse_round_address,
-    read_match,
-)
-from decoy_cli.esta.awpy.tables import is_awpy_source
+from decoy_cli.esta import Round, iter_match_files, parse_round_address, read_match
 from decoy_cli.files import write_csv
 from decoy_cli.replay import DEFAULT_MAX_SNAP_M
 from decoy_cli.replay.plot import plot_round_plan
@@ -40,7 +33,7 @@ from decoy_cli.replay.study import (
     study_round,
 )
 from decoy_cli.sim.setup import RoundSetup
-from decoy_cli.waypoints.build import WorldChoice, builtin_graph, canonical_map, pick_world
+from decoy_cli.waypoints.build import GameWorld, builtin_graph, canonical_map
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import load_navmesh
 
@@ -61,7 +54,7 @@ def snap(
     graph_file: Path | None = typer.Option(
         None, "--graph", help="Waypoint graph (.npz from build-waypoints; overrides --map)."
     ),
-    world: WorldChoice = world_option(),
+    world: GameWorld = world_option(),
     max_snap: float = typer.Option(
         DEFAULT_MAX_SNAP_M,
         "--max-snap",
@@ -101,15 +94,9 @@ def snap(
     console = make_console()
     map_id = canonical_map(map_name)
     path = Path(target)
-    if graph_file is not None and world != "auto":
+    if graph_file is not None and world != "csgo":
         raise DecoyError("--graph brings its own world: leave out --world")
-    if graph_file is not None:
-        graph = WaypointGraph.load(graph_file)
-    else:
-        source = path if path.exists() else Path(target.rsplit(":", 1)[0])
-        files = collect_match_files([source])[0] if source.exists() else []
-        cs2_data = bool(files) and all(is_awpy_source(f) for f in files)
-        graph = builtin_graph(map_id, pick_world(world, cs2_data, map_id))
+    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id, world)
     if path.exists():
         for option, given in (
             ("--plot", plot is not None),

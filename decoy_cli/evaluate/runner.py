@@ -56,7 +56,7 @@ from decoy_cli.evaluate.tables import Accumulator
 from decoy_cli.replay.deaths import DeathProtocol
 from decoy_cli.replay.missing import Missing
 from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING, MoverName
-from decoy_cli.waypoints.build import WorldChoice
+from decoy_cli.waypoints.build import GameWorld
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.places import place_names
 from decoy_cli.world.occlusion import read_sight_scene
@@ -133,21 +133,20 @@ def make_settings(
     fastdtw: bool | None = None,
     graph: Path | None = None,
     sight_mesh: Path | None = None,
-    world: WorldChoice = "auto",
-    cs2_data: bool = False,
+    world: GameWorld = "csgo",
 ) -> EvalSettings:
     """Settings for a run; with combat the damage model is loaded once here, so a bad
     `--models` choice fails at once with one line instead of in every round. `fastdtw` None
     means: on for the paper's Table 2 setting (no combat, no bomb), off otherwise. The world:
-    the graph's, else the one `world` picks (`pick_world`; `cs2_data`: every input is CS2's)."""
-    from decoy_cli.waypoints.build import builtin_graph, canonical_map, pick_world
+    the graph's, else the shipped one `world` names."""
+    from decoy_cli.waypoints.build import builtin_graph, canonical_map
 
     name = canonical_map(map_name)
     graph_path, graph_sha = "", ""
     graph_of_run = None
-    if graph is not None and world != "auto":
+    if graph is not None and world != "csgo":
         raise DecoyError("--graph brings its own world: leave out --world")
-    world_of_run = "" if graph is not None else pick_world(world, cs2_data, name)
+    world_of_run = "" if graph is not None else world
     if world_of_run == "cs2":
         graph_of_run = builtin_graph(name, "cs2")  # fails now when none ships
     if graph is not None:  # absolute, for workers elsewhere; its map must be the run's

@@ -30,7 +30,6 @@ GRAPH_FILE = "waypoints.npz"
 CS2_GRAPH_FILE = "cs2_waypoints.npz"
 """A map's graph on its CS2 world (built with `--nav` from CS2's nav mesh; it carries the world)."""
 GameWorld = Literal["csgo", "cs2"]
-WorldChoice = Literal["auto", "csgo", "cs2"]
 CARRIED_KIND = POLYGON_NAV_KIND
 """Worlds of this kind are not in the package: a graph built on one carries it."""
 
@@ -158,16 +157,6 @@ def builtin_graph(map_name: str = BUILTIN_MAP, world: GameWorld = "csgo") -> Way
             "--nav FILE` and give it with --graph"
         )
     return WaypointGraph.load(folder / CS2_GRAPH_FILE)
-
-
-def pick_world(asked: WorldChoice, cs2_data: bool, map_name: str) -> GameWorld:
-    """The world rounds of `map_name` replay on: the one `asked`, or with "auto" CS2's when the
-    data is CS2's (`cs2_data`: read from awpy's tables, which only CS2 demos give) and the
-    package ships a CS2 world of the map, else CS:GO's."""
-    if asked != "auto":
-        return asked
-    shipped = (asset_dir(canonical_map(map_name)) / CS2_GRAPH_FILE).is_file()
-    return "cs2" if cs2_data and shipped else "csgo"
 
 
 def graph_world(graph: WaypointGraph) -> World:
