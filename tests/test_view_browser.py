@@ -210,6 +210,32 @@ def test_zoom_pan_and_reset(browser: Browser, run: Path) -> None:
     assert browser.screenshot() == whole
 
 
+def test_hovering_a_player_names_him_his_weapon_and_hp(browser: Browser, run: Path) -> None:
+    data = page_data(run / "view.html")
+    browser.open(run / "view.html")
+    _set_slider(browser, 20)
+    assert browser.evaluate("document.getElementById('hover').textContent") == ""
+    box = _box(browser, "#map")
+    text = ""
+    for y in np.linspace(box["y"] + 5, box["y"] + box["h"] - 5, 40):  # until a player is hit
+        for x in np.linspace(box["x"] + 5, box["x"] + box["w"] - 5, 40):
+            browser.call(
+                "Input.dispatchMouseEvent",
+                {"type": "mouseMoved", "x": float(x), "y": float(y)},
+                session=True,
+            )
+            text = browser.evaluate("document.getElementById('hover').textContent")
+            if text:
+                break
+        if text:
+            break
+    names = {p["name"] for shown in data["rounds"] for p in shown["players"]}
+    name = text.split(" (")[0]
+    assert name in names, text
+    weapon = text.split(" · weapon ")[1].split(" · ")[0]
+    assert weapon and weapon != "–" and " · HP real " in text, text
+
+
 def test_the_heatmap_layer(browser: Browser, run: Path) -> None:
     browser.open(run / "view.html")
     _set_slider(browser, 20)
