@@ -25,7 +25,7 @@ from decoy_cli.waypoints.build import (
 )
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
-from decoy_cli.world.cs2_world import cs2_world
+from decoy_cli.world.cs2_world import SAME_MAP_SHARE, cs2_world, on_map_share
 from decoy_cli.world.nav_data import REGIONS, asset_dir, load_navmesh
 from decoy_cli.world.nav_json import read_nav, read_nav_json
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
@@ -305,11 +305,12 @@ def test_build_waypoints_nav_refuses_bad_requests(
 
 
 @pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
-def test_the_cs2_dust2_nav_makes_a_world_of_the_map() -> None:
-    world = cs2_world(CS2_NAV, "de_dust2")
-    low, high = world.bounds
-    assert world.meta["areas"] == 2248
-    assert 70 < high[0] - low[0] < 90 and 75 < high[1] - low[1] < 90  # de_dust2's size (m)
+def test_the_cs2_dust2_nav_is_de_dust2_s_and_no_other_map_s() -> None:
+    """Its areas lie on de_dust2's built-in nav; another map refuses it before any building
+    (the world itself: `test_the_shipped_cs2_graph_is_current`)."""
+    nav = read_nav(CS2_NAV)
+    assert nav.num_areas == 2248 and nav.version == 35
+    assert on_map_share(nav, "de_dust2") > SAME_MAP_SHARE
     with pytest.raises(WorldError, match="not a nav mesh of de_nuke"):
         cs2_world(CS2_NAV, "de_nuke")
 
@@ -334,6 +335,8 @@ def test_the_shipped_cs2_graph_carries_a_cs2_world() -> None:
     graph = builtin_graph("de_dust2", "cs2")
     world = graph_world(graph)
     assert world.source.startswith("CS2 de_dust2 nav mesh")
+    low, high = world.bounds
+    assert 70 < high[0] - low[0] < 90 and 75 < high[1] - low[1] < 90  # de_dust2's size (m)
     assert graph.world_triangles is not None and set(graph.regions) == set(REGIONS)
     assert all(len(nodes) > 50 for nodes in graph.regions.values())
 

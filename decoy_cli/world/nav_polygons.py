@@ -188,14 +188,14 @@ def _shared_stretches(edges: _Edges, floors: _Floors) -> tuple[list[list], list]
     step faces of those where the two floors differ in height (made once per pair)."""
     covered: list[list[tuple[float, float]]] = [[] for _ in range(edges.count)]
     tris: list = []
+    (sx, sy), (ex, ey) = edges.start[:, :2].T, edges.end[:, :2].T
     for first in range(0, edges.count, 256):
         rows = slice(first, min(first + 256, edges.count))
-        rel_s = edges.start[None, :, :2] - edges.start[rows, None, :2]
-        rel_e = edges.end[None, :, :2] - edges.start[rows, None, :2]
-        n = edges.normal[rows, None, :]
-        d = edges.direction[rows, None, :]
-        off = np.maximum(np.abs((rel_s * n).sum(-1)), np.abs((rel_e * n).sum(-1)))
-        t0, t1 = (rel_s * d).sum(-1), (rel_e * d).sum(-1)
+        x0, y0 = sx[rows, None], sy[rows, None]
+        (nx, ny), (dx, dy) = edges.normal[rows].T[:, :, None], edges.direction[rows].T[:, :, None]
+        rsx, rsy, rex, rey = sx - x0, sy - y0, ex - x0, ey - y0  # the others' ends, from e's start
+        off = np.maximum(np.abs(rsx * nx + rsy * ny), np.abs(rex * nx + rey * ny))
+        t0, t1 = rsx * dx + rsy * dy, rex * dx + rey * dy
         lo = np.maximum(np.minimum(t0, t1), 0.0)
         hi = np.minimum(np.maximum(t0, t1), edges.length[rows, None])
         ok = (off <= TOUCH_TOL_U) & (hi - lo > TOUCH_TOL_U)
