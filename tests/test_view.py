@@ -61,14 +61,6 @@ def one_error(result: Any) -> str:
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("run") / "evaluate"
-    result = runner.invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "2"])
-    assert result.exit_code == 0, result.output
-    return out
-
-
-@pytest.fixture(scope="module")
 def browser() -> Iterator[Browser]:
     assert CHROMIUM is not None
     with Browser(CHROMIUM) as chromium:

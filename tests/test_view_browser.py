@@ -4,7 +4,7 @@ aspect and the controls' place from 390 px to 1024 x 768, the URL's fragment, th
 list (sort marker, readable columns, a chosen row's player), the slider's end, zoom and pan, the
 heatmap layer, clickable events; and the trace's HP, heading and weapon against the round.
 
-One `decoy evaluate` of the shipped sample serves the module (about 15 s).
+One `decoy evaluate` of the shipped sample (tests/conftest.py) serves the module and test_view.py.
 """
 
 from __future__ import annotations
@@ -18,22 +18,13 @@ from typing import Any
 import numpy as np
 import pytest
 from browser import Browser, find_chromium
-from test_view import SAMPLE, _clock, _set_slider, needs_browser, page_data, runner
+from test_view import SAMPLE, _clock, _set_slider, needs_browser, page_data
 
-from decoy_cli.cli import app
 from decoy_cli.esta import read_match
 from decoy_cli.replay.view_trace import HEADING_STEP, decode_path
 from decoy_cli.view.page import winner_info
 
 pytestmark = needs_browser
-
-
-@pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("run") / "evaluate"
-    result = runner.invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "2"])
-    assert result.exit_code == 0, result.output
-    return out
 
 
 @pytest.fixture(scope="module")
