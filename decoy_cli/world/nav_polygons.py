@@ -26,6 +26,7 @@ The same rules as the CS:GO rectangle world (`nav_geometry.py`, whose constants 
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Iterator
 from itertools import pairwise
 from pathlib import Path
 
@@ -81,9 +82,8 @@ def polygon_triangles(nav: PolygonNav) -> np.ndarray:
     edges = _Edges(nav)
     covered, tris = _shared_stretches(edges, floors)
     walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]] = defaultdict(list)
-    for e in range(edges.count):
-        for lo, hi in subtract((0.0, edges.length[e]), covered[e]):
-            tris += _open_faces(edges, floors, e, lo, hi, walls)
+    for e, t0, t1, found in _open_pieces(edges, floors, covered):
+        tris += _piece_faces(edges, floors, e, t0, t1, found, walls)
     tris += _corner_walls(walls)
     floor_tris = floors.triangles.reshape(-1, 3, 3)
     faces = np.asarray(tris, dtype=np.float64).reshape(-1, 3, 3)
@@ -226,7 +226,13 @@ def _lower_goes_under(edges: _Edges, floors: _Floors, e: int, f: int, lo: float,
     into_upper = -PROBES_U[1] if z_e > z_f else PROBES_U[1]  # e's inside, or f's (e's outside)
     upper, low = (edges.area[e], z_f) if z_e > z_f else (edges.area[f], z_e)
     x, y, _ = edges.point(e, (lo + hi) / 2, into_upper)
-    return any(area != upper and abs(h - low) <= JUMP_U for area, h in floors.under(x, y))
+    return _floor_near(floors, x, y, low, upper)
+
+
+def _floor_near(floors: _Floors, x: float, y: float, z: float, left_out: int) -> bool:
+    """Whether a floor within a jump of height `z` lies under (x, y), the area `left_out`'s
+    aside: the test for a lower floor going on beneath an upper one."""
+    return any(area != left_out and abs(h - z) <= JUMP_U for area, h in floors.under(x, y))
 
 
 def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
@@ -265,53 +271,57 @@ def _beyond(
     return None
 
 
-def _open_faces(
+def _open_pieces(
+    edges: _Edges, floors: _Floors, covered: list[list[tuple[float, float]]]
+) -> Iterator[tuple[int, float, float, tuple[float, float] | None]]:
+    """Every open piece of every edge, at most `PIECE_U` long: (edge, t0, t1, beyond), where
+    `beyond` is the (gap, height) of the nearest other floor beyond the piece's middle, None
+    where there is none within reach."""
+    for e in range(edges.count):
+        for lo, hi in subtract((0.0, edges.length[e]), covered[e]):
+            cuts = np.linspace(lo, hi, max(1, int(np.ceil((hi - lo) / PIECE_U))) + 1)
+            for t0, t1 in pairwise(cuts):
+                mid = (t0 + t1) / 2
+                beyond = _beyond(edges, floors, e, mid, float(edges.point(e, mid)[2]))
+                yield e, float(t0), float(t1), beyond
+
+
+def _piece_faces(
     edges: _Edges,
     floors: _Floors,
     e: int,
-    lo: float,
-    hi: float,
+    t0: float,
+    t1: float,
+    found: tuple[float, float] | None,
     walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
 ) -> list:
-    """Faces of the open stretch [lo, hi] of edge e (module docstring), piece by piece; the
-    wall ends at the edge's corners are noted in `walls` for `_corner_walls`."""
-    tris: list = []
-    count = max(1, int(np.ceil((hi - lo) / PIECE_U)))
-    cuts = np.linspace(lo, hi, count + 1)
-    for t0, t1 in pairwise(cuts):
-        mid = (t0 + t1) / 2
-        z0, z1, zm = (float(edges.point(e, t)[2]) for t in (t0, t1, mid))
-        found = _beyond(edges, floors, e, mid, zm)
-        if found is not None and abs(found[1] - zm) <= JUMP_U and found[0] > SAME_LEVEL_REACH_U:
-            found = None  # a floor of this level so far off has a wall between
-        if found is None:
-            top = _wall_top(edges, floors, e, mid, zm)
-            tris += _strip(edges, e, t0, t1, POLYGON_WALL_PUSH_U, z0, z1)
-            if top is not None:
-                tris += _face(edges, e, t0, t1, POLYGON_WALL_PUSH_U, (z0, z1), (z0 + top, z1 + top))
-                _note_ends(edges, e, t0, t1, top, walls)
-            continue
-        gap, other = found
-        rise = other - zm
-        if abs(rise) <= JUMP_U and gap <= BRIDGE_MAX_GAP_U:
-            tris += _strip(edges, e, t0, t1, gap / 2, z0, z1)
-            if rise < -STEP_U:  # the higher side closes the step
-                tris += _face(edges, e, t0, t1, gap / 2, (z0, z1), (other, other))
-            continue
-        push = min(POLYGON_WALL_PUSH_U, gap / 2)
-        tris += _strip(edges, e, t0, t1, push, z0, z1)
-        # under a walkway the lower floor goes on beneath the upper one: no face there
-        beneath = -PROBES_U[1] if rise < 0 else gap + PROBES_U[1]
-        x, y, _ = edges.point(e, mid, beneath)
-        low = min(zm, other)
-        upper = edges.area[e] if rise < 0 else -1
-        if abs(rise) > OVERHEAD_U and any(
-            a != upper and a != edges.area[e] and abs(h - low) <= JUMP_U
-            for a, h in floors.under(x, y)
-        ):
-            continue
-        tris += _face(edges, e, t0, t1, push, (z0, z1), (other, other))
-    return tris
+    """Faces of the open piece [t0, t1] of edge e by what lies beyond it (module docstring);
+    its wall's ends at the edge's corners are noted in `walls` for `_corner_walls`."""
+    mid = (t0 + t1) / 2
+    z0, z1, zm = (float(edges.point(e, t)[2]) for t in (t0, t1, mid))
+    if found is not None and abs(found[1] - zm) <= JUMP_U and found[0] > SAME_LEVEL_REACH_U:
+        found = None  # a floor of this level so far off has a wall between
+    if found is None:
+        top = _wall_top(edges, floors, e, mid, zm)
+        tris = _strip(edges, e, t0, t1, POLYGON_WALL_PUSH_U, z0, z1)
+        if top is not None:
+            tris += _face(edges, e, t0, t1, POLYGON_WALL_PUSH_U, (z0, z1), (z0 + top, z1 + top))
+            _note_ends(edges, e, t0, t1, top, walls)
+        return tris
+    gap, other = found
+    rise = other - zm
+    if abs(rise) <= JUMP_U and gap <= BRIDGE_MAX_GAP_U:
+        tris = _strip(edges, e, t0, t1, gap / 2, z0, z1)
+        if rise < -STEP_U:  # the higher side closes the step
+            tris += _face(edges, e, t0, t1, gap / 2, (z0, z1), (other, other))
+        return tris
+    push = min(POLYGON_WALL_PUSH_U, gap / 2)
+    tris = _strip(edges, e, t0, t1, push, z0, z1)
+    # under a walkway the lower floor goes on beneath the upper one: no face there
+    x, y, _ = edges.point(e, mid, -PROBES_U[1] if rise < 0 else gap + PROBES_U[1])
+    if abs(rise) > OVERHEAD_U and _floor_near(floors, x, y, min(zm, other), edges.area[e]):
+        return tris
+    return tris + _face(edges, e, t0, t1, push, (z0, z1), (other, other))
 
 
 def _wall_top(edges: _Edges, floors: _Floors, e: int, t: float, z: float) -> float | None:
@@ -384,20 +394,20 @@ def _face(edges: _Edges, e: int, t0: float, t1: float, push: float, low, high):
 def open_edge_rays(
     nav: PolygonNav, heights: tuple[float, ...], reach: float, back: float = 8.0
 ) -> tuple[np.ndarray, np.ndarray, float]:
-    """Horizontal rays out of the open edges that have no floor beyond them (where this world
-    puts a wall): one per piece and height above its floor, from `back` inside the edge to
-    `reach` beyond it. (starts, ends) in Hammer units and `back`: what a study of how far the
-    real walls stand casts against a map's geometry (benchmarks/studies/cs2_world.py)."""
+    """Horizontal rays out of the middle of every open piece with no floor beyond it within
+    reach (a wall, and nothing else, there), one per height above its floor, from `back` inside
+    the edge to `reach` beyond it: (starts, ends) in Hammer units and `back`, what a study of
+    how far the real walls stand casts against a map's geometry
+    (benchmarks/studies/cs2_world.py)."""
     floors, edges = _Floors(nav), _Edges(nav)
     covered, _ = _shared_stretches(edges, floors)
     starts, ends = [], []
-    for e in range(edges.count):
-        for lo, hi in subtract((0.0, edges.length[e]), covered[e]):
-            for t in np.arange(lo + PIECE_U / 2, hi - PIECE_U / 2, PIECE_U):
-                z = float(edges.point(e, t)[2])
-                if _beyond(edges, floors, e, t, z) is not None:
-                    continue
-                for height in heights:
-                    starts.append([*edges.point(e, t, -back)[:2], z + height])
-                    ends.append([*edges.point(e, t, reach)[:2], z + height])
+    for e, t0, t1, found in _open_pieces(edges, floors, covered):
+        if found is not None:
+            continue
+        t = (t0 + t1) / 2
+        z = float(edges.point(e, t)[2])
+        for height in heights:
+            starts.append([*edges.point(e, t, -back)[:2], z + height])
+            ends.append([*edges.point(e, t, reach)[:2], z + height])
     return np.asarray(starts).reshape(-1, 3), np.asarray(ends).reshape(-1, 3), back
