@@ -27,7 +27,7 @@ from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import SAME_MAP_SHARE, cs2_world, on_map_share
 from decoy_cli.world.nav_data import REGIONS, asset_dir, load_navmesh
-from decoy_cli.world.nav_json import read_nav, read_nav_json
+from decoy_cli.world.nav_json import read_nav
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -61,7 +61,7 @@ def write_nav(path: Path, document: dict) -> Path:
 
 
 def triangles_of(tmp_path: Path, polygons: list) -> np.ndarray:
-    return polygon_triangles(read_nav_json(write_nav(tmp_path / "t.json", nav_document(polygons))))
+    return polygon_triangles(read_nav(write_nav(tmp_path / "t.json", nav_document(polygons))))
 
 
 def faces_on_line(tris: np.ndarray, axis: int, value: float, tol: float = 0.5) -> np.ndarray:
@@ -80,7 +80,7 @@ def test_a_nav_reads_plain_xz_and_gzip_alike(tmp_path: Path) -> None:
     (tmp_path / "a.json").write_text(text)
     (tmp_path / "a.json.xz").write_bytes(lzma.compress(text.encode()))
     (tmp_path / "a.json.gz").write_bytes(gzip.compress(text.encode()))
-    navs = [read_nav_json(tmp_path / name) for name in ("a.json", "a.json.xz", "a.json.gz")]
+    navs = [read_nav(tmp_path / name) for name in ("a.json", "a.json.xz", "a.json.gz")]
     for nav in navs:
         assert nav.num_areas == 2 and nav.version == 35
         assert np.array_equal(nav.corners, navs[0].corners)
@@ -88,7 +88,7 @@ def test_a_nav_reads_plain_xz_and_gzip_alike(tmp_path: Path) -> None:
 
 
 def test_clockwise_corners_are_turned_counter_clockwise(tmp_path: Path) -> None:
-    nav = read_nav_json(write_nav(tmp_path / "c.json", nav_document([square(0, 0, 50, 0)[::-1]])))
+    nav = read_nav(write_nav(tmp_path / "c.json", nav_document([square(0, 0, 50, 0)[::-1]])))
     x, y = nav.polygon(0)[:, 0], nav.polygon(0)[:, 1]
     assert np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
 
@@ -112,7 +112,7 @@ def test_a_bad_nav_is_one_world_error(tmp_path: Path, change, message: str) -> N
     document = nav_document([square(0, 0, 100, 0), square(100, 0, 100, 0)])
     change(document)
     with pytest.raises(WorldError, match=message):
-        read_nav_json(write_nav(tmp_path / "bad.json", document))
+        read_nav(write_nav(tmp_path / "bad.json", document))
 
 
 @pytest.mark.parametrize(
@@ -126,13 +126,13 @@ def test_a_bad_nav_is_one_world_error(tmp_path: Path, change, message: str) -> N
 def test_damaged_files_are_one_world_error(tmp_path: Path, content: bytes, message: str) -> None:
     (tmp_path / "bad.json").write_bytes(content)
     with pytest.raises(WorldError, match=message):
-        read_nav_json(tmp_path / "bad.json")
+        read_nav(tmp_path / "bad.json")
 
 
 def test_a_compressed_bomb_is_refused_without_unpacking_it(tmp_path: Path) -> None:
     (tmp_path / "bomb.json.xz").write_bytes(lzma.compress(b" " * 70_000_000))
     with pytest.raises(WorldError, match="unpacks to more than"):
-        read_nav_json(tmp_path / "bomb.json.xz")
+        read_nav(tmp_path / "bomb.json.xz")
 
 
 def test_a_binary_nav_without_awpy_3_says_how_to_read_it(tmp_path: Path) -> None:
@@ -248,7 +248,7 @@ def dust2_piece(tmp_path: Path) -> Path:
 
 
 def piece_seed(path: Path) -> list[float]:
-    nav = read_nav_json(path)
+    nav = read_nav(path)
     areas = (nav.corners[:, 2, 0] - nav.corners[:, 0, 0]) * (
         nav.corners[:, 2, 1] - nav.corners[:, 0, 1]
     )

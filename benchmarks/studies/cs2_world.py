@@ -39,7 +39,7 @@ from decoy_cli.waypoints.los_pairs import eye_pairs, random_node_pairs
 from decoy_cli.world.cs2_world import cs2_world
 from decoy_cli.world.los import compare_line_of_sight
 from decoy_cli.world.meshfile import read_mesh
-from decoy_cli.world.nav_json import read_nav_json
+from decoy_cli.world.nav_json import read_nav
 from decoy_cli.world.nav_polygons import open_edge_rays
 from decoy_cli.world.navmesh import nav_world
 from decoy_cli.world.physics import PhysicsWorld
@@ -53,7 +53,7 @@ ROUNDS = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-r01-12.json.xz"
 def wall_distances(physics_brush: PhysicsWorld) -> np.ndarray:
     """Distances (Hammer units) from the CS2 nav's open edges with no floor beyond to the
     brush mesh's walls, for the rays that hit one within 200 u."""
-    starts, ends, back = open_edge_rays(read_nav_json(NAV), heights=(20.0, 64.0), reach=200.0)
+    starts, ends, back = open_edge_rays(read_nav(NAV), heights=(20.0, 64.0), reach=200.0)
     fraction, _ = physics_brush.ray_test(starts * HAMMER_TO_M, ends * HAMMER_TO_M)
     hit = np.isfinite(fraction) & (fraction < 1)
     return fraction[hit] * (200.0 + back) - back

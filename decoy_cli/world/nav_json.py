@@ -73,14 +73,6 @@ def read_nav(path: str | Path) -> PolygonNav:
     return _polygons(parse_json(_decompressed(data, limit, path), str(path), WorldError), path)
 
 
-def read_nav_json(path: str | Path) -> PolygonNav:
-    """The polygons of an awpy JSON nav file (plain, .xz or .gz), as `read_nav` reads it."""
-    path = Path(path)
-    limit = int(MAX_FILE_MB * 1e6)
-    data = _decompressed(read_limited(path, limit, WorldError), limit, path)
-    return _polygons(parse_json(data, str(path), WorldError), path)
-
-
 def _binary_document(path: Path) -> dict[str, object]:
     """A binary CS2 nav read by awpy 3's `NavMesh`, in the JSON form's shape."""
     try:
