@@ -3,6 +3,7 @@
 Builds the CS2 world and its graph from ../shared/data/cs2_maps/de_dust2.nav.json.xz (or loads
 the graph given with --graph), then measures on both:
 
+* the map check: the share of the CS2 nav's areas on each built-in map's nav;
 * walls: how far beyond the CS2 nav's open edges the brush mesh's walls stand (the measurement
   behind `POLYGON_WALL_PUSH_U`), rays at 20 and 64 u above the floor;
 * line of sight against the brush mesh (../shared/data/meshes): random pairs of each world's
@@ -30,13 +31,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.csgo import HAMMER_TO_M, MAP_NAMES
 from decoy_cli.esta import read_match
 from decoy_cli.geometry import eye_point
 from decoy_cli.waypoints.build import build_graph, builtin_graph, graph_world
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.los_pairs import eye_pairs, random_node_pairs
-from decoy_cli.world.cs2_world import cs2_world
+from decoy_cli.world.cs2_world import cs2_world, on_map_share
 from decoy_cli.world.los import compare_line_of_sight
 from decoy_cli.world.meshfile import read_mesh
 from decoy_cli.world.nav_json import read_nav
@@ -114,11 +115,12 @@ def snapping(graph_file: Path | None) -> dict[str, str]:
 
 
 def whole_rounds(graph_file: Path | None, seeds: int, out: Path) -> dict[str, object]:
-    """Winner agreement and plants over seeds, under both death protocols (medians)."""
+    """Winner agreement, plants, the real deaths the replay reproduces and the killers it
+    gets right, over seeds, under both death protocols (medians)."""
     extra = ["--graph", str(graph_file)] if graph_file else []
     result: dict[str, object] = {}
     for deaths in ("data", "simulated"):
-        winners, plants = [], []
+        winners, plants, recalled, killers = [], [], [], []
         for seed in range(seeds):
             folder = out / f"{deaths}-{seed}"
             subprocess.run(
@@ -130,8 +132,12 @@ def whole_rounds(graph_file: Path | None, seeds: int, out: Path) -> dict[str, ob
             rounds = pd.read_csv(folder / "rounds.csv")
             winners.append(float((rounds.winner_original == rounds.winner_replay).mean()))
             plants.append(int(rounds.plant_replay.fillna(False).astype(bool).sum()))
+            recalled.append(rounds.deaths_recalled.sum() / rounds.deaths_original.sum())
+            killers.append(rounds.killers_agree.sum() / max(1, rounds.killers_known.sum()))
         result[f"winner agreement ({deaths})"] = round(float(np.median(winners)), 3)
         result[f"plants ({deaths})"] = float(np.median(plants))
+        result[f"real deaths reproduced ({deaths})"] = round(float(np.median(recalled)), 3)
+        result[f"killer agrees ({deaths})"] = round(float(np.median(killers)), 3)
     return result
 
 
@@ -160,6 +166,9 @@ def main() -> int:
         random_node_pairs(graphs["CS:GO nav world"], args.pairs, seed=0, max_distance=40.0),
     )
     kills = kill_eyes()
+    nav = read_nav(NAV)
+    shares = {name: round(on_map_share(nav, name), 3) for name in MAP_NAMES}
+    print(f"CS2 de_dust2 nav's area centres within 1 m of each built-in nav: {shares}")
     with PhysicsWorld(brush) as physics_brush:
         distances = wall_distances(physics_brush)
         print(

@@ -2,8 +2,8 @@
 
 The JSON form names no map, so the file is checked against the map's built-in (CS:GO) nav
 mesh: CS2 kept the coordinates of the maps it remade, so most of a CS2 nav's areas lie on the
-CS:GO nav of the same map (de_dust2: 98% within 1 m) and few on another map's (at most 34% for
-de_dust2's file against the other seven). A file below `SAME_MAP_SHARE` is refused.
+CS:GO nav of the same map and few on another map's (benchmarks/studies/cs2_world.py prints the
+shares for de_dust2's file). A file below `SAME_MAP_SHARE` is refused.
 """
 
 from __future__ import annotations
