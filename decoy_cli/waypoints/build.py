@@ -30,8 +30,6 @@ GRAPH_FILE = "waypoints.npz"
 CS2_GRAPH_FILE = "cs2_waypoints.npz"
 """A map's graph on its CS2 world (built with `--nav` from CS2's nav mesh; it carries the world)."""
 GameWorld = Literal["csgo", "cs2"]
-CARRIED_KIND = POLYGON_NAV_KIND
-"""Worlds of this kind are not in the package: a graph built on one carries it."""
 
 
 def canonical_map(name: str) -> str:
@@ -110,7 +108,7 @@ def build_graph(
         region: np.nonzero(np.isin(node_place, [place_index[p] for p in region_places]))[0]
         for region, region_places in nav.regions.items()
     }
-    carried = world.meta.get("kind") == CARRIED_KIND
+    carried = world.meta.get("kind") == POLYGON_NAV_KIND  # no package holds it: the graph does
     stats = result.stats.as_dict()
     stats.pop("seconds")  # timings vary run to run; the file must not
     graph = WaypointGraph(
@@ -130,7 +128,7 @@ def build_graph(
                 "source": world.source,
                 "triangles": world.num_triangles,
                 "sha256": world.fingerprint(),
-                **({"kind": CARRIED_KIND} if carried else {}),
+                **({"kind": POLYGON_NAV_KIND} if carried else {}),
             },
             "params": asdict(params),
             "seeds_m": np.round(seed_points, 6).tolist(),
@@ -170,7 +168,7 @@ def graph_world(graph: WaypointGraph) -> World:
             triangles=graph.world_triangles,
             name=str(described.get("name", map_name)),
             source=str(described.get("source", "the world the graph carries")),
-            meta={"kind": CARRIED_KIND},
+            meta={"kind": POLYGON_NAV_KIND},
         )
         if world.fingerprint() != described.get("sha256"):
             raise GraphError("the world this graph carries does not match its own fingerprint")
