@@ -12,6 +12,7 @@ import shlex
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 from decoy_cli.esta.frame_rate import describe_rates
@@ -91,14 +92,24 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
 
 def world_line(settings: EvalSettings) -> str:
     """The world the rounds replay on, in words, and why that one."""
-    from decoy_cli.evaluate.job import run_graph
-
-    source = run_graph(settings).world_source or "unnamed"
+    source = _world_source(settings.map_name, settings.world, settings.graph) or "unnamed"
     if settings.graph:
         return f"{source}, from the graph {settings.graph}"
     if settings.world == "cs2":
         return f"{source} (the CS2 world the package ships for {settings.map_name})"
     return f"{source} (the CS:GO world of {settings.map_name})"
+
+
+@cache
+def _world_source(map_name: str, world: str, graph: str) -> str:
+    """Where the world of a run's graph comes from (the console, report.md and summary.json
+    each say it: the graph is read once)."""
+    from decoy_cli.waypoints.build import builtin_graph
+    from decoy_cli.waypoints.graph import WaypointGraph
+
+    if graph:
+        return WaypointGraph.load(graph).world_source
+    return builtin_graph(map_name, "cs2" if world == "cs2" else "csgo").world_source
 
 
 def sight_line(settings: EvalSettings) -> str | None:
