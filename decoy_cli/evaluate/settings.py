@@ -101,10 +101,10 @@ def index_key(settings: EvalSettings, file_sha: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def round_seed(settings: EvalSettings, file_sha: str, round_num: int) -> int:
-    """The simulator seed of one round: fixed by the run's seed, the file (or `seed_source`)
-    and the round."""
-    digest = hashlib.sha256(f"{settings.seed}|{file_sha}|{round_num}".encode()).digest()
+def round_seed(settings: EvalSettings, source: str, round_num: int) -> int:
+    """The simulator seed of one round: fixed by the run's seed, the round's `seed_source` and
+    its number."""
+    digest = hashlib.sha256(f"{settings.seed}|{source}|{round_num}".encode()).digest()
     return int.from_bytes(digest[:8], "little") & (2**63 - 1)
 
 
