@@ -122,7 +122,12 @@ def test_the_page_holds_the_cached_trace_of_every_round(run: Path) -> None:
         assert {k: v for k, v in shown.items() if k not in ("label", "info")} == expected
 
 
-def test_the_thinned_paths_follow_the_round_s_frames(run: Path) -> None:
+def shown_players(
+    run: Path,
+) -> Iterator[tuple[dict[str, Any], Any, np.ndarray, int, dict[str, Any], np.ndarray]]:
+    """Each player the run's page shows, beside his round in the sample: (what the page holds
+    of the round, the round, its frames' seconds, his row, what the page holds of him, his
+    alive-and-present frames)."""
     data = page_data(run / "view.html")
     match = read_match(next(SAMPLE.glob("*.json.xz")))
     for shown in data["rounds"]:
@@ -130,20 +135,23 @@ def test_the_thinned_paths_follow_the_round_s_frames(run: Path) -> None:
         seconds = np.asarray(round_.frame_seconds)
         for p, player in enumerate(shown["players"]):
             alive = np.asarray(round_.alive[p]) & np.asarray(round_.present[p])
-            points = np.concatenate(
-                [decode_path(s) for s in player["original"]] or [np.zeros((0, 5))]
-            )
-            assert len(points) <= alive.sum()
-            frames = np.flatnonzero(alive)
-            if not len(frames):
-                continue
-            # every alive frame lies on the thinned path: within the tolerance and the rounding
-            t = seconds[frames]
-            inside = (t >= points[0, 0] - 1e-9) & (t <= points[-1, 0] + 1e-9)
-            for axis in (1, 2, 3):
-                guess = np.interp(t[inside], points[:, 0], points[:, axis])
-                error = np.abs(guess - round_.position[p, frames[inside], axis - 1])
-                assert error.max() <= THIN_M + 0.1, (shown["label"], player["name"], axis)
+            yield shown, round_, seconds, p, player, alive
+
+
+def test_the_thinned_paths_follow_the_round_s_frames(run: Path) -> None:
+    for _, round_, seconds, p, player, alive in shown_players(run):
+        points = np.concatenate([decode_path(s) for s in player["original"]] or [np.zeros((0, 5))])
+        assert len(points) <= alive.sum()
+        frames = np.flatnonzero(alive)
+        if not len(frames):
+            continue
+        # every alive frame lies on the thinned path: within the tolerance and the rounding
+        t = seconds[frames]
+        inside = (t >= points[0, 0] - 1e-9) & (t <= points[-1, 0] + 1e-9)
+        for axis in (1, 2, 3):
+            guess = np.interp(t[inside], points[:, 0], points[:, axis])
+            error = np.abs(guess - round_.position[p, frames[inside], axis - 1])
+            assert error.max() <= THIN_M + 0.1, (round_.round_num, player["name"], axis)
 
 
 def test_thinning_keeps_what_interpolation_would_miss() -> None:

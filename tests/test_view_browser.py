@@ -18,9 +18,8 @@ from typing import Any
 import numpy as np
 import pytest
 from browser import Browser, find_chromium
-from test_view import SAMPLE, _clock, _set_slider, needs_browser, page_data
+from test_view import _clock, _set_slider, needs_browser, page_data, shown_players
 
-from decoy_cli.esta import read_match
 from decoy_cli.replay.view_trace import HEADING_STEP, decode_path
 from decoy_cli.view.page import winner_info
 
@@ -361,25 +360,18 @@ def _changes_at(changes: list[int], seconds: np.ndarray) -> list[Any]:
 
 
 def test_the_trace_s_hp_weapon_and_heading_follow_the_round(run: Path) -> None:
-    data = page_data(run / "view.html")
-    match = read_match(next(SAMPLE.glob("*.json.xz")))
-    for shown in data["rounds"]:
-        round_ = match.round(int(shown["label"].rsplit(":", 1)[1]))
-        seconds = np.asarray(round_.frame_seconds)
-        for p, player in enumerate(shown["players"]):
-            alive = np.asarray(round_.alive[p]) & np.asarray(round_.present[p])
-            hp = _changes_at(player["hp_original"], seconds)
-            assert np.array_equal(np.where(alive, round_.hp[p], 0), hp)
-            held = [
-                shown["weapons"][i] if i >= 0 else ""
-                for i in _changes_at(player["weapon"], seconds)
-            ]
-            assert [w if a else "" for w, a in zip(round_.weapon[p], alive, strict=True)] == held
-            for segment in player["original"]:
-                kept = decode_path(segment)
-                frames = np.searchsorted(seconds, kept[:, 0] - 1e-6)
-                turn = np.abs((kept[:, 4] - round_.yaw[p, frames] + 180) % 360 - 180)
-                assert turn.max() <= HEADING_STEP / 2 + 1e-6
+    for shown, round_, seconds, p, player, alive in shown_players(run):
+        hp = _changes_at(player["hp_original"], seconds)
+        assert np.array_equal(np.where(alive, round_.hp[p], 0), hp)
+        held = [
+            shown["weapons"][i] if i >= 0 else "" for i in _changes_at(player["weapon"], seconds)
+        ]
+        assert [w if a else "" for w, a in zip(round_.weapon[p], alive, strict=True)] == held
+        for segment in player["original"]:
+            kept = decode_path(segment)
+            frames = np.searchsorted(seconds, kept[:, 0] - 1e-6)
+            turn = np.abs((kept[:, 4] - round_.yaw[p, frames] + 180) % 360 - 180)
+            assert turn.max() <= HEADING_STEP / 2 + 1e-6
 
 
 def test_an_older_trace_without_hp_still_draws(
