@@ -216,6 +216,41 @@ def test_a_ledge_is_a_face_down_with_no_wall_above(tmp_path: Path) -> None:
     assert len(face) and face[:, :, 2].max() == pytest.approx(150)
 
 
+def floors_under(tris: np.ndarray, x: float, y: float) -> list[float]:
+    """Heights of the non-vertical triangles under the point (x, y) (Hammer units)."""
+    heights = []
+    for tri in tris:
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = tri
+        det = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)
+        if abs(det) < 1e-9:
+            continue
+        l0 = ((y1 - y2) * (x - x2) + (x2 - x1) * (y - y2)) / det
+        l1 = ((y2 - y0) * (x - x2) + (x0 - x2) * (y - y2)) / det
+        if min(l0, l1, 1 - l0 - l1) >= -1e-9:
+            heights.append(l0 * z0 + l1 * z1 + (1 - l0 - l1) * z2)
+    return heights
+
+
+def test_a_hole_over_a_pit_is_closed_at_its_own_level(tmp_path: Path) -> None:
+    """Two floors at 100 u, 16 u apart, over a pit floor at -100 that shows first beyond each
+    edge: the hole between the two is closed at 100 (it is one floor a player walks across),
+    not a ledge down into the pit."""
+    pit = square(-100, -100, 400, -100)
+    tris = triangles_of(tmp_path, [square(0, 0, 100, 100), square(116, 0, 100, 100), pit])
+    for x in (102.0, 106.0, 110.0, 114.0):
+        assert max(floors_under(tris, x, 50.0)) == pytest.approx(100), x
+
+
+def test_the_holes_where_four_corners_meet_are_closed(tmp_path: Path) -> None:
+    """Four floors 10 u apart meeting at their corners: the strips across each gap run past the
+    corners, so the hole in the middle is floor too."""
+    corners = [square(0, 0, 100, 0), square(110, 0, 100, 0)]
+    corners += [square(0, 110, 100, 0), square(110, 110, 100, 0)]
+    tris = triangles_of(tmp_path, corners)
+    for x, y in ((103.0, 103.0), (105.0, 105.0), (108.0, 102.0)):
+        assert floors_under(tris, x, y), (x, y)
+
+
 def test_a_nav_of_another_map_is_refused(tmp_path: Path) -> None:
     far = nav_document([square(20000, 20000, 100, 0), square(20100, 20000, 100, 0)])
     with pytest.raises(WorldError, match="not a nav mesh of de_dust2"):

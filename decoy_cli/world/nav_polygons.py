@@ -13,8 +13,10 @@ The same rules as the CS:GO rectangle world (`nav_geometry.py`, whose constants 
   (CS:GO's `LEDGE_REACH_U`) and gets: nothing near: a wall `POLYGON_WALL_PUSH_U` beyond the
   edge (where the nav stops short of the real walls), full height, capped below any floor
   overhead, left out where it would stand on another floor of the same level; an area within
-  a jump in height across a gap of at most `BRIDGE_MAX_GAP_U`: floor to the gap's middle (a
-  hole in the mesh), closed by a face from the higher side; one of that level farther than
+  a jump in height across a gap of at most `BRIDGE_MAX_GAP_U` (looked for first, so that a
+  floor far below the gap does not hide it): floor to the gap's middle (a hole in the mesh),
+  square past the edge's ends so that the holes where corners meet close too, and closed by
+  a face from the higher side; one of that level farther than
   `SAME_LEVEL_REACH_U`: a wall, as for nothing near; any other area near (higher or lower):
   floor to the push, then a face between the two heights (a ledge to drop from, the
   foot of a box to jump onto), none where that face would hang into a passage under a
@@ -248,17 +250,28 @@ def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
 def _beyond(
     edges: _Edges, floors: _Floors, e: int, t: float, z: float
 ) -> tuple[float, float] | None:
-    """(gap, height) of the nearest other floor beyond edge e at `t` within reach, or None."""
+    """(gap, height) of the nearest other floor beyond edge e at `t` within reach, or None.
+    A floor within a jump of `z` across a hole (at most `BRIDGE_MAX_GAP_U`) comes first, even
+    where a floor far below shows sooner: the hole's far side, not the pit under it."""
+    level = _first_floor(edges, floors, e, t, z, JUMP_U, BRIDGE_MAX_GAP_U)
+    return level or _first_floor(edges, floors, e, t, z, MAX_SHARED_STEP_U, PROBES_U[-1])
+
+
+def _first_floor(
+    edges: _Edges, floors: _Floors, e: int, t: float, z: float, within: float, reach: float
+) -> tuple[float, float] | None:
+    """(gap, height) of the nearest other area's floor beyond edge e at `t`, up to `reach`
+    out, among those at most `within` from height `z` (the closest in height where several)."""
     own = edges.area[e]
 
     def nearest_floor(distance: float) -> float | None:
         x, y, _ = edges.point(e, t, distance)
         near = [(abs(h - z), h) for a, h in floors.under(x, y) if a != own]
-        near = [(dz, h) for dz, h in near if dz <= MAX_SHARED_STEP_U]
+        near = [(dz, h) for dz, h in near if dz <= within]
         return min(near)[1] if near else None
 
     before = 0.0
-    for distance in PROBES_U:
+    for distance in (d for d in PROBES_U if d <= reach):
         height = nearest_floor(distance)
         if height is not None:
             for _ in range(5):  # where the floor begins, to a thirty-second of the step
@@ -311,7 +324,11 @@ def _piece_faces(
     gap, other = found
     rise = other - zm
     if abs(rise) <= JUMP_U and gap <= BRIDGE_MAX_GAP_U:
-        tris = _strip(edges, e, t0, t1, gap / 2, z0, z1)
+        # past the edge's ends too, square: where several areas' corners meet, the hole
+        # between them is closed (each strip alone leaves the corner open)
+        c0 = t0 - gap / 2 if t0 <= TOUCH_TOL_U else t0
+        c1 = t1 + gap / 2 if t1 >= edges.length[e] - TOUCH_TOL_U else t1
+        tris = _strip(edges, e, c0, c1, gap / 2, *(float(edges.point(e, t)[2]) for t in (c0, c1)))
         if rise < -STEP_U:  # the higher side closes the step
             tris += _face(edges, e, t0, t1, gap / 2, (z0, z1), (other, other))
         return tris
