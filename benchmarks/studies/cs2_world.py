@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -103,7 +104,7 @@ def snapping(graph_file: Path | None) -> dict[str, str]:
         check=True,
         capture_output=True,
         text=True,
-        env={"COLUMNS": "200", "PATH": sys.exec_prefix + "/bin:/usr/bin:/bin"},
+        env={**os.environ, "COLUMNS": "200", "PATH": sys.exec_prefix + "/bin:/usr/bin:/bin"},
     ).stdout
     keep = ("snap error median", "snapped within 0.5 m", "unsnappable", "in the air", "unreachable")
     found = {}
