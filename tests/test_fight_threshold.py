@@ -187,3 +187,24 @@ def test_the_shipped_threshold_is_what_the_command_chooses_on_the_real_rounds(
     halves = re.search(r"alone: ([0-9.]+), ([0-9.]+)", " ".join(result.output.split()))
     assert halves is not None  # each half of the rounds alone chooses within one step of it
     assert all(abs(float(h) - shipped["threshold"]) <= 0.05 + 1e-9 for h in halves.groups())
+
+
+@pytest.mark.skipif(
+    not (DATA / "cs2_dust2_both").is_dir() or not (DATA / "events_ancient").is_dir(),
+    reason="needs ../shared/data/cs2_dust2_both, esta_dust2_events and events_ancient",
+)
+def test_world_cs2_chooses_on_sight_in_cs2_s_world(tmp_path: Path) -> None:
+    """`--world cs2`: the pairs are those in sight in CS2's de_dust2 world, not CS:GO's."""
+    folder = dip_alone(tmp_path)
+    both = DATA / "cs2_dust2_both" / "spirit-vs-falcons-m2-dust2-r01-12.json.xz"
+    data = [both, DATA / "esta_dust2_events", DATA / "events_ancient"]
+    rounds = read_match(both).rounds
+    counts = {w: len(fight_pairs(rounds, builtin_graph(world=w)).lost_hp) for w in ("csgo", "cs2")}
+    assert counts["csgo"] != counts["cs2"]
+    result = runner.invoke(
+        app,
+        ["models", "fight-threshold", str(folder), *map(str, data), "--world", "cs2"],
+        env=WIDE,
+    )
+    assert result.exit_code == 0, result.output
+    assert f"{counts['cs2']} player-frames" in result.output

@@ -68,9 +68,9 @@ WORLD_HELP = (
 )
 
 
-def world_option() -> GameWorld:
+def world_option(help_text: str = WORLD_HELP) -> GameWorld:
     """The `--world` option (Typer's parameter default)."""
-    return typer.Option("csgo", "--world", help=WORLD_HELP)
+    return typer.Option("csgo", "--world", help=help_text)
 
 
 def mover_option(default: MoverName) -> MoverName:

@@ -23,7 +23,7 @@ from decoy_cli.commands._damage_output import (
     progress_bars,
 )
 from decoy_cli.commands._groups import with_groups
-from decoy_cli.commands._options import SampleOptions
+from decoy_cli.commands._options import SampleOptions, world_option
 from decoy_cli.damage import CHOICES_HELP, PAPER_FOLDER, parse_models
 from decoy_cli.damage.calibration import Calibration, CalibrationKind, Decision
 from decoy_cli.damage.choice import MODELS_METAVAR
@@ -35,6 +35,7 @@ from decoy_cli.modeling.network_evaluation import DRAWS
 from decoy_cli.modeling.paper_download import PAPER_BASE_URL, PAPER_COMMIT, PAPER_REPOSITORY
 from decoy_cli.modeling.scores import MIN_CELL
 from decoy_cli.modeling.split import SplitPart
+from decoy_cli.waypoints.build import GameWorld
 
 DEFAULT_IMPORT_OUT = PAPER_FOLDER
 DEFAULT_EVALUATE_OUT = Path("decoy-out") / "models" / "evaluation"
@@ -165,6 +166,9 @@ def fight_threshold_command(
         help="Least share of each map's real damaging steps DIP must still call hits (those "
         "it did not train on, where the map has any).",
     ),
+    world: GameWorld = world_option(
+        "The world whose sight gives the pairs: CS:GO's (csgo) or CS2's (cs2, de_dust2)."
+    ),
 ) -> None:
     """Choose the DIP threshold the simulator's fight decides by, where the fight works: the
     best F1 on real rounds of both teams (a player with one enemy in sight at a frame, both
@@ -181,7 +185,7 @@ def fight_threshold_command(
         raise DecoyError(f"{model_folder}: holds no dip.json to choose a threshold for")
     check_folder_writable(model_folder)
     dip = load_dip(model_folder)
-    found = choose_for_files(dip, data, builtin_graph(), min_recall)
+    found = choose_for_files(dip, data, builtin_graph(world=world), min_recall)
     chosen = found.chosen
     table = Table(
         title=f"The fight's threshold: {found.rounds} rounds, {found.pairs} player-frames"
