@@ -2,7 +2,7 @@
 
 numba's `cache=True` keys each cached function by its own source file alone. A kernel that calls
 a compiled function of another module, or reads another module's constant, keeps the machine
-code it was compiled with after that module changes: quiet_play's `_play` inlines the movers'
+code it was compiled with after that module changes: quiet_play's `play_quiet` inlines the movers'
 `begin_edge`, and once kept the old edge speeds after the ladder cap was added there. So
 `njit_cached` compiles as `numba.njit(cache=True, ...)` does, but into a cache folder named after
 a fingerprint of every source file of the package: any change to them starts a fresh cache.

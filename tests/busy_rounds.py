@@ -129,11 +129,11 @@ def _recorded(monkeypatch: pytest.MonkeyPatch, module: object, name: str, entry:
 
 
 def count_stretch_decisions(monkeypatch: pytest.MonkeyPatch) -> list[int]:
-    """From now on, the decisions each compiled stretch makes (`quiet_play._play`), call by
+    """From now on, the decisions each compiled stretch makes (`quiet_play.play_quiet`), call by
     call: a test that the compiled path was taken."""
     from decoy_cli.sim import quiet_play
 
-    return _recorded(monkeypatch, quiet_play, "_play", 2)
+    return _recorded(monkeypatch, quiet_play, "play_quiet", 2)
 
 
 def count_quiet_steps(monkeypatch: pytest.MonkeyPatch) -> list[int]:

@@ -30,7 +30,7 @@ from numba.experimental import structref
 from decoy_cli.compiled import njit_cached
 from decoy_cli.env.observation import NUM_ACTIONS, ObservationEncoder, encode_into
 from decoy_cli.sim.engine import Simulator
-from decoy_cli.sim.quiet_play import Choices, StretchEnd, _play, hands_back
+from decoy_cli.sim.quiet_play import Choices, StretchEnd, hands_back, play_quiet
 from decoy_cli.sim.round_state import StructBase, pack
 from decoy_cli.sim.schedule import NEVER
 
@@ -182,7 +182,7 @@ class RoundSteps:
                 self._check(agent, chosen)
             hand_in = False
             if tick > start:  # `_quiet_step` took the positions and the bomb over itself
-                sim.note_quiet_play(tick, made, 0, False)
+                sim.note_quiet_play(tick, made, 0)
             if status == StepEnd.PLAYED:  # nothing ended
                 quiet.tick = tick
                 return ArrayStep(*out, tick, None, None)
@@ -305,8 +305,9 @@ def _finish(e, winner, bomb, done, tick, out):
 
 @njit_cached
 def _hands_back(e, chosen, watch):
-    """Whether an action handed in would end `_play`'s stretch with its first tick half played
-    (`quiet_play.hands_back`). A move no edge makes `_play` leaves to Python before the tick."""
+    """Whether an action handed in would end `play_quiet`'s stretch with its first tick half
+    played (`quiet_play.hands_back`). A move no edge makes `play_quiet` leaves to Python before
+    the tick."""
     r, due = e.round, e.due
     for i in range(due.shape[0]):
         if due[i] and hands_back(
@@ -320,9 +321,9 @@ def _hands_back(e, chosen, watch):
 def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     """A step's quiet stretch from `tick` through at most `horizon`: the actions handed in
     first (if `hand_in`: they are taken at the stretch's first tick, unless one may hand back,
-    `_hands_back`), then decisions and motion (`_play`) up to the next tick an agent is due,
-    where the step ends and its state is written as `_finish` writes it. After a glide a
-    carried bomb (`bomb`: `_BombInputs`) follows its carrier. Returns how it ended (a
+    `_hands_back`), then decisions and motion (`play_quiet`, which moves a carried bomb,
+    `bomb`: `_BombInputs`) up to the next tick an agent is due, where the step ends and its
+    state is written as `_finish` writes it. Returns how it ended (a
     `StepEnd` value as a plain int: an enum costs a Python call per step to return), the bad or
     untaken agent (else -1), the tick reached and the decisions made."""
     if hand_in:
@@ -333,10 +334,7 @@ def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
             return StepEnd.LEFT_TO_RUN.value, -1, tick, 0
     r = e.round
     c = (e.given, e.draws, e.plant, e.defuse, e.top, e.hold_ticks)
-    reached, _, made, _, glide_end, status = _play(r, c, tick, horizon, 0, NEVER, watch)
-    carrier, bomb_pos = bomb[1], bomb[2]
-    if glide_end >= 0 and carrier >= 0:  # the carried bomb, as `BombRules.follow` moves it
-        bomb_pos[:] = r.pos[carrier]
+    reached, _, made, _, status = play_quiet(r, c, tick, horizon, 0, NEVER, watch, bomb[1], bomb[2])
     if status == StretchEnd.AIRBORNE:
         return StepEnd.IN_THE_AIR.value, -1, reached, made
     if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played

@@ -59,7 +59,7 @@ def take_decision(r, a, act, speed, cap, hold_ticks, plant, defuse, tick):
     the agent wants to plant or defuse as told and leaves a damaging drop; a STOP (or a move no
     edge makes) holds `hold_ticks`; a move starts the agent along its edge at `speed`, its cap
     first set to `cap` (m/s). The one place both the engine's decisions (`Simulator._decide`)
-    and the compiled stretches' (`quiet_play._play`) are taken. Returns how (`Taken`, as an
+    and the compiled stretches' (`quiet_play.play_quiet`) are taken. Returns how (`Taken`, as an
     int: an enum costs more to return) and the change in the number of agents on a damaging
     drop."""
     r.decisions[a] += 1

@@ -266,9 +266,10 @@ class Simulator:
         while True:
             left = limit - self.decision_count
             played = play_stretch(
-                self.state, self.tick, horizon, left, watched, choices, self.agents.weapon
+                self.state, self.tick, horizon, left, watched, choices, self.agents.weapon,
+                self.rules.carrier(self.bomb), self.bomb.position,
             )  # fmt: skip
-            self.note_quiet_play(played.tick, played.made, played.falls, played.glided)
+            self.note_quiet_play(played.tick, played.made, played.falls)
             if played.status != StretchEnd.NEED_DRAWS:
                 break
             player.refill()
@@ -276,15 +277,13 @@ class Simulator:
             raise ValueError("an agent due for a decision is in the air")
         return played.status
 
-    def note_quiet_play(self, tick: int, made: int, falls: int, glided: bool) -> None:
-        """Take over a quiet stretch played in compiled code (`run`, the environment's steps):
-        the tick it reached, the decisions it made and the damaging drops they started; if it
-        glided, the bomb, which on quiet ticks only follows its carrier (`BombRules.follow`)."""
+    def note_quiet_play(self, tick: int, made: int, falls: int) -> None:
+        """Take over a quiet stretch played in compiled code (`quiet_play.play_quiet`, from
+        `run` or the environment's steps): the tick it reached, the decisions it made and the
+        damaging drops they started (the agents, the mover and a carried bomb it moved itself)."""
         self.tick = tick
         self.decision_count += made
         self._falling += falls
-        if glided:
-            self.rules.follow(self.agents, self.bomb)
 
     def quiet_horizon(self) -> int:
         """The last tick through which nothing but decisions and motion can happen from here

@@ -3,8 +3,9 @@
 A quiet stretch is a run of ticks on which nothing but decisions and motion can happen: up to
 the next combat step, recorded tick, bomb-rule tick or the end (`Simulator._stretch_end`). A
 policy whose choices need no Python per decision (`QuietPlayer`) plays it in one compiled loop
-(`_play`): at each tick the due agents decide, then the motion glides to the next arrival or
-decision, exactly as `Simulator.run` plays it tick by tick. Choices come from either
+(`play_quiet`): at each tick the due agents decide, then the motion glides to the next arrival
+or decision and a carried bomb follows its carrier, exactly as `Simulator.run` plays it tick by
+tick. Choices come from either
 
 * uniform draws over each agent's possible actions (`random_play.RandomPolicy`), or
 * actions handed in for the agents due at the stretch's first tick (the environment's step,
@@ -31,13 +32,14 @@ from decoy_cli.compiled import njit_cached
 from decoy_cli.sim.decisions import Decision, Taken, take_decision
 from decoy_cli.sim.movement.kernels import kinematic_glide
 from decoy_cli.sim.round_state import RoundState, take_motion
+from decoy_cli.sim.rules import carry
 from decoy_cli.sim.schedule import is_due, next_due
 from decoy_cli.waypoints.graph import STOP_ACTION
 from decoy_cli.weapons import max_speed_m_s
 
 
 class StretchEnd(IntEnum):
-    """How `_play` ended."""
+    """How `play_quiet` ended."""
 
     QUIET_END = 0
     """It reached the stretch's end, or an agent due next was handed a move no edge makes (the
@@ -104,8 +106,8 @@ class Choices:
         return self.given, self.draws, self.plant, self.defuse, top, self.hold_ticks
 
     def decision(self, agent: int, action: int) -> Decision:
-        """The engine's `Decision` of `action` by `agent`, as `_play` takes it: a move at full
-        speed, or a STOP of `hold_ticks` that plants or defuses as the agent's flags say."""
+        """The engine's `Decision` of `action` by `agent`, as `play_quiet` takes it: a move at
+        full speed, or a STOP of `hold_ticks` that plants or defuses as the agent's flags say."""
         stop = action == STOP_ACTION
         key = (stop and bool(self.plant[agent]), stop and bool(self.defuse[agent]), action)
         found = self._decisions.get(key)
@@ -127,25 +129,26 @@ class Stretch(NamedTuple):
     tick: int  # the tick it reached
     made: int  # decisions made
     falls: int  # damaging drops started
-    glided: bool  # whether the mover moved (the agents' positions are the mover's then)
     status: StretchEnd
 
 
 def play_stretch(
     state: RoundState, tick: int, horizon: int, decisions_left: int, watch: np.ndarray,
-    choices: Choices, weapons: np.ndarray,
+    choices: Choices, weapons: np.ndarray, carrier: int, bomb_position: np.ndarray,
 ) -> Stretch:  # fmt: skip
     """Play the quiet stretch of a round with the kinematic mover after `tick` through at most
-    `horizon` with `choices` (`_play`) and the agents' `weapons` (their full speeds), making at
-    most `decisions_left` decisions; `choices.next_draw` moves on."""
+    `horizon` with `choices` (`play_quiet`) and the agents' `weapons` (their full speeds),
+    making at most `decisions_left` decisions, the bomb at `bomb_position` following `carrier`
+    (`BombRules.carrier`); `choices.next_draw` moves on."""
     if choices.hold_ticks < 1:
         raise ValueError(f"a STOP holds at least 1 tick, not {choices.hold_ticks}")
     c = choices.arrays(choices.top_speeds.of(weapons))
-    reached, used, made, falls, glide_end, status = _play(
-        state.kernel, c, tick, horizon, choices.next_draw, decisions_left, watch
-    )
+    reached, used, made, falls, status = play_quiet(
+        state.kernel, c, tick, horizon, choices.next_draw, decisions_left, watch, carrier,
+        bomb_position,
+    )  # fmt: skip
     choices.next_draw = used
-    return Stretch(reached, made, falls, glide_end >= 0, StretchEnd(status))
+    return Stretch(reached, made, falls, StretchEnd(status))
 
 
 def decide_tick(
@@ -170,8 +173,8 @@ def decide_tick(
 @njit_cached
 def hands_back(a, act, at, watch, plant, defuse, out_edges, edge_fall):
     """Whether agent a's decision `act` at node `at` ends a quiet stretch with its tick half
-    played (`_play` returns DECIDED): a STOP to plant or defuse by an agent the bomb rules watch
-    (they may act on it), or a damaging drop (the engine lands it)."""
+    played (`play_quiet` returns DECIDED): a STOP to plant or defuse by an agent the bomb rules
+    watch (they may act on it), or a damaging drop (the engine lands it)."""
     if act == STOP_ACTION:
         return watch[a] and (plant[a] or defuse[a])
     edge = out_edges[at, act]
@@ -226,49 +229,50 @@ def decide_due(r, c, tick, next_draw, watch):
 
 
 @njit_cached
-def _play(r, c, tick, horizon, next_draw, decisions_left, watch):
+def play_quiet(r, c, tick, horizon, next_draw, decisions_left, watch, carrier, bomb_position):
     """The quiet stretch after `tick` through `horizon`, as `Simulator.run` plays it tick by
     tick, on the round `r` (`RoundState.kernel`): at each tick the due agents decide
     (`decide_due`, `c`: `Choices.arrays`, draws from `next_draw` on), then if the tick after
-    them is quiet the motion glides to the next arrival or decision or the horizon.
-    A handed-in action must be 0..8 (`Choices`). Returns (tick, next draw, decisions made,
-    damaging drops started, tick of the last glide's end or -1, status)."""
+    them is quiet the motion glides to the next arrival or decision or the horizon, and the
+    bomb at `bomb_position` follows `carrier` (`rules.carry`; -1: nobody carries it), all the
+    bomb rules do on quiet ticks. The one driver of compiled stretches: the engine's
+    (`play_stretch`) and the environment's steps (`env_step`). A handed-in action must be 0..8
+    (`Choices`). Returns (tick, next draw, decisions made, damaging drops started, status)."""
     given, draws, node, out_edges = c[0], c[1], r.node, r.out_edges
     alive, waiting, hold_until = r.alive, r.waiting, r.hold_until
     n = alive.shape[0]
     made = falls = 0
-    glide_end = -1
     while True:
         if tick + 1 > horizon:
-            return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
+            return tick, next_draw, made, falls, StretchEnd.QUIET_END
         drawn = 0
         for i in range(n):
             if is_due(i, waiting, alive, hold_until, tick + 1):
                 if given[i] == -1:
-                    return tick, next_draw, made, falls, glide_end, StretchEnd.DUE
+                    return tick, next_draw, made, falls, StretchEnd.DUE
                 if given[i] == DRAW:
                     drawn += 1
                 elif given[i] != STOP_ACTION and out_edges[node[i], given[i]] < 0:
-                    return tick, next_draw, made, falls, glide_end, StretchEnd.QUIET_END
+                    return tick, next_draw, made, falls, StretchEnd.QUIET_END
         if drawn > draws.shape[0] - next_draw:
-            return tick, next_draw, made, falls, glide_end, StretchEnd.NEED_DRAWS
+            return tick, next_draw, made, falls, StretchEnd.NEED_DRAWS
         tick += 1
         next_draw, now, fell, hand_back, airborne = decide_due(r, c, tick, next_draw, watch)
         made += now
         falls += fell
         if airborne:
-            return tick, next_draw, made, falls, glide_end, StretchEnd.AIRBORNE
+            return tick, next_draw, made, falls, StretchEnd.AIRBORNE
         if hand_back or made >= decisions_left:
-            return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
+            return tick, next_draw, made, falls, StretchEnd.DECIDED
         due_at = next_due(waiting, alive, hold_until, tick - 1)
         last = min(horizon, due_at - 1)
         if due_at == tick or last < tick:
-            return tick, next_draw, made, falls, glide_end, StretchEnd.DECIDED
+            return tick, next_draw, made, falls, StretchEnd.DECIDED
         flags = r.flags
         flags[:] = False
         ticks, _ = kinematic_glide(
             r.mpos, r.start, r.target, r.fv, r.iv, flags, r.prm, last - tick + 1
         )
         tick += ticks - 1
-        glide_end = tick
         take_motion(r)
+        carry(bomb_position, r.pos, carrier)

@@ -134,7 +134,7 @@ def take_motion(r):
     """Take over what the mover's last call did (`r`: `RoundState.kernel`): the agents stand
     where the mover has them, those that moved face their heading, and the alive ones that
     arrived stand on their goal node and wait for a decision. The one place both the engine
-    (`Simulator._moved`) and the compiled stretches (`quiet_play._play`) take motion over."""
+    (`Simulator._moved`) and the compiled stretches (`quiet_play.play_quiet`) take motion over."""
     r.pos[:] = r.mpos
     flags, yaw, fv, alive, node, goal_node = r.flags, r.yaw, r.fv, r.alive, r.node, r.goal_node
     for i in range(yaw.shape[0]):

@@ -1,4 +1,5 @@
-"""Bomb and round rules of a CS:GO round, advanced tick by tick by the engine (pure numpy).
+"""Bomb and round rules of a CS:GO round, advanced tick by tick by the engine (numpy; `carry`,
+the one rule compiled stretches apply too, compiled).
 
 Durations are whole tick counts (`RulesConfig`), so every rule fires on an exact tick:
 
@@ -49,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import TICK_RATE, seconds_to_ticks
 from decoy_cli.sim.sites import (
     BOMB_TARGET_BOXES,
@@ -233,7 +235,7 @@ class BombRules:
             if not agents.alive[bomb.carrier]:  # killed without `on_death`
                 events += self.on_death(tick, bomb.carrier, agents, bomb)
             else:
-                bomb.position = agents.position[bomb.carrier].copy()
+                carry(bomb.position, agents.position, bomb.carrier)
                 events += self._plant(tick, agents, bomb, wants_plant, moving)
         elif bomb.status == BombStatus.DROPPED and self.config.auto_pickup:
             events += self._pickup(tick, agents, bomb)
@@ -257,11 +259,12 @@ class BombRules:
             watch[:] = True
         return watch
 
-    def follow(self, agents: Agents, bomb: Bomb) -> None:
-        """All that `step` does on a quiet tick (`quiet_until`): a carried bomb follows its
-        carrier. The engine calls it instead of `step` after ticks it knows are quiet."""
-        if self.config.bomb_enabled and bomb.status == BombStatus.CARRIED and bomb.carrier >= 0:
-            bomb.position = agents.position[bomb.carrier].copy()
+    def carrier(self, bomb: Bomb) -> int:
+        """Who carries the bomb (-1: nobody, or no bomb rules): the agent it follows (`carry`)
+        on the quiet ticks a compiled stretch glides through, where it does nothing else."""
+        if self.config.bomb_enabled and bomb.status == BombStatus.CARRIED:
+            return bomb.carrier
+        return -1
 
     def on_death(self, tick: int, agent: int, agents: Agents, bomb: Bomb) -> list[SimEvent]:
         """An agent died: its plant or defuse stops, and the bomb it carried drops where it
@@ -470,6 +473,16 @@ class BombRules:
         bomb.defuser = -1
         bomb.defuse_ticks = 0
         return SimEvent(tick, "defuse_aborted", defuser, data={"reason": reason})
+
+
+@njit_cached
+def carry(bomb_position, positions, carrier):
+    """A carried bomb follows its carrier: `bomb_position` (3,) takes the position of agent
+    `carrier` among `positions` (N, 3), in place (-1: nobody carries it; nothing moves). The one
+    place the rule is written: `BombRules.step` applies it at every tick it plays, the compiled
+    stretches (`quiet_play.play_quiet`) after their glides."""
+    if carrier >= 0:
+        bomb_position[:] = positions[carrier]
 
 
 def _first_true(*checks: tuple[str, bool]) -> str:
