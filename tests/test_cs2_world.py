@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from differences import npz_difference
+from shipped_graphs import assert_rebuilt_when_inputs_changed
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
@@ -26,7 +26,7 @@ from decoy_cli.waypoints.build import (
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import SAME_MAP_SHARE, cs2_world, on_map_share
-from decoy_cli.world.nav_data import REGIONS, asset_dir, load_navmesh
+from decoy_cli.world.nav_data import REGIONS, load_navmesh
 from decoy_cli.world.nav_json import read_nav
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
 
@@ -356,14 +356,8 @@ def test_the_cs2_dust2_nav_is_de_dust2_s_and_no_other_map_s() -> None:
 @pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
 def test_the_shipped_cs2_graph_is_current(tmp_path: Path) -> None:
     """Rebuilding the CS2 de_dust2 graph from the nav file gives the shipped bytes (the command
-    in assets/de_dust2/ATTRIBUTION.md)."""
-    shipped = asset_dir("de_dust2") / CS2_GRAPH_FILE
-    out = tmp_path / "cs2.npz"
-    result = runner.invoke(
-        app, ["build-waypoints", "--nav", str(CS2_NAV), "--out", str(out), "--no-plot"]
-    )
-    assert result.exit_code == 0, result.output
-    assert out.read_bytes() == shipped.read_bytes(), npz_difference(out, shipped)
+    in assets/de_dust2/ATTRIBUTION.md), run whenever its inputs changed since its stamp."""
+    assert_rebuilt_when_inputs_changed("de_dust2", CS2_GRAPH_FILE, tmp_path)
 
 
 def test_the_shipped_cs2_graph_carries_a_cs2_world() -> None:
