@@ -61,12 +61,13 @@ def build_arguments(map_name: str, graph_file: str, out: Path) -> list[str]:
 def fingerprint(map_name: str, graph_file: str) -> str:
     """The fingerprint of what a shipped graph is built from (module docstring)."""
     digest = hashlib.sha256()
+    named = [(str(path.relative_to(PACKAGE.parent)), path) for path in CODE]
     assets = sorted(p for p in (ASSETS / map_name).iterdir() if p.suffix not in NOT_INPUTS)
-    inputs = [*CODE, *assets]
+    named += [(f"assets/{map_name}/{path.name}", path) for path in assets]
     if graph_file == "cs2_waypoints.npz":
-        inputs.append(CS2_NAV)
-    for path in inputs:
-        digest.update(str(path.relative_to(ROOT.parent)).encode())
+        named.append(("the CS2 nav file", CS2_NAV))
+    for name, path in named:
+        digest.update(name.encode())
         digest.update(path.read_bytes() if path.is_file() else b"absent")
     libraries = [f"python {sys.version_info.major}.{sys.version_info.minor}"]
     libraries += [f"{name} {version(name)}" for name in LIBRARIES]
