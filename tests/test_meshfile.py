@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from worlds import write_awmh
 
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import OutputError, WorldError
@@ -169,6 +171,58 @@ def test_tri_two_triangles_in_hammer_units(tmp_path: Path) -> None:
 def test_extension_is_case_insensitive(tmp_path: Path) -> None:
     world = read_mesh(_two_triangles_tri(tmp_path / "TWO.TRI"), units="m")
     assert world.triangles[0, 1, 0] == 100
+
+
+# ---- .mesh (awpy 3) -------------------------------------------------------------------------
+
+
+def _awmh(version: int, vertices: int, triangles: int, body: bytes = b"") -> bytes:
+    return struct.pack("<4s3I", b"AWMH", version, vertices, triangles) + body
+
+
+def test_awpy3_mesh_reads_the_triangles_a_tri_holds(tmp_path: Path) -> None:
+    tri = read_mesh(_two_triangles_tri(tmp_path / "two.tri"))
+    write_awmh(tri, tmp_path / "two.mesh")
+    mesh = read_mesh(tmp_path / "two.mesh")
+    np.testing.assert_allclose(mesh.triangles, tri.triangles, rtol=1e-6, atol=1e-9)
+    assert mesh.meta["format"] == "mesh" and mesh.name == "two"
+    (tmp_path / "tail.mesh").write_bytes((tmp_path / "two.mesh").read_bytes() + b"more")
+    np.testing.assert_array_equal(read_mesh(tmp_path / "tail.mesh").triangles, mesh.triangles)
+
+
+def test_real_dust2_as_an_awpy3_mesh(dust2_tri: Path, tmp_path: Path) -> None:
+    world = read_mesh(dust2_tri)
+    write_awmh(world, tmp_path / "de_dust2.mesh")
+    mesh = read_mesh(tmp_path / "de_dust2.mesh")
+    assert mesh.num_triangles == world.num_triangles
+    np.testing.assert_allclose(mesh.triangles, world.triangles, rtol=0, atol=1e-4)
+
+
+AWMH_ERRORS = [
+    (b"OBJ " + bytes(12), "not an awpy .mesh file"),
+    (b"AWM", "not an awpy .mesh file"),
+    (_awmh(2, 3, 1, bytes(48)), "awpy .mesh version 2; this decoy reads version 1"),
+    (_awmh(1, 3, 1, bytes(47)), "truncated: its header promises 3 vertices and 1 triangles"),
+    (_awmh(1, 2**32 - 1, 2**32 - 1), "promises 4,294,967,295 vertices"),
+    (_awmh(1, 3, 0, bytes(36)), "the mesh has no triangles"),
+    (_awmh(1, 3, 1, bytes(36) + struct.pack("<3I", 0, 1, 3)), "refers to vertex 3, but 3"),
+    (
+        _awmh(1, 3, 1, struct.pack("<9f3I", 0, 0, 0, 1, 0, 0, float("nan"), 1, 0, 0, 1, 2)),
+        "triangle 0 has a NaN or infinite coordinate",
+    ),
+]
+
+
+@pytest.mark.parametrize(("content", "fragment"), AWMH_ERRORS)
+def test_a_bad_awpy3_mesh_is_one_line_naming_the_file(
+    tmp_path: Path, content: bytes, fragment: str
+) -> None:
+    path = tmp_path / "bad.mesh"
+    path.write_bytes(content)
+    with pytest.raises(WorldError) as caught:
+        read_mesh(path)
+    assert str(path) in str(caught.value) and fragment in str(caught.value)
+    assert "\n" not in str(caught.value)
 
 
 # ---- options ---------------------------------------------------------------------------------

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from both_teams import BothTeams, Mate
 from typer.testing import CliRunner
+from worlds import write_awmh
 
 from decoy_cli.cli import app
 from decoy_cli.errors import WorldError
@@ -20,7 +21,7 @@ from decoy_cli.esta import read_match
 from decoy_cli.replay.replayer import ReplayOptions, replay_round
 from decoy_cli.sim.combat import CombatBatch, DamageResult
 from decoy_cli.waypoints.build import builtin_graph, graph_world
-from decoy_cli.world.meshfile import write_obj
+from decoy_cli.world.meshfile import read_mesh, write_obj
 from decoy_cli.world.occlusion import read_sight_scene
 from decoy_cli.world.world import World
 
@@ -77,6 +78,14 @@ def test_a_wall_of_the_sight_mesh_blocks_what_the_nav_world_sees(tmp_path: Path)
     open_mesh = write_mesh(tmp_path / "open.obj", None)
     assert hits(doc, tmp_path, open_mesh) > 0  # nothing between them in this mesh either
     walled = write_mesh(tmp_path / "walled.obj", (t_feet, ct_feet))
+    assert hits(doc, tmp_path, walled) == 0
+
+
+def test_an_awpy3_mesh_is_taken_as_the_sight_mesh(tmp_path: Path) -> None:
+    """The same walled geometry written as awpy 3's `.mesh` blocks the same shots."""
+    doc, t_feet, ct_feet = facing()
+    walled = tmp_path / "walled.mesh"
+    write_awmh(read_mesh(write_mesh(tmp_path / "walled.obj", (t_feet, ct_feet))), walled)
     assert hits(doc, tmp_path, walled) == 0
 
 

@@ -247,3 +247,17 @@ def fixture_room() -> World:
     return make_world(
         [floor(x0, y0, x1, y1), walls_around(x0, y0, x1, y1)], "fixture room", (-7.0, 12.0, 0.0)
     )
+
+
+def write_awmh(world: World, path, version: int = 1) -> None:
+    """The world as awpy 3's `.mesh` (little-endian `AWMH`, version, vertex and triangle
+    counts as uint32, float32 vertices in Hammer units, uint32 corner indices), written by
+    hand from the format awpy documents: a fixture in the real layout."""
+    import struct
+
+    from decoy_cli.csgo import HAMMER_TO_M
+
+    vertices, indices = world.vertices_and_indices()
+    header = struct.pack("<4s3I", b"AWMH", version, len(vertices), len(indices))
+    body = (vertices / HAMMER_TO_M).astype("<f4").tobytes() + indices.astype("<u4").tobytes()
+    path.write_bytes(header + body)

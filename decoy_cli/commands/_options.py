@@ -43,8 +43,8 @@ DEATHS_HELP = (
 )
 SIGHT_MESH_HELP = (
     "The map's geometry to test line of sight in when shooting: a triangle mesh in Hammer units, "
-    "z up (awpy's .tri, or an .obj). Default: the nav world the graph was built on, which lacks "
-    "windows, props and low cover."
+    "z up (awpy's .tri, awpy 3's .mesh, or an .obj). Default: the nav world the graph was built "
+    "on, which lacks windows, props and low cover."
 )
 MISSING_HELP = (
     "Fields the game needs and the data lacks (weapon in hand, armour, the bomb's carrier, the "

@@ -52,7 +52,8 @@ class UserMesh:
     mesh: Annotated[
         Path | None,
         typer.Option(
-            "--mesh", help="A user mesh (.obj or awpy .tri) instead of the built-in nav world."
+            "--mesh",
+            help="A user mesh (.obj, awpy .tri or awpy 3 .mesh) instead of the built-in nav world.",
         ),
     ] = None
     units: Annotated[Literal["hammer", "m"], typer.Option("--units", help="Mesh units.")] = "hammer"

@@ -1,9 +1,13 @@
-"""User map meshes: read a Wavefront `.obj` or an awpy-style `.tri` into a `World`, and write both.
+"""User map meshes: read a Wavefront `.obj`, an awpy-style `.tri` or an awpy 3 `.mesh` into a
+`World`, and write the first two.
 
 Formats:
 
 * `.tri` (awpy): raw little-endian float32, 9 values per triangle (three x, y, z vertices), no
   header; the file size is a multiple of 36 bytes.
+* `.mesh` (awpy 3's collision meshes, `awpy get`): little-endian, `AWMH`, then version (1),
+  vertex count and triangle count as uint32, the vertices (3 float32 each), the triangles (3
+  uint32 vertex indices each); bytes after them are ignored, as awpy ignores them.
 * `.obj` (Wavefront): `v x y z [w | r g b]` vertices and `f` faces of 3 or more vertex
   references (`i`, `i/t`, `i//n`, `i/t/n`; negative = relative to the vertices defined so far),
   polygons fan-triangulated. Every other statement (vn, vt, o, g, s, usemtl, mtllib, l, p,
@@ -35,6 +39,7 @@ from __future__ import annotations
 import hashlib
 import numbers
 import os
+import struct
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -59,13 +64,16 @@ UP_AXES: dict[str, np.ndarray] = {
 }
 """Rotation that turns each possible file up axis onto +z (all with determinant +1)."""
 
-FORMATS = (".obj", ".tri")
+FORMATS = (".obj", ".tri", ".mesh")
 
 MIN_EXTENT_M = 5.0
 MAX_EXTENT_M = 2000.0
 """Plausible horizontal size of a CS:GO map (de_dust2 is about 100 m across)."""
 
 _TRI_BYTES = 36
+_AWMH = b"AWMH"
+_AWMH_VERSION = 1
+_AWMH_HEADER = struct.Struct("<4s3I")
 
 
 def read_mesh(
@@ -77,14 +85,15 @@ def read_mesh(
     offset: Sequence[float] = (0.0, 0.0, 0.0),
     name: str | None = None,
 ) -> World:
-    """Read a `.obj` or `.tri` mesh into a `World` in metres (see the module docstring)."""
+    """Read a `.obj`, `.tri` or `.mesh` into a `World` in metres (see the module docstring)."""
     path = Path(path)
     factor = _metres_per_unit(path, units, scale)
     axis, rotation = _up_rotation(path, up_axis)
     shift = _offset(path, offset)
     data = _read_bytes(path)
     suffix = path.suffix.lower()
-    raw = _parse_tri(data, path) if suffix == ".tri" else _parse_obj(data, path)
+    parse = {".tri": _parse_tri, ".mesh": _parse_awmh}.get(suffix, _parse_obj)
+    raw = parse(data, path)
     with np.errstate(over="ignore", invalid="ignore"):
         triangles = (raw.astype(np.float64) * factor) @ rotation.T + shift
     if not np.all(np.isfinite(triangles)):
@@ -214,7 +223,40 @@ def _parse_tri(data: bytes, path: Path) -> np.ndarray:
             f"{path}: {len(data)} bytes is not a multiple of {_TRI_BYTES} "
             "(9 float32 per triangle): truncated or not a .tri file"
         )
-    triangles = np.frombuffer(data, dtype="<f4").reshape(-1, 3, 3)
+    return _finite(np.frombuffer(data, dtype="<f4").reshape(-1, 3, 3), path)
+
+
+def _parse_awmh(data: bytes, path: Path) -> np.ndarray:
+    """(T, 3, 3) float32 triangles of an awpy 3 `.mesh` file, in file units. The counts of
+    the header are checked against the file's size before anything is allocated."""
+    if len(data) < _AWMH_HEADER.size or data[:4] != _AWMH:
+        raise WorldError(f"{path}: not an awpy .mesh file (it does not start with AWMH)")
+    _, version, vertices, triangles = _AWMH_HEADER.unpack_from(data)
+    if version != _AWMH_VERSION:
+        raise WorldError(f"{path}: awpy .mesh version {version}; this decoy reads version 1")
+    size = _AWMH_HEADER.size + 12 * vertices + 12 * triangles
+    if len(data) < size:
+        raise WorldError(
+            f"{path}: truncated: its header promises {vertices:,} vertices and {triangles:,} "
+            f"triangles ({size:,} bytes), the file has {len(data):,} bytes"
+        )
+    if triangles == 0:
+        raise WorldError(f"{path}: the mesh has no triangles")
+    start = _AWMH_HEADER.size
+    points = np.frombuffer(data, "<f4", 3 * vertices, start).reshape(-1, 3)
+    corners = np.frombuffer(data, "<u4", 3 * triangles, start + 12 * vertices).reshape(-1, 3)
+    outside = corners >= vertices
+    if outside.any():
+        t = int(np.argmax(outside.any(axis=1)))
+        raise WorldError(
+            f"{path}: triangle {t} refers to vertex {int(corners[t].max())}, but {vertices:,} "
+            "vertices are defined"
+        )
+    return _finite(points[corners], path)
+
+
+def _finite(triangles: np.ndarray, path: Path) -> np.ndarray:
+    """The triangles, when none has a NaN or infinite coordinate."""
     bad = ~np.isfinite(triangles).all(axis=(1, 2))
     if bad.any():
         raise WorldError(

@@ -61,10 +61,10 @@ class OcclusionScene:
 
 
 def read_sight_scene(path: Path, feet: np.ndarray, map_name: str) -> OcclusionScene:
-    """A map's own geometry for line of sight, from an awpy-style `.tri` or an `.obj` in Hammer
-    units, z up (`read_mesh`). Refused (`WorldError`) when it is larger than a map or when fewer
-    than `SIGHT_FLOOR_SHARE` of the map's waypoints (`feet`, metres) have a floor of it under
-    them, as a mesh of another map or in other units would not."""
+    """A map's own geometry for line of sight, from an awpy-style `.tri`, an awpy 3 `.mesh` or
+    an `.obj` in Hammer units, z up (`read_mesh`). Refused (`WorldError`) when it is larger
+    than a map or when fewer than `SIGHT_FLOOR_SHARE` of the map's waypoints (`feet`, metres)
+    have a floor of it under them, as a mesh of another map or in other units would not."""
     world = read_mesh(path)
     low, high = world.bounds
     width = float(np.max(high[:2] - low[:2]))
