@@ -132,17 +132,55 @@ class Simulator:
         done, unless `after_end`: then, after the outcome, the agents go on moving and are
         recorded (a replay following the data through the round-end delay, when real players
         still move), while the rules, combat and the outcome stay as they ended."""
-        if after_end and self.outcome is not None:
-            start = len(self.events)
-            self._move_after_end(self.tick + 1)
-            return self.events[start:]
-        if self.done:
+        if self.done and not (after_end and self.outcome is not None):
             return []
         start = len(self.events)
-        self.tick += 1
-        self._decide()
-        self._finish_tick(self._move())
+        self._advance(self.tick + 1)
         return self.events[start:]
+
+    def _advance(
+        self,
+        end: int,
+        stop: Callable[[], bool] | None = None,
+        player: QuietPlayer | None = None,
+        limit: int = NEVER,
+    ) -> None:
+        """Decide, then move: the one driver of the round's ticks (`step`, `run`), from this
+        tick through at most `end`. With a `player` (`run`'s `QuietPlayer`) and the next ticks
+        quiet, a stretch of them is handed to compiled code (`_play_quiet`, up to `limit`
+        decisions in all); otherwise, or when that stretch ends with a tick half played, the
+        next tick's decisions are made here and then its motion:
+
+        * after the outcome, with that of the ticks after it on which no decision falls due and
+          nothing is recorded, in one mover call (the rules, combat and the outcome stay);
+        * glided with the quiet ticks after it (`_glide`) when `stop` says go on;
+        * else (no `stop`: `step`) played whole with the rest of the tick (`_finish_tick`)."""
+        decided = False
+        if player is not None and self.outcome is None and not self._falling:
+            horizon = self._stretch_end(self.tick, end)
+            if horizon > self.tick:
+                before = (self.tick, self.decision_count)
+                watched = self.rules.watched(self.agents, self.bomb)
+                decided = self._play_quiet(player, horizon, limit, watched) == StretchEnd.DECIDED
+                if not decided and (self.tick, self.decision_count) != before:
+                    return  # the caller asks its stopping rules again
+        if not decided:
+            self.tick += 1
+            self._decide()
+        if self.outcome is not None:
+            due = next_due(self.waiting, self.agents.alive, self.hold_until, self.tick)
+            last = min(end, due - 1, self.recorder.next_tick - 1)
+            ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
+            self.tick += ticks - 1
+            self._moved(moved)
+            self._record()
+            return
+        if stop is not None and not stop():
+            last = min(self._quiet_until(self.tick - 1), end)
+            if last >= self.tick:
+                self._glide(last)
+                return
+        self._finish_tick(self._move())
 
     def _finish_tick(self, moving: np.ndarray) -> None:
         """The rest of a tick after the decisions and the motion: the bomb rules, the combat
@@ -174,19 +212,6 @@ class Simulator:
                 )
             )
 
-    def _move_after_end(self, end: int) -> None:
-        """Movement after the outcome (see `step`): the next tick's decisions, then its motion
-        and that of the ticks after it up to `end` on which no decision falls due and nothing
-        is recorded, in one mover call."""
-        self.tick += 1
-        self._decide()
-        last = min(end, next_due(self.waiting, self.agents.alive, self.hold_until, self.tick) - 1)
-        last = min(last, self.recorder.next_tick - 1)
-        ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
-        self.tick += ticks - 1
-        self._moved(moved)
-        self._record()
-
     def run(
         self,
         until: Callable[[Simulator], bool] | None = None,
@@ -211,50 +236,22 @@ class Simulator:
         to stop at a tick give `to_tick`; to watch positions, `step`.
 
         A `quiet_play.QuietPlayer` policy (the random policy) has whole quiet stretches of
-        decisions and motion played in compiled code (`_play_quiet`) when the mover is
-        kinematic and no `until` is given, with the same result."""
+        decisions and motion played in compiled code when the mover is kinematic and no `until`
+        is given, with the same result. Each pass of the loop is one `_advance`."""
         end = self._max_tick if to_tick is None else int(to_tick)
         limit = NEVER if max_decisions is None else self.decision_count + int(max_decisions)
 
         def stop() -> bool:
             return self.decision_count >= limit or (until is not None and until(self))
 
-        quiet_player = None
+        player = None
         if until is None and isinstance(self.mover, KinematicMover):
-            quiet_player = self._player
+            player = self._player
         while self.tick < end and not stop():
-            if self.done:
-                if not (after_end and self.outcome is not None):
-                    break
-                self._move_after_end(end)
-                continue
-            if quiet_player is not None and not self._falling:
-                horizon = self._stretch_end(self.tick, end)
-                if horizon > self.tick:
-                    before = (self.tick, self.decision_count)
-                    watched = self.rules.watched(self.agents, self.bomb)
-                    status = self._play_quiet(quiet_player, horizon, limit, watched)
-                    if status == StretchEnd.DECIDED:
-                        self._after_decisions(end, stop)
-                        continue
-                    if (self.tick, self.decision_count) != before:
-                        continue  # ask the stopping rules again
-            self.tick += 1
-            self._decide()
-            self._after_decisions(end, stop)
+            if self.done and not (after_end and self.outcome is not None):
+                break
+            self._advance(end, stop, player, limit)
         return self.recording
-
-    def _after_decisions(self, end: int, stop: Callable[[], bool]) -> None:
-        """The rest of a tick whose decisions are made: the glide through the quiet ticks from
-        it, or the tick played whole (also when `stop` now says so, to be asked again)."""
-        if stop():
-            self._finish_tick(self._move())
-            return
-        last = min(self._quiet_until(self.tick - 1), end)
-        if last >= self.tick:
-            self._glide(last)
-        else:
-            self._finish_tick(self._move())
 
     def _play_quiet(
         self, player: QuietPlayer, horizon: int, limit: int, watched: np.ndarray
