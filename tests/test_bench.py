@@ -89,9 +89,8 @@ def test_the_model_fallback_is_said_and_labelled(quick_run) -> None:
     assert model["loaded"] is False and "no-such-models" in model["error"]
     assert "could not be loaded" in result.stdout
     assert "line of sight only, no inference" in report["sections"]["table1"]["damage_model"]
-    assert "line of sight only, no inference" in report["sections"]["combat_step"]["damage_model"]
     assert report["sections"]["replay"]["options"]["combat"] is False
-    for name in ("kinematic", "env"):  # the portable sections name what they shot with
+    for name in ("kinematic", "env", "combat_step"):  # the portable sections name their model
         assert "no-such-models did not load" in report["sections"][name]["damage_model"]
 
 
@@ -130,11 +129,77 @@ def test_throughput_sections_count_what_they_measured(quick_run) -> None:
     assert reader["mb_per_s_decompressed"] > reader["mb_per_s_compressed"] > 0
     metrics = sections["metrics"]
     assert metrics["pairs"] == 100 and metrics["evaluated"] == 100
-    assert [row["layout"] for row in sections["combat_step"]["rows"]] == ["spread", "clustered"]
-    for row in sections["combat_step"]["rows"]:
+    kernels = [(row["kernel"], row["size"]) for row in metrics["kernels"]]
+    assert kernels == [
+        (kernel, size)
+        for size in ("310x310", "451x451")
+        for kernel in ("dtw", "frechet", "frechet x-y")
+    ]
+    for row in metrics["kernels"]:
+        assert row["calls"] == 50 and row["max_ms"] >= row["median_ms"] >= row["min_ms"] > 0
+    rows = sections["combat_step"]["rows"]
+    assert [(row["agents"], row["layout"]) for row in rows] == [(10, "spread"), (10, "clustered")]
+    for row in rows:
         parts = row["parts"]
         assert row["steps"] == 20
         assert parts["step"]["median_ms"] >= parts["visible_pairs"]["median_ms"] > 0
+
+
+def test_the_sizes_reach_table_1_the_kinematic_core_and_the_combat_step(tmp_path: Path) -> None:
+    out = tmp_path / "bench.json"
+    args = ["bench", "--quick", "--sections", "table1,kinematic,combat_step", "--models", "none"]
+    sizes = ["--agents", "3,4,3", "--decisions", "150", "--combat-agents", "2,12"]
+    result = runner.invoke(app, [*args, *sizes, "--out", str(out)], env=WIDE)
+    assert result.exit_code == 0, result.output
+    report = json.loads(out.read_text())
+    assert report["config"]["agent_counts"] == [3, 4] and report["config"]["decisions"] == 150
+    table = report["sections"]["table1"]
+    assert [row["agents"] for row in table["rows"]] == [3, 4]
+    assert table["decisions_per_row"] == 150
+    assert all(150 <= row["decisions"] < 1000 for row in table["rows"])
+    assert 150 <= report["sections"]["kinematic"]["decisions"] < 1000
+    rows = report["sections"]["combat_step"]["rows"]
+    shapes = [(row["agents"], row["layout"], row["steps"]) for row in rows]
+    # 20 quick steps at 10 agents or fewer; proportionally fewer above: 20 * 10 // 12
+    assert shapes == [
+        (2, "spread", 20),
+        (2, "clustered", 20),
+        (12, "spread", 16),
+        (12, "clustered", 16),
+    ]
+    assert "one combat step" in result.stdout and "12" in result.stdout
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--agents", "1", "--agents 1: Table 1 plays 2 to 520 agents on de_dust2"),
+        ("--agents", "521", "--agents 521: Table 1 plays 2 to 520 agents"),
+        ("--agents", "2,x", "--agents '2,x': give whole numbers separated by commas"),
+        ("--agents", ",", "--agents ',': give whole numbers"),
+        ("--combat-agents", "7", "--combat-agents 7: give an even count from 2 to"),
+        ("--combat-agents", "0", "--combat-agents 0: give an even count"),
+        ("--decisions", "0", "Invalid value for '--decisions'"),
+    ],
+)
+def test_bad_sizes_are_one_line_before_any_section(option: str, value: str, message: str) -> None:
+    result = runner.invoke(app, ["bench", "--quick", option, value], env=WIDE)
+    assert result.exit_code != 0
+    assert result.stderr.startswith(f"error: {message}") and result.stderr.count("\n") == 1
+    assert "Table 1" not in result.stdout
+
+
+def test_given_sizes_replace_the_quick_ones_and_no_other() -> None:
+    quick = BenchConfig.create(quick=True, models=ModelName.NONE)
+    sized = BenchConfig.create(
+        quick=True, models=ModelName.NONE, agent_counts=[6, 2, 6], decisions=7, combat_agents=[100]
+    )
+    assert (sized.agent_counts, sized.decisions, sized.combat_agents) == ((6, 2), 7, (100,))
+    assert (quick.agent_counts, quick.decisions, quick.combat_agents) == ((2, 10), 1000, (10,))
+    assert sized.combat_repeats == quick.combat_repeats == 20
+    assert sized.metric_pairs == quick.metric_pairs
+    with pytest.raises(DecoyError, match="--decisions 0"):
+        BenchConfig.create(quick=False, models=ModelName.NONE, decisions=0)
 
 
 def test_find_data_prefers_the_given_folder_then_the_candidates(tmp_path: Path) -> None:
@@ -164,7 +229,7 @@ def test_without_data_the_data_sections_are_skipped_with_the_reason() -> None:
 def test_a_failing_section_is_an_error_entry_not_a_crash() -> None:
     config = BenchConfig.create(quick=True, models="/no/such/folder")
     status = ModelStatus("/no/such/folder", loaded=True, label="pretend")
-    result = run_isolated("combat_step", config, status, None)
+    result = run_isolated("table1", config, status, None)
     assert "no such model folder" in result["error"]
 
 
@@ -218,7 +283,7 @@ def test_a_learned_model_runs_in_the_combat_step(tmp_path: Path) -> None:
     assert status.loaded and status.error is None and str(tmp_path) in status.label
     config = BenchConfig.create(quick=True, models=str(tmp_path))
     result = run_section("combat_step", config, status, None)
-    assert result["damage_model"] == status.label
+    assert result["damage_model"] == str(tmp_path)  # loaded: named as given
     clustered = result["rows"][1]
     assert clustered["visible_pairs_median"] > 0
     assert clustered["parts"]["model"]["median_ms"] > 0

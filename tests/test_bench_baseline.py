@@ -10,8 +10,17 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from decoy_cli.bench.baseline import Ratio, baseline_tree, current_tree, headlines
+from decoy_cli.bench import BenchConfig
+from decoy_cli.bench.baseline import (
+    Ratio,
+    baseline_tree,
+    current_tree,
+    headlines,
+    run_args,
+    run_in,
+)
 from decoy_cli.cli import app
+from decoy_cli.damage.choice import ModelName
 from decoy_cli.errors import DecoyError
 
 runner = CliRunner()
@@ -40,8 +49,17 @@ def test_headlines_are_rates_higher_is_better() -> None:
         "ticks/s, 2 agents": 5.0,
         "ticks/s, 10 agents": 2.0,
     }
-    step = {"layout": "spread", "parts": {"step": {"median_ms": 0.5}}}
-    assert headlines("combat_step", {"rows": [step]}) == {"steps/s, spread": 2000.0}
+    step = {"agents": 10, "layout": "spread", "parts": {"step": {"median_ms": 0.5}}}
+    crowd = {"agents": 100, "layout": "spread", "parts": {"step": {"median_ms": 4.0}}}
+    assert headlines("combat_step", {"rows": [step, crowd]}) == {
+        "steps/s, 10 agents, spread": 2000.0,
+        "steps/s, 100 agents, spread": 250.0,
+    }
+    kernel = {"kernel": "dtw", "size": "310x310", "median_ms": 0.25}
+    assert headlines("metrics", {"pairs_per_s": 10.0, "kernels": [kernel]}) == {
+        "pairs/s": 10.0,
+        "calls/s, dtw 310x310": 4000.0,
+    }
     assert headlines("replay", {"error": "boom"}) == {}
     assert headlines("reader", {"files": 0}) == {}
     # an older baseline's result without a figure, or a zero time, gives no ratio, not a crash
@@ -60,8 +78,9 @@ def test_a_git_ref_side_by_side_with_a_relative_out(
     assert result.exit_code == 0, result.output
     assert "speed-up of the current code over HEAD" in result.output
     report = json.loads((tmp_path / "side" / "bench.json").read_text())["side_by_side"]
-    (row,) = report["ratios"]
+    row, *kernels = report["ratios"]
     assert row["section"] == "metrics" and len(row["current"]) == len(row["baseline"]) == 1
+    assert row["figure"] == "pairs/s" and len(kernels) == 6  # dtw and frechet, two sizes
     assert row["current"][0] > 0 and row["baseline"][0] > 0
     runs = report["runs"]["metrics"]
     assert "/baseline-" in runs["baseline"][0]["code"]
@@ -71,16 +90,51 @@ def test_a_git_ref_side_by_side_with_a_relative_out(
 
 @needs_git
 def test_a_portable_section_runs_this_trees_file_on_the_baselines_package(tmp_path: Path) -> None:
-    args = ["bench", "--quick", "--sections", "kinematic", "--repeats", "1", "--baseline", "HEAD"]
-    result = runner.invoke(app, [*args, "--models", "none", "--out", str(tmp_path / "b.json")])
+    args = ["bench", "--quick", "--sections", "kinematic,combat_step", "--repeats", "1"]
+    sizes = ["--decisions", "150", "--combat-agents", "2"]
+    out = ["--baseline", "HEAD", "--models", "none", "--out", str(tmp_path / "b.json")]
+    result = runner.invoke(app, [*args, *sizes, *out])
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "b.json").read_text())["side_by_side"]
-    (row,) = report["ratios"]
-    assert row["figure"] == "ticks/s, 10 agents" and row["baseline"][0] > 0
-    runs = report["runs"]["kinematic"]
-    assert "/baseline-" in runs["baseline"][0]["code"]
+    figures = [(row["section"], row["figure"]) for row in report["ratios"]]
+    assert figures == [
+        ("kinematic", "ticks/s, 10 agents"),
+        ("combat_step", "steps/s, 2 agents, spread"),
+        ("combat_step", "steps/s, 2 agents, clustered"),
+    ]
+    assert all(row["baseline"][0] > 0 for row in report["ratios"])
+    kinematic = report["runs"]["kinematic"]["baseline"][0]
+    assert "/baseline-" in kinematic["code"]
     assert not list(tmp_path.glob("**/.numba-cache"))  # removed with the baseline's tree
-    assert runs["baseline"][0]["damage_model"] == "none"
+    assert kinematic["damage_model"] == "none"
+    assert 150 <= kinematic["decisions"] < 1000  # the current code's sizes, on either side
+    (combat,) = report["runs"]["combat_step"]["baseline"]
+    assert [row["agents"] for row in combat["rows"]] == [2, 2]
+
+
+def test_either_tree_is_asked_only_what_it_supports(tmp_path: Path) -> None:
+    folder = tmp_path / "models"
+    config = BenchConfig.create(quick=True, models=ModelName.NONE)
+    run = run_args(config)
+    assert "map_name" not in run["switches"] and "map" not in run["portable"]
+    assert run["sizes"] == {"agent_counts": [2, 10], "decisions": 1000}
+    assert run["portable"]["combat_agents"] == [10] and run["portable"]["decisions"] == 1000
+    elsewhere = BenchConfig.create(quick=True, models=str(folder), map_name="mirage")
+    run = run_args(elsewhere)
+    assert run["switches"]["map_name"] == run["portable"]["map"] == "de_mirage"
+    assert run["switches"]["models"] == run["portable"]["models"] == str(folder.resolve())
+
+
+def test_the_driver_sets_table_1_sizes_and_refuses_a_size_the_tree_lacks(tmp_path: Path) -> None:
+    config = BenchConfig.create(quick=True, models=ModelName.NONE, agent_counts=[3], decisions=60)
+    run = run_args(config)
+    result = run_in(current_tree(), "table1", run, None, tmp_path)
+    assert [row["agents"] for row in result["rows"]] == [3]
+    assert result["decisions_per_row"] == 60
+    lacking = {**run, "sizes": {**run["sizes"], "combat_width": 3}}
+    refused = run_in(current_tree(), "table1", lacking, None, tmp_path)
+    assert "BenchConfig has no combat_width" in refused["error"]
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_baseline_that_runs_the_current_code_is_an_error(tmp_path: Path) -> None:

@@ -4,10 +4,14 @@
 * combat.py: the cost of one combat step (line of sight, batch, damage model, damage);
 * metrics.py: fidelity-metric throughput on synthetic player-rounds;
 * data.py: reader and replay throughput on match files (real data, or the synthetic sample);
+* awpy.py: the awpy readers on a full-rate match;
+* portable.py: the sections measured by one file on any version's code (the kinematic core,
+  the environment, the combat step at any agent count, the metrics and their kernels);
 * machine.py: the machine and versions, and peak memory;
-* runner.py: the sections, one spawned process each, and the JSON report.
+* runner.py: the sections, their sizes, one spawned process each, and the JSON report;
+* baseline.py: the sections on this code and on a baseline, alternating, as ratios.
 
-The scripts in benchmarks/ reuse these functions. Nothing here prints.
+Some scripts in benchmarks/ (profiles and studies) reuse these functions. Nothing here prints.
 """
 
 from decoy_cli.bench.data import BenchData, find_data

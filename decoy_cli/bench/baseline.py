@@ -9,6 +9,11 @@ tree on the side's package; runs alternate current, baseline, current, baseline,
 pair gives one ratio of the section's headline figures (`headlines`), reported as median, min
 and max.
 
+Either tree is asked only what it supports (`run_args`): `create` gets the switches every
+version takes (the map only off the built-in one), Table 1's sizes are set on the config after
+it (fields every version's `BenchConfig` has; a tree without one says so instead of measuring
+something else), and the portable sections read the current code's sizes from their settings.
+
 The baseline is a git ref of the checkout this code runs from (exported with `git archive` into
 a folder beside the report, removed afterwards) or the Python interpreter of another environment
 where another version is installed. Each run starts in an empty folder beside the report and
@@ -35,7 +40,10 @@ from pathlib import Path
 import decoy_cli
 from decoy_cli.bench import portable
 from decoy_cli.bench.portable import PORTABLE_SECTIONS
-from decoy_cli.bench.records import BenchSwitches, RatioRecord, SideBySide
+from decoy_cli.bench.records import BenchSwitches, RatioRecord, RunArgs, SideBySide
+from decoy_cli.bench.runner import BenchConfig, portable_config
+from decoy_cli.csgo import BUILTIN_MAP
+from decoy_cli.damage import SHIPPED_CHOICES
 from decoy_cli.errors import DecoyError
 from decoy_cli.files import JsonObject, JsonValue, object_at, objects_in
 
@@ -46,11 +54,13 @@ if sys.path and sys.path[0] in ("", os.getcwd()):
 args = json.loads(sys.argv[1])
 devnull = os.open(os.devnull, os.O_WRONLY)
 os.dup2(devnull, 1)
+import dataclasses
 import decoy_cli
 from decoy_cli.bench import BenchConfig, check_damage_model, find_data, run_section
 from pathlib import Path
-config = BenchConfig.create(**args["config"])
-status = check_damage_model(args["config"]["models"])
+run = args["run"]
+config = BenchConfig.create(**run["switches"])
+status = check_damage_model(run["switches"]["models"])
 data = find_data(Path(args["data"])) if args["data"] else None
 try:
     if args["portable"]:  # the current tree's file, run on this tree's package
@@ -59,8 +69,14 @@ try:
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
         section = module.PORTABLE_SECTIONS[args["section"]]
-        result = section(args["config"])
+        result = section(run["portable"])
     else:
+        fields = {field.name for field in dataclasses.fields(config)}
+        lacking = sorted(set(run["sizes"]) - fields)
+        if lacking:
+            raise ValueError("this version's BenchConfig has no " + ", ".join(lacking))
+        sizes = {k: tuple(v) if isinstance(v, list) else v for k, v in run["sizes"].items()}
+        config = dataclasses.replace(config, **sizes)
         result = run_section(args["section"], config, status, data)
 except Exception as error:
     result = {"error": f"{type(error).__name__}: {error}"}
@@ -165,9 +181,32 @@ def _git(where: Path, *args: str) -> str:
     return done.stdout
 
 
-def run_in(
-    tree: CodeTree, section: str, config: BenchSwitches, data: Path | None, work: Path
-) -> JsonObject:
+def run_args(config: BenchConfig) -> RunArgs:
+    """What either tree is given to run `config`'s sections (module docstring); a model folder
+    made absolute, as the runs start in folders of their own."""
+    models = str(config.models)
+    if models not in (*SHIPPED_CHOICES, "none"):  # a folder, as the loader reads it
+        models = str(Path(models).resolve())
+    switches: BenchSwitches = {
+        "quick": config.quick,
+        "models": models,
+        "mover": config.mover,
+        "combat": config.combat,
+        "bomb": config.bomb,
+        "seed": config.seed,
+    }
+    if config.map_name != BUILTIN_MAP:  # only then: earlier versions know no map_name
+        switches["map_name"] = config.map_name
+    portable = portable_config(config)
+    portable["models"] = models
+    return {
+        "switches": switches,
+        "sizes": {"agent_counts": list(config.agent_counts), "decisions": config.decisions},
+        "portable": portable,
+    }
+
+
+def run_in(tree: CodeTree, section: str, run: RunArgs, data: Path | None, work: Path) -> JsonObject:
     """One section in a fresh process of `tree`, in an empty folder of `work` removed after;
     its result, or {"error": one line}."""
     env = dict(os.environ)
@@ -179,9 +218,13 @@ def run_in(
         env["NUMBA_CACHE_DIR"] = str(tree.numba_cache)
     scratch = Path(tempfile.mkdtemp(prefix="section-", dir=work))
     result = scratch / "result.json"
-    args = {"config": config, "data": str(data) if data else None, "section": section}
-    args["result"] = str(result)
-    args["portable"] = str(PORTABLE_FILE) if section in PORTABLE_SECTIONS else None
+    args = {
+        "run": run,
+        "data": str(data) if data else None,
+        "section": section,
+        "result": str(result),
+        "portable": str(PORTABLE_FILE) if section in PORTABLE_SECTIONS else None,
+    }
     try:
         done = subprocess.run(
             [tree.python, "-c", DRIVER, json.dumps(args)],
@@ -214,6 +257,10 @@ def headlines(section: str, result: JsonObject) -> dict[str, float]:
     figures: dict[str, JsonValue] = {}
     if section == "metrics":
         figures = {"pairs/s": result.get("pairs_per_s")}
+        for row in objects_in(result.get("kernels")):
+            median = row.get("median_ms")
+            rate = 1e3 / median if isinstance(median, int | float) and median else None
+            figures[f"calls/s, {row.get('kernel')} {row.get('size')}"] = rate
     elif section == "reader" and result.get("files"):
         figures = {"MB/s (JSON)": result.get("mb_per_s_decompressed")}
     elif section == "awpy":
@@ -234,7 +281,7 @@ def headlines(section: str, result: JsonObject) -> dict[str, float]:
         for row in objects_in(result.get("rows")):
             median = object_at(object_at(row, "parts"), "step").get("median_ms")
             rate = 1e3 / median if isinstance(median, int | float) and median else None
-            figures[f"steps/s, {row.get('layout')}"] = rate
+            figures[f"steps/s, {row.get('agents')} agents, {row.get('layout')}"] = rate
     return {k: float(v) for k, v in figures.items() if isinstance(v, int | float) and v > 0}
 
 
@@ -267,7 +314,7 @@ class Ratio:
 
 def side_by_side(
     sections: list[str],
-    config: BenchSwitches,
+    run: RunArgs,
     data: Path | None,
     current: CodeTree,
     baseline: CodeTree,
@@ -284,7 +331,7 @@ def side_by_side(
             pair: dict[str, JsonObject] = {}
             for side, tree in (("current", current), ("baseline", baseline)):
                 on_run(section, side, repeat)
-                pair[side] = run_in(tree, section, config, data, work)
+                pair[side] = run_in(tree, section, run, data, work)
                 runs[section][side].append(pair[side])
             code = {side: result.get("code") for side, result in pair.items()}
             if code["current"] is not None and code["current"] == code["baseline"]:

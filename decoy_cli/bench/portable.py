@@ -1,11 +1,15 @@
-"""Bench sections that run from this file on any version's code: the kinematic core and the
-environment, measured the same way on the current code and on a baseline that predates them.
+"""Bench sections that run from this file on any version's code: the kinematic core, the
+environment, the combat step and the metrics, measured the same way on the current code and on
+a baseline that predates them.
 
 `decoy bench --baseline REF` runs each section in a fresh process of either code tree. The
-sections here use only what every version of the simulator offers (`speed_table` of
-`decoy_cli.bench.simspeed`, `DecoyParallelEnv`, `load_damage_model`), so the baseline's process
-loads this file by path (`baseline.DRIVER`) and its imports resolve to the baseline's package:
-one measuring code, two simulators.
+sections here use only what every version of the benchmark offers (`speed_table` and `NeverHits`
+of `decoy_cli.bench.simspeed`, `step_costs` of `decoy_cli.bench.combat`, `metric_throughput`
+and `walk` of `decoy_cli.bench.metrics`, `dtw` and `frechet` of `decoy_cli.metrics`,
+`DecoyParallelEnv`, `load_damage_model`), so the baseline's process loads this file by path
+(`baseline.DRIVER`) and its imports resolve to the baseline's package: one measuring code, two
+simulators. Their sizes come from the settings (`PortableConfig`, made from the current code's
+`BenchConfig`), so both sides measure the same amount of work.
 
 * `kinematic`: the Table 1 protocol at 10 agents with the kinematic mover, whose engine plays
   event by event (`Simulator.run`);
@@ -17,7 +21,13 @@ one measuring code, two simulators.
   that, the random masked actions drawn for all agents at once as a batched trainer would (so
   the rounds part after the first decisions; against a baseline without it, the ratio is of
   the array interface to the baseline's PettingZoo one: an interface change as much as a
-  speed-up).
+  speed-up);
+* `combat_step`: one combat step in its parts at each agent count asked (half T, half CT),
+  spread over the map and clustered (`decoy_cli.bench.combat`); larger counts take
+  proportionally fewer steps, at least `MIN_COMBAT_STEPS`;
+* `metrics`: the throughput of the ten fidelity metrics on synthetic player-rounds, and the
+  exact DTW and discrete Fréchet kernels alone on a pair of the longest ESTA rounds' length
+  and on one of the paper protocol's length (`KERNEL_FRAMES`).
 """
 
 from __future__ import annotations
@@ -29,7 +39,16 @@ from typing import TYPE_CHECKING, TypedDict
 import numpy as np
 
 if TYPE_CHECKING:  # types only: this file also runs on versions without these modules
-    from decoy_cli.bench.records import ArrayFigures, EnvResult, KinematicResult, PortableConfig
+    from decoy_cli.bench.records import (
+        ArrayFigures,
+        CombatResult,
+        CombatRow,
+        EnvResult,
+        KernelRow,
+        KinematicResult,
+        MetricsResult,
+        PortableConfig,
+    )
     from decoy_cli.env import DecoyArrayEnv, DecoyParallelEnv
     from decoy_cli.sim.combat import DamageModel
 
@@ -38,6 +57,15 @@ KINEMATIC_AGENTS = 10
 
 ENV_ROUNDS = 5
 """Timed environment rounds (one more, untimed, warms up the compiled code)."""
+
+COMBAT_AGENTS = 10
+"""The combat step's default agent count (5v5), whose steps are `combat_repeats`."""
+
+MIN_COMBAT_STEPS = 5
+"""The fewest timed steps of a crowded combat step."""
+
+KERNEL_FRAMES = (310, 451)
+"""Curve lengths of the kernel timings: the longest ESTA rounds at 2 Hz, the paper protocol's."""
 
 
 class _TableMap(TypedDict, total=False):
@@ -56,7 +84,7 @@ def kinematic_section(config: PortableConfig) -> KinematicResult:
     """Table 1's protocol at `KINEMATIC_AGENTS` agents with the kinematic mover."""
     from decoy_cli.bench.simspeed import speed_table
 
-    decisions = 1_000 if config.get("quick") else 10_000
+    decisions = int(config.get("decisions", 1_000 if config.get("quick") else 10_000))
     model, label = _model(config)
     on_map: _TableMap = {"map_name": config["map"]} if "map" in config else {}
     rows = speed_table(
@@ -193,6 +221,15 @@ def _play_arrays(env: DecoyArrayEnv, rng: np.random.Generator, seed: int) -> int
     return decisions
 
 
+def _builtin_map() -> str:
+    """The map a section plays when the settings name none."""
+    try:
+        from decoy_cli.csgo import BUILTIN_MAP
+    except ImportError:  # a version from before the one map constant
+        return "de_dust2"
+    return BUILTIN_MAP
+
+
 def _model(config: PortableConfig) -> tuple[DamageModel | None, str]:
     """The damage model the config names and how the report names it (None: "none", or a
     model that did not load, said so; the section then runs without shooting)."""
@@ -207,8 +244,79 @@ def _model(config: PortableConfig) -> tuple[DamageModel | None, str]:
         return None, f"none ({models} did not load: {error})"
 
 
-PORTABLE_SECTIONS: dict[str, Callable[[PortableConfig], KinematicResult | EnvResult]] = {
+def combat_section(config: PortableConfig) -> CombatResult:
+    """The combat step's parts at each agent count of the settings (module docstring)."""
+    from decoy_cli.bench.combat import step_costs
+    from decoy_cli.bench.simspeed import NeverHits
+
+    model, label = _model(config)
+    repeats = int(config.get("combat_repeats", 20 if config.get("quick") else 300))
+    on_map: _TableMap = {"map_name": config["map"]} if "map" in config else {}
+    rows: list[CombatRow] = []
+    for agents in config.get("combat_agents", [COMBAT_AGENTS]):
+        steps = repeats * COMBAT_AGENTS // max(agents, COMBAT_AGENTS)
+        rows += step_costs(
+            model or NeverHits(),
+            agents // 2,
+            max(steps, MIN_COMBAT_STEPS),
+            int(config.get("seed", 0)),
+            **on_map,
+        )
+    return {"map": config.get("map", _builtin_map()), "damage_model": label, "rows": rows}
+
+
+def metrics_section(config: PortableConfig) -> MetricsResult:
+    """The metric throughput and the distance kernels (module docstring)."""
+    from decoy_cli.bench.metrics import metric_throughput
+
+    pairs = int(config.get("metric_pairs", 100 if config.get("quick") else 2000))
+    result: MetricsResult = metric_throughput(pairs, int(config.get("seed", 0)))
+    repeats = int(config.get("kernel_repeats", 50 if config.get("quick") else 500))
+    result["kernels"] = kernel_times(repeats, int(config.get("seed", 0)))
+    return result
+
+
+def kernel_times(repeats: int, seed: int = 0) -> list[KernelRow]:
+    """Wall times of `dtw`, `frechet` and `frechet` on x-y alone, each on one pair of random
+    walks of every `KERNEL_FRAMES` length, after a call that compiles or loads the kernel."""
+    from decoy_cli.bench.metrics import walk
+    from decoy_cli.metrics import dtw, frechet
+
+    rng = np.random.default_rng(seed)
+    rows: list[KernelRow] = []
+    for frames in KERNEL_FRAMES:
+        a, b = walk(rng, frames), walk(rng, frames)
+        for kernel, first, second in (
+            ("dtw", a, b),
+            ("frechet", a, b),
+            ("frechet x-y", a[:, :2], b[:, :2]),
+        ):
+            call = dtw if kernel == "dtw" else frechet
+            call(first, second)
+            times = []
+            for _ in range(repeats):
+                started = time.perf_counter()
+                call(first, second)
+                times.append((time.perf_counter() - started) * 1e3)
+            rows.append(
+                {
+                    "kernel": kernel,
+                    "size": f"{frames}x{frames}",
+                    "calls": repeats,
+                    "median_ms": float(np.median(times)),
+                    "min_ms": min(times),
+                    "max_ms": max(times),
+                }
+            )
+    return rows
+
+
+PORTABLE_SECTIONS: dict[
+    str, Callable[[PortableConfig], KinematicResult | EnvResult | CombatResult | MetricsResult]
+] = {
     "kinematic": kinematic_section,
     "env": env_section,
+    "combat_step": combat_section,
+    "metrics": metrics_section,
 }
 """The sections this file runs, by name."""

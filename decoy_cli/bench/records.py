@@ -76,7 +76,8 @@ class Table1Result(Measured):
 
 
 class PortableConfig(TypedDict, total=False):
-    """What a portable section (`portable`) reads of the run's settings."""
+    """What a portable section (`portable`) reads of the run's settings (the sizes are the
+    current code's `BenchConfig`, so that both sides of a side-by-side run measure the same)."""
 
     quick: bool
     models: str
@@ -84,6 +85,11 @@ class PortableConfig(TypedDict, total=False):
     bomb: bool
     seed: int
     map: str
+    decisions: int
+    combat_agents: list[int]
+    combat_repeats: int
+    metric_pairs: int
+    kernel_repeats: int
 
 
 @final
@@ -187,9 +193,26 @@ class ReplayResult(_ReplayFigures, Measured):
     options: ReplaySettings
 
 
+class KernelRow(TypedDict):
+    """One distance kernel on one pair of curves (`portable.kernel_times`)."""
+
+    kernel: str
+    size: str
+    calls: int
+    median_ms: float
+    min_ms: float
+    max_ms: float
+
+
+class _MetricsFigures(TypedDict, total=False):
+    """The distance kernels alone, beside the throughput (`portable.metrics_section`)."""
+
+    kernels: list[KernelRow]
+
+
 @final
-class MetricsResult(Measured):
-    """The `metrics` section (`metrics.metric_throughput`)."""
+class MetricsResult(_MetricsFigures, Measured):
+    """The `metrics` section (`metrics.metric_throughput`, and the kernels)."""
 
     pairs: int
     evaluated: int
@@ -306,6 +329,23 @@ class BenchSwitches(TypedDict, total=False):
     bomb: bool
     seed: int
     map_name: str
+
+
+class BenchSizes(TypedDict, total=False):
+    """How much Table 1 measures, set on either code tree's `BenchConfig` after `create`
+    (fields every version of it has)."""
+
+    agent_counts: list[int]
+    decisions: int
+
+
+class RunArgs(TypedDict):
+    """What a side-by-side run gives either code tree (`baseline.run_args`): the keywords of
+    its `BenchConfig.create`, the sizes set after it, and the portable sections' settings."""
+
+    switches: BenchSwitches
+    sizes: BenchSizes
+    portable: PortableConfig
 
 
 class RatioRecord(TypedDict):

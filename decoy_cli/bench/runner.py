@@ -15,6 +15,7 @@ import datetime
 import multiprocessing
 import os
 import time
+from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass, replace
@@ -23,7 +24,7 @@ from decoy_cli import __version__
 from decoy_cli.bench.awpy import BENCH_ROUNDS, awpy_reader_throughput
 from decoy_cli.bench.data import BenchData, reader_throughput, replay_throughput
 from decoy_cli.bench.machine import load_average, peak_rss_mb, ru_maxrss_mb
-from decoy_cli.bench.portable import PORTABLE_SECTIONS
+from decoy_cli.bench.portable import COMBAT_AGENTS, PORTABLE_SECTIONS
 from decoy_cli.bench.records import (
     BenchReport,
     MachineInfo,
@@ -35,14 +36,13 @@ from decoy_cli.bench.simspeed import (
     AGENT_COUNTS,
     PAPER_DECISIONS,
     PAPER_TICKS_PER_S,
-    NeverHits,
     speed_table,
 )
 from decoy_cli.csgo import BUILTIN_MAP
 from decoy_cli.damage.choice import ModelChoice, ModelName
 from decoy_cli.errors import DecoyError
 from decoy_cli.sim.setup import MoverName, RunSpec
-from decoy_cli.waypoints.build import canonical_map
+from decoy_cli.waypoints.build import builtin_graph, canonical_map
 
 REPORT_FORMAT = 1
 
@@ -52,9 +52,9 @@ SECTIONS = ("table1", "kinematic", "env", "combat_step", "replay", "metrics", "r
 DATA_SECTIONS = ("replay", "reader")
 """Sections that need match files; skipped, with the reason, when there are none."""
 
-MODEL_SECTIONS = ("table1", "combat_step", "replay")
-"""Sections that run the damage model (the others do not load it, nor torch)."""
-"""Sections that need match files; skipped, with the reason, when there are none."""
+MODEL_SECTIONS = ("table1", "replay")
+"""Sections given the damage model checked here (the portable ones load their own; the
+others do not load it, nor torch)."""
 
 PAPER = "DECOY paper (Wang, Ustun, McGroarty, WSC 2025), Table 1"
 
@@ -64,7 +64,9 @@ class BenchConfig(RunSpec):
     """What to run and how much of it: the full benchmark, or a quick smoke run.
 
     `combat` and `bomb` (`RunSpec`) switch the mechanics of Table 1 and of the replay section
-    (the paper's Table 1 has every mechanic on); Table 1 runs the paper's physics mover."""
+    (the paper's Table 1 has every mechanic on); Table 1 runs the paper's physics mover.
+    `agent_counts` are Table 1's rows, `decisions` the agent decisions of each row and of the
+    kinematic row, `combat_agents` the sizes of the combat step (half T, half CT)."""
 
     quick: bool
     models: ModelChoice
@@ -72,9 +74,11 @@ class BenchConfig(RunSpec):
     map_name: str = BUILTIN_MAP
     agent_counts: tuple[int, ...] = AGENT_COUNTS
     decisions: int = PAPER_DECISIONS
+    combat_agents: tuple[int, ...] = (COMBAT_AGENTS,)
     combat_repeats: int = 300
     replay_rounds: int | None = None
     metric_pairs: int = 2000
+    kernel_repeats: int = 500
     reader_files: int | None = None
     awpy_rounds: int = BENCH_ROUNDS
 
@@ -89,9 +93,14 @@ class BenchConfig(RunSpec):
         bomb: bool = True,
         seed: int = 0,
         map_name: str = BUILTIN_MAP,
+        agent_counts: Sequence[int] | None = None,
+        decisions: int | None = None,
+        combat_agents: Sequence[int] | None = None,
     ) -> BenchConfig:
         """The full sizes (the paper's 10,000 decisions at 2-100 agents, every data file and
-        round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files)."""
+        round), or the quick ones (1,000 decisions at 2 and 10 agents, a few rounds and files);
+        Table 1's agent counts and decisions and the combat step's agent counts where given
+        (checked against the map's spawns and waypoints: `check_sizes`)."""
         config = cls(
             quick=quick,
             models=models,
@@ -101,18 +110,63 @@ class BenchConfig(RunSpec):
             seed=seed,
             map_name=canonical_map(map_name),
         )
-        if not quick:
-            return config
+        if quick:
+            config = replace(
+                config,
+                agent_counts=(2, 10),
+                decisions=1_000,
+                combat_repeats=20,
+                replay_rounds=3,
+                metric_pairs=100,
+                kernel_repeats=50,
+                reader_files=2,
+                awpy_rounds=4,
+            )
+        check_sizes(config.map_name, agent_counts, decisions, combat_agents)
         return replace(
             config,
-            agent_counts=(2, 10),
-            decisions=1_000,
-            combat_repeats=20,
-            replay_rounds=3,
-            metric_pairs=100,
-            reader_files=2,
-            awpy_rounds=4,
+            agent_counts=config.agent_counts if agent_counts is None else _once(agent_counts),
+            decisions=config.decisions if decisions is None else decisions,
+            combat_agents=config.combat_agents if combat_agents is None else _once(combat_agents),
         )
+
+
+def _once(counts: Sequence[int]) -> tuple[int, ...]:
+    """The counts in the order given, each once."""
+    return tuple(dict.fromkeys(counts))
+
+
+def check_sizes(
+    map_name: str,
+    agent_counts: Sequence[int] | None,
+    decisions: int | None,
+    combat_agents: Sequence[int] | None,
+) -> None:
+    """A DecoyError that says which size given is wrong, if one is: Table 1 places its agents
+    on spawn waypoints (half T, half CT, distinct waypoints) and the combat step on any
+    waypoints, so the map's graph bounds both."""
+    if decisions is not None and decisions < 1:
+        raise DecoyError(f"--decisions {decisions}: give at least 1 agent decision")
+    if agent_counts is None and combat_agents is None:
+        return
+    graph = builtin_graph(map_name)
+    if agent_counts is not None:
+        t_room, ct_room = (len(graph.region_of(side)) for side in ("t_spawn", "ct_spawn"))
+        room = min(2 * t_room + 1, 2 * ct_room)  # n // 2 T, the rest CT
+        wrong = [n for n in agent_counts if not 2 <= n <= room]
+        if wrong or not agent_counts:
+            raise DecoyError(
+                f"--agents {wrong[0] if wrong else '(none)'}: Table 1 plays 2 to {room} agents "
+                f"on {map_name} (its spawns' waypoints, half T and half CT)"
+            )
+    if combat_agents is not None:
+        room = graph.num_nodes - graph.num_nodes % 2
+        wrong = [n for n in combat_agents if n % 2 or not 2 <= n <= room]
+        if wrong or not combat_agents:
+            raise DecoyError(
+                f"--combat-agents {wrong[0] if wrong else '(none)'}: give an even count from 2 "
+                f"to {room} (half T, half CT, on distinct waypoints of {map_name})"
+            )
 
 
 @dataclass(frozen=True)
@@ -152,9 +206,6 @@ def run_section(
     name: str, config: BenchConfig, status: ModelStatus, data: BenchData | None
 ) -> Measurement:
     """Run one section in this process; its result with wall time and peak memory."""
-    from decoy_cli.bench.combat import step_costs
-    from decoy_cli.bench.metrics import metric_throughput
-
     model = None
     if status.loaded and name in MODEL_SECTIONS:
         from decoy_cli.damage import load_damage_model
@@ -185,11 +236,6 @@ def run_section(
         }
     elif name in PORTABLE_SECTIONS:
         result = PORTABLE_SECTIONS[name](portable_config(config))
-    elif name == "combat_step":
-        costs = step_costs(
-            model or NeverHits(), 5, config.combat_repeats, config.seed, config.map_name
-        )
-        result = {"map": config.map_name, "damage_model": status.label, "rows": costs}
     elif name == "replay":
         data = _needed(data, name)
         replayed = replay_throughput(
@@ -203,8 +249,6 @@ def run_section(
         replayed["data"] = data.describe()
         replayed["damage_model"] = status.label if model else None
         result = replayed
-    elif name == "metrics":
-        result = metric_throughput(config.metric_pairs, config.seed)
     elif name == "reader":
         data = _needed(data, name)
         files = data.files[: config.reader_files] if config.reader_files else data.files
@@ -232,6 +276,11 @@ def portable_config(config: BenchConfig) -> PortableConfig:
         "combat": config.combat,
         "bomb": config.bomb,
         "seed": config.seed,
+        "decisions": config.decisions,
+        "combat_agents": list(config.combat_agents),
+        "combat_repeats": config.combat_repeats,
+        "metric_pairs": config.metric_pairs,
+        "kernel_repeats": config.kernel_repeats,
     }
     if config.map_name != BUILTIN_MAP:  # only then: earlier versions' sections know no map
         settings["map"] = config.map_name

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import cast
 
+from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
@@ -27,7 +28,7 @@ TITLES = {
     "table1": "Table 1: simulator speed",
     "kinematic": "kinematic core, Table 1 at 10 agents",
     "env": "environment, 5v5",
-    "combat_step": "one 5v5 combat step",
+    "combat_step": "one combat step",
     "replay": "replay throughput",
     "metrics": "metric throughput",
     "reader": "reader throughput",
@@ -75,7 +76,7 @@ def load_text(load: list[float] | None) -> str:
     return f"{load[0]:.2f} (1 min)" if load else "unknown"
 
 
-def section_table(name: str, result: SectionResult) -> Table | Text:
+def section_table(name: str, result: SectionResult) -> Table | Text | Group:
     """The section's table, or one line when it was skipped or failed (the section's name
     says which result it is)."""
     title = TITLES[name]
@@ -214,14 +215,25 @@ def _env_table(result: EnvResult) -> Table:
 
 def _combat_table(result: CombatResult) -> Table:
     table = _table(
-        "one 5v5 combat step, median ms",
-        ["layout", "steps", "line of sight", "batch", "model", "damage", "step", "visible pairs"],
-        caption=f"damage model: {result['damage_model']}; peak memory "
+        "one combat step, median ms",
+        [
+            "agents",
+            "layout",
+            "steps",
+            "line of sight",
+            "batch",
+            "model",
+            "damage",
+            "step",
+            "visible pairs",
+        ],
+        caption=f"half T, half CT; damage model: {result['damage_model']}; peak memory "
         f"{result['peak_rss_mb']:.0f} MB",
     )
     for row in result["rows"]:
         parts = row["parts"]
         table.add_row(
+            str(row["agents"]),
             row["layout"],
             str(row["steps"]),
             *(
@@ -259,7 +271,7 @@ def _replay_table(result: ReplayResult) -> Table:
     return table
 
 
-def _metrics_table(result: MetricsResult) -> Table:
+def _metrics_table(result: MetricsResult) -> Table | Group:
     table = _table(
         "metric throughput (ten metrics, both protocols, one thread)",
         ["player-round pairs", "mean frames", "wall s", "pairs/s", "ms per pair"],
@@ -272,7 +284,23 @@ def _metrics_table(result: MetricsResult) -> Table:
         f"{result['pairs_per_s']:,.0f}",
         f"{result['ms_per_pair']:.3f}",
     )
-    return table
+    if "kernels" not in result:
+        return table
+    kernels = _table(
+        "distance kernels alone, ms per call",
+        ["kernel", "curves", "calls", "median", "min", "max"],
+        caption="exact DTW and discrete Fréchet (3-D, or x-y alone) on random walks",
+    )
+    for row in result["kernels"]:
+        kernels.add_row(
+            row["kernel"],
+            row["size"],
+            str(row["calls"]),
+            f"{row['median_ms']:.3f}",
+            f"{row['min_ms']:.3f}",
+            f"{row['max_ms']:.3f}",
+        )
+    return Group(table, kernels)
 
 
 def _reader_table(result: ReaderResult) -> Table:

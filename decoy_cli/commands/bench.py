@@ -19,8 +19,8 @@ from decoy_cli.bench import (
     report,
     run_isolated,
 )
-from decoy_cli.bench.baseline import baseline_tree, current_tree, side_by_side
-from decoy_cli.bench.records import BenchSwitches, SectionResult
+from decoy_cli.bench.baseline import baseline_tree, current_tree, run_args, side_by_side
+from decoy_cli.bench.records import RunArgs, SectionResult
 from decoy_cli.commands._bench_tables import (
     TITLES,
     load_text,
@@ -30,8 +30,7 @@ from decoy_cli.commands._bench_tables import (
 )
 from decoy_cli.commands._console import make_console
 from decoy_cli.commands._options import MAPS_HELP, models_option, mover_option
-from decoy_cli.csgo import BUILTIN_MAP
-from decoy_cli.damage import SHIPPED_CHOICES, ModelName, parse_models
+from decoy_cli.damage import ModelName, parse_models
 from decoy_cli.errors import DecoyError, OutputError
 from decoy_cli.files import check_writable, write_json
 from decoy_cli.sim.setup import MoverName
@@ -44,7 +43,28 @@ def bench(
         False,
         "--quick",
         help="A smoke run of a few seconds per section: 1,000 decisions at 2 and 10 agents, "
-        "3 rounds, 100 metric pairs, 2 files.",
+        "20 combat steps, 3 rounds, 100 metric pairs, 2 files.",
+    ),
+    agents: str | None = typer.Option(
+        None,
+        "--agents",
+        metavar="N,N,...",
+        help="Table 1's agent counts, comma-separated (default 2,6,10,20,100, the paper's; "
+        "2,10 with --quick).",
+    ),
+    decisions: int | None = typer.Option(
+        None,
+        "--decisions",
+        min=1,
+        help="Agent decisions per row of Table 1 and of the kinematic core (default 10,000, "
+        "the paper's; 1,000 with --quick).",
+    ),
+    combat_agents: str | None = typer.Option(
+        None,
+        "--combat-agents",
+        metavar="N,N,...",
+        help="Agent counts of the combat step, even, comma-separated, half T and half CT "
+        "(default 10; e.g. 10,100 adds a crowded step, timed over proportionally fewer steps).",
     ),
     models: str = models_option(ModelName.SHIPPED),
     data: Path | None = typer.Option(
@@ -88,9 +108,10 @@ def bench(
 ) -> None:
     """Measure the simulator's speed (the paper's Table 1) and the throughput of the pipeline.
 
-    Sections: Table 1, a 5v5 combat step, replay, metrics and reader throughput, each in its
-    own process; prints tables and writes a JSON report with the machine. Exits non-zero when a
-    section failed.
+    Sections: Table 1, the kinematic core, the environment, the combat step (5v5 unless
+    --combat-agents), replay, metrics (and the DTW and Fréchet kernels alone), reader and awpy
+    throughput, each in its own process; prints tables and writes a JSON report with the
+    machine. Exits non-zero when a section failed.
 
     --mover is Table 1's (physics by default, as the paper's). --models is the combat step's:
     if the models cannot be loaded, the benchmark says so and runs line of sight without
@@ -110,22 +131,15 @@ def bench(
         bomb=bomb,
         seed=seed,
         map_name=map_name,
+        agent_counts=_counts(agents, "--agents"),
+        decisions=decisions,
+        combat_agents=_counts(combat_agents, "--combat-agents"),
     )
     bench_data = find_data(data)
     machine = machine_info()
     console.print(machine_line(machine), highlight=False)
     if baseline is not None:
-        switches: BenchSwitches = {
-            "quick": quick,
-            "models": str(choice),
-            "mover": mover,
-            "combat": combat,
-            "bomb": bomb,
-            "seed": seed,
-        }
-        if config.map_name != BUILTIN_MAP:  # only then: earlier versions know no --map
-            switches["map_name"] = config.map_name
-        _side_by_side(console, chosen, switches, bench_data, baseline, repeats, out)
+        _side_by_side(console, chosen, run_args(config), bench_data, baseline, repeats, out)
         return
     status = check_damage_model(choice)
     if status.error:
@@ -186,10 +200,25 @@ def _chosen_sections(text: str) -> list[str]:
     return [name for name in SECTIONS if name in names]
 
 
+def _counts(text: str | None, option: str) -> list[int] | None:
+    """Comma-separated whole numbers (BenchConfig.create checks their range)."""
+    if text is None:
+        return None
+    try:
+        counts = [int(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        counts = []
+    if not counts:
+        raise DecoyError(
+            f"{option} {text!r}: give whole numbers separated by commas, e.g. 2,10,100"
+        )
+    return counts
+
+
 def _side_by_side(
     console: Console,
     chosen: list[str],
-    config: BenchSwitches,
+    run: RunArgs,
     bench_data: BenchData | None,
     ref: str,
     repeats: int,
@@ -199,9 +228,6 @@ def _side_by_side(
     Paths are made absolute: the runs start in folders of their own."""
     work = out.resolve().parent
     work.mkdir(parents=True, exist_ok=True)
-    models = config["models"]
-    if models not in (*SHIPPED_CHOICES, "none"):  # a folder, as the loader reads it
-        config = {**config, "models": str(Path(models).resolve())}
     data = bench_data.folder.resolve() if bench_data else None
     with baseline_tree(ref, work) as baseline:
         console.print(
@@ -218,7 +244,7 @@ def _side_by_side(
             task = progress.add_task("")
             result = side_by_side(
                 chosen,
-                config,
+                run,
                 data,
                 current_tree(),
                 baseline,
