@@ -19,10 +19,10 @@ Errors are EstaError with one line naming the file. Where a problem lies decides
   weapon, a player twice in one frame. `read_match` still returns the match: the round is left
   out of `Match.rounds`, its error is kept in `Match.round_errors`, and `Match.round(num)` raises
   it, so a batch over many rounds can record per-round failures and go on.
-All rounds are built when the match is read (benchmarks/bench/bench_reader.py measures how fast), so
-the decoded JSON is dropped at once and errors show up front. JSON is decoded with msgspec
-straight into typed structs (decoy_cli/esta/schema.py): faster than orjson into dicts when
-measured, and its type errors carry the JSON path.
+All rounds are built when the match is read (`decoy bench --sections reader` measures how fast),
+so the decoded JSON is dropped at once and errors show up front. JSON is decoded with msgspec
+straight into typed structs (decoy_cli/esta/schema.py): faster than orjson into dicts
+(benchmarks/studies/json_decoders.py), and its type errors carry the JSON path.
 """
 
 from __future__ import annotations

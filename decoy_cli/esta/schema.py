@@ -1,10 +1,10 @@
 """The part of the awpy 1.x match schema the reader decodes, as msgspec structs.
 
 Decoding straight into these structs (instead of generic dicts) skips every key the project does
-not use, checks every type on the way with a JSON path in the message, and is about twice as fast
-as orjson into dicts (see benchmarks/bench/bench_reader.py). Every field is optional and may be
-null; numbers are declared `float` so that ints written as floats (and floats written as ints) pass,
-and the builders check integrality where an int is meant. Unknown keys are ignored.
+not use, checks every type on the way with a JSON path in the message, and is faster than orjson
+into dicts (benchmarks/studies/json_decoders.py compares the decoders). Every field is optional
+and may be null; numbers are declared `float` so that ints written as floats (and floats written
+as ints) pass, and the builders check integrality where an int is meant. Unknown keys are ignored.
 """
 
 from __future__ import annotations

@@ -1,14 +1,16 @@
-"""How fast the ESTA reader is, and which JSON parser it should use.
+"""Which JSON decoder the ESTA reader uses: msgspec straight into typed structs, against json,
+orjson and msgspec into dicts (the choice stated in decoy_cli/esta/schema.py and reader.py).
 
 Times, on the 15 real T-side matches in ../shared/data/esta_dust2_tside and on a synthetic match
 of about 50 MB (the rounds of the largest real file repeated, renumbered, xz-compressed once into
-the system temp folder and reused): xz decompression, then each parser on the decompressed bytes
-(json, orjson and msgspec into dicts; msgspec into the reader's typed structs, which is what the
-reader does), then the whole `read_match` (read, decompress, decode, build arrays and tables).
-Each step is run `--repeats` times per file and the median kept; for the 15 real files the table
-shows the median and range over files.
+the system temp folder and reused): xz decompression, then each decoder on the decompressed
+bytes (json, orjson and msgspec into dicts; msgspec into the reader's typed structs, which is
+what the reader does), then the whole `read_match` (read, decompress, decode, build arrays and
+tables). Each step is run `--repeats` times per file and the median kept; for the 15 real files
+the table shows the median and range over files. The reader's throughput alone is
+`decoy bench --sections reader`.
 
-    python benchmarks/bench/bench_reader.py [--repeats 3] [--synthetic-mb 50]
+    python benchmarks/studies/json_decoders.py [--repeats 3] [--synthetic-mb 50]
 """
 
 from __future__ import annotations
@@ -70,7 +72,7 @@ def _time_file(path: Path, repeats: int) -> tuple[int, dict[str, float]]:
 
 def _synthetic(source: Path, target_mb: float) -> Path:
     """A match of about `target_mb` MB decompressed: the source's rounds repeated, renumbered."""
-    folder = Path(tempfile.gettempdir()) / "decoy_bench_reader"
+    folder = Path(tempfile.gettempdir()) / "decoy_json_decoders"
     folder.mkdir(exist_ok=True)
     path = folder / f"synthetic-{target_mb:g}MB-from-{source.name}"
     if path.exists():
