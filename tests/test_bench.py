@@ -173,8 +173,8 @@ def test_the_sizes_reach_table_1_the_kinematic_core_and_the_combat_step(tmp_path
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [
-        ("--agents", "1", "--agents 1: Table 1 plays 2 to 520 agents on de_dust2"),
-        ("--agents", "521", "--agents 521: Table 1 plays 2 to 520 agents"),
+        ("--agents", "1", "--agents 1: Table 1 plays 2 to "),
+        ("--agents", "2,100000", "--agents 100000: Table 1 plays 2 to "),
         ("--agents", "2,x", "--agents '2,x': give whole numbers separated by commas"),
         ("--agents", ",", "--agents ',': give whole numbers"),
         ("--combat-agents", "7", "--combat-agents 7: give an even count from 2 to"),
@@ -200,6 +200,13 @@ def test_given_sizes_replace_the_quick_ones_and_no_other() -> None:
     assert sized.metric_pairs == quick.metric_pairs
     with pytest.raises(DecoyError, match="--decisions 0"):
         BenchConfig.create(quick=False, models=ModelName.NONE, decisions=0)
+    graph = builtin_graph()  # n // 2 T and the rest CT, each on a waypoint of its spawn
+    room = min(2 * len(graph.region_of("t_spawn")) + 1, 2 * len(graph.region_of("ct_spawn")))
+    assert BenchConfig.create(quick=True, models="none", agent_counts=[room]).agent_counts == (
+        room,
+    )
+    with pytest.raises(DecoyError, match=f"--agents {room + 1}: Table 1 plays 2 to {room} "):
+        BenchConfig.create(quick=True, models="none", agent_counts=[room + 1])
 
 
 def test_find_data_prefers_the_given_folder_then_the_candidates(tmp_path: Path) -> None:
