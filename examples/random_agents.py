@@ -62,7 +62,7 @@ def main() -> None:
             sim = env.sim
             print(
                 f"{number:>5} {end['winner']:>6} {end['reason']:<14} {sim.tick:>6} "
-                f"{int(sim.decisions.sum()):>9} {wall:>7.2f}"
+                f"{int(sim.state.decisions.sum()):>9} {wall:>7.2f}"
             )
     finally:
         env.close()

@@ -101,7 +101,7 @@ def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
     assert a.outcome == b.outcome, seed
     assert a.tick == b.tick, seed
     assert a.events == b.events, seed
-    assert a.decision_count == b.decision_count == int(a.decisions.sum()), seed
+    assert a.decision_count == b.decision_count == int(a.state.decisions.sum()), seed
     assert (a.bomb.status, a.bomb.carrier, a.bomb.site) == (
         b.bomb.status,
         b.bomb.carrier,
@@ -111,7 +111,7 @@ def assert_same_round(a: Simulator, b: Simulator, seed: int) -> None:
     for name in ("ticks", "position", "yaw", "hp", "alive"):
         x, y = getattr(a.recording, name), getattr(b.recording, name)
         np.testing.assert_array_equal(x, y, err_msg=f"seed {seed}: {name}")
-    np.testing.assert_array_equal(a.decisions, b.decisions)
+    np.testing.assert_array_equal(a.state.decisions, b.state.decisions)
 
 
 def _recorded(monkeypatch: pytest.MonkeyPatch, module: object, name: str, entry: int) -> list[int]:

@@ -260,7 +260,7 @@ def _round_summary(env: DecoyArrayEnv) -> tuple:
     assert sim is not None
     agents, bomb = sim.agents, sim.bomb
     return (
-        sim.outcome, sim.tick, sim.decision_count, sim.decisions.tolist(),
+        sim.outcome, sim.tick, sim.decision_count, sim.state.decisions.tolist(),
         agents.position.tobytes(), agents.yaw.tobytes(), agents.hp.tolist(),
         agents.alive.tolist(), bomb.status, bomb.carrier, bomb.site, bomb.position.tobytes(),
     )  # fmt: skip

@@ -288,7 +288,7 @@ def test_agents_are_asked_exactly_when_they_arrive_or_their_stop_ends() -> None:
             np.testing.assert_allclose(sim.agents.position[0], [1.0, 0.0, 0.0], atol=1e-9)
     assert {a: policy.ticks_of(a) for a in range(3)} == expected
     assert due == policy.asked  # needs_decision names exactly who is asked at the next tick
-    assert sim.decisions.tolist() == [5, 5, 0]
+    assert sim.state.decisions.tolist() == [5, 5, 0]
     assert sim.agents.position[2].tolist() == [2.0, 0.0, 0.0]
 
 

@@ -242,13 +242,13 @@ def test_ignored_actions_and_invalid_moves(env: DecoyParallelEnv) -> None:
     obs, *_ = env.step(random_actions(obs, env.agents, rng))
     waiting = [n for n in env.agents if not entry(env, obs, n, "needs_decision")[0]]
     assert waiting
-    decisions = env.sim.decisions.copy()
+    decisions = env.sim.state.decisions.copy()
     actions = random_actions(obs, env.agents, rng)
     actions.update(dict.fromkeys(waiting, 0))
     env.step(actions)
     for name in waiting:
         assert (
-            env.sim.decisions[env.possible_agents.index(name)]
+            env.sim.state.decisions[env.possible_agents.index(name)]
             == decisions[env.possible_agents.index(name)]
         )
 

@@ -62,14 +62,15 @@ def test_until_is_asked_whenever_more_than_motion_may_have_happened(physics) -> 
     """Predicates on decisions and on deaths stop the run at the tick stepping stops at."""
 
     def decisions(count: int) -> Callable[[Simulator], bool]:
-        return lambda sim: int(sim.decisions.sum()) >= count
+        return lambda sim: int(sim.state.decisions.sum()) >= count
 
     def deaths(count: int) -> Callable[[Simulator], bool]:
         return lambda sim: int((~sim.agents.alive).sum()) >= count
 
     # a count of decisions part way through each round (the whole round's count, stepped)
     totals = [
-        int(_play(physics, "kinematic", seed, every_tick).decisions.sum()) for seed in range(8)
+        int(_play(physics, "kinematic", seed, every_tick).state.decisions.sum())
+        for seed in range(8)
     ]
     cases = [(seed, decisions(max(5, totals[seed] * (seed + 1) // 9))) for seed in range(8)]
     for seed, until in [*cases, (5, deaths(2)), (6, deaths(1))]:

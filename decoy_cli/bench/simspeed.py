@@ -118,7 +118,7 @@ def run_agents(
         ) as sim:
             start_tick = sim.tick
             sim.run(max_decisions=decisions - made)
-        made += int(sim.decisions.sum())
+        made += int(sim.state.decisions.sum())
         ticks += sim.tick - start_tick
         kills += int((~agents.alive).sum())
         rounds += 1

@@ -179,8 +179,9 @@ def encode_into(r, e, bomb, done, tick, out):
     obs, masks, due = out[0], out[1], out[2]
     bomb_state, carrier, bomb_pos, round_inputs = bomb
     # the fields read per agent, taken out of the structs once
-    pos, yaw, hp, alive, waiting, hold_until = r.pos, r.yaw, r.hp, r.alive, r.waiting, r.hold_until
-    armor, helmet, kit, node, out_edges = r.armor, r.helmet, r.kit, r.node, r.out_edges
+    pos, yaw, hp, alive, waiting = r.position, r.yaw, r.hp, r.alive, r.waiting
+    armor, helmet, kit, node, out_edges = r.armor, r.helmet, r.has_defuser, r.node, r.out_edges
+    hold_until = r.hold_until
     mates, enemies, half, centre, is_ct = e.mates, e.enemies, e.half, e.centre, e.is_ct
     n = pos.shape[0]
     obs[:] = 0.0

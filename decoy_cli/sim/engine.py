@@ -33,7 +33,7 @@ from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick, play_
 from decoy_cli.sim.recording import Recorder, Recording
 from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
-from decoy_cli.sim.schedule import NEVER, due_agents, next_due
+from decoy_cli.sim.schedule import NEVER
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.weapons import max_speed_m_s
@@ -96,18 +96,13 @@ class Simulator:
         self.mover.reset(
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
-        self.state = state = RoundState.open(agents, mover, graph)
-        """The round's arrays as compiled code takes them; the engine's below are its own."""
-        self.waiting = state.waiting  # asks for a decision at the next tick
-        self.hold_until = state.hold_until  # end tick of a STOP
-        self.goal_node = state.goal_node
-        self.fall_m = state.fall_m  # depth of the damaging drop each agent is on (0: none)
-        self._falling = 0  # how many agents are on such a drop
+        self.state = RoundState.open(agents, mover, graph)
+        """The round's arrays, their one owner: the agents' (the very arrays of `agents`), the
+        decisions' (who waits, STOPs, wants to plant or defuse, is on a drop), the mover's and
+        the graph's; compiled code takes them as one struct."""
+        self._falling = 0  # how many agents are on a damaging drop (`state.fall_m` > 0)
         self._fall_killed = False  # a landing killed since the outcome was last judged
-        self.wants_plant = state.wants_plant
-        self.wants_defuse = state.wants_defuse
-        self.decisions = state.decisions
-        self.decision_count = 0  # decisions.sum(), kept as they are made
+        self.decision_count = 0  # state.decisions.sum(), kept as they are made
         self._deciding = -1  # the agent whose policy is deciding right now
         self._player = policy if isinstance(policy, QuietPlayer) else None  # decides compiled
         for agent in np.flatnonzero(~agents.alive):  # dead from the start: no body to bump into
@@ -168,8 +163,7 @@ class Simulator:
             self.tick += 1
             self._decide()
         if self.outcome is not None:
-            due = next_due(self.waiting, self.agents.alive, self.hold_until, self.tick)
-            last = min(end, due - 1, self.recorder.next_tick - 1)
+            last = min(end, self.state.next_due(self.tick) - 1, self.recorder.next_tick - 1)
             ticks, moved = self.mover.glide(max(1, last - self.tick + 1))
             self.tick += ticks - 1
             self._moved(moved)
@@ -185,9 +179,9 @@ class Simulator:
     def _finish_tick(self, moving: np.ndarray) -> None:
         """The rest of a tick after the decisions and the motion: the bomb rules, the combat
         step, the outcome and the recording."""
-        agents = self.agents
+        agents, state = self.agents, self.state
         self.events += self.rules.step(
-            self.tick, agents, self.bomb, self.wants_plant, self.wants_defuse, moving
+            self.tick, agents, self.bomb, state.wants_plant, state.wants_defuse, moving
         )
         if self.combat is not None and self.tick % self.combat_every_ticks == 0:
             alive_before = agents.alive.copy()
@@ -300,12 +294,12 @@ class Simulator:
         self.mover.place(agent, self.graph.positions[node])
         self.agents.position[agent] = self.graph.positions[node]
         self.agents.node[agent] = node
-        self.goal_node[agent] = -1
+        self.state.goal_node[agent] = -1
         self._set_fall(agent, 0.0)
         if agent != self._deciding:
             self.mover.clear_goal(agent)
-            self.hold_until[agent] = 0
-            self.waiting[agent] = bool(self.agents.alive[agent])
+            self.state.hold_until[agent] = 0
+            self.state.waiting[agent] = bool(self.agents.alive[agent])
         self.events.append(SimEvent(self.tick, "relocate", agent, data={"node": int(node)}))
 
     def hand_bomb(self, agent: int) -> None:
@@ -354,7 +348,7 @@ class Simulator:
         arrives before: no decision falls due, and `_stretch_end`. Equal to `tick` when the
         tick after it is not quiet. Asked once the decisions of the tick after `tick` are made
         (they are the only part of that tick already played)."""
-        due = next_due(self.waiting, self.agents.alive, self.hold_until, tick)
+        due = self.state.next_due(tick)
         if due == tick + 1:
             return tick
         return max(tick, min(self._stretch_end(tick, self._max_tick), due - 1))
@@ -367,14 +361,11 @@ class Simulator:
         alive = self.agents.alive
         if self.outcome is not None or alive.tobytes() != self._alive_judged:
             return tick  # judged yet? (not after a kill from outside)
+        state = self.state
         rules = self.rules.quiet_until(
-            tick,
-            self.agents,
-            self.bomb,
-            self.wants_plant,
-            self.wants_defuse,
+            tick, self.agents, self.bomb, state.wants_plant, state.wants_defuse,
             self.mover.is_standing,
-        )
+        )  # fmt: skip
         last = min(end, self._max_tick - 1, rules)
         if self.combat is not None:
             last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
@@ -390,16 +381,18 @@ class Simulator:
         ticks, moved = self.mover.glide(last - self.tick + 1)
         self.tick += ticks - 1
         moving = self._moved(moved)
+        state = self.state
         self.events += self.rules.step(
-            self.tick, self.agents, self.bomb, self.wants_plant, self.wants_defuse, moving
+            self.tick, self.agents, self.bomb, state.wants_plant, state.wants_defuse, moving
         )
         if self._fall_killed:  # at the glide's last tick
             self._judge_and_announce()
 
     def _set_fall(self, agent: int, depth: float) -> None:
         """Note the depth of the damaging drop an agent is on (0: none), keeping the count."""
-        self._falling += int(depth > 0) - int(self.fall_m[agent] > 0)
-        self.fall_m[agent] = depth
+        fall_m = self.state.fall_m
+        self._falling += int(depth > 0) - int(fall_m[agent] > 0)
+        fall_m[agent] = depth
 
     def _land(self, arrived: np.ndarray) -> None:
         """Fall damage for the agents that arrived at the end of a drop deeper than the safe
@@ -407,7 +400,7 @@ class Simulator:
         the simulation kills (`kills`: deaths follow the data), where it leaves 1 HP. Before the
         round's end only: afterwards nothing changes health."""
         for agent in np.flatnonzero(arrived).tolist():
-            height = float(self.fall_m[agent])
+            height = float(self.state.fall_m[agent])
             if not height:
                 continue
             self._set_fall(agent, 0.0)
@@ -436,39 +429,39 @@ class Simulator:
 
     def _kill(self, agent: int) -> None:
         self.mover.remove(agent)
-        self.waiting[agent] = False
-        self.wants_plant[agent] = False
-        self.wants_defuse[agent] = False
+        state = self.state
+        state.waiting[agent] = False
+        state.wants_plant[agent] = False
+        state.wants_defuse[agent] = False
         if self.outcome is None:  # after the end the bomb stays as the round left it
             self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
 
     @property
     def decision_due(self) -> bool:
         """Whether some agent will ask its policy for an action at the next tick."""
-        due = next_due(self.waiting, self.agents.alive, self.hold_until, self.tick)
-        return not self.done and due == self.tick + 1
+        return not self.done and self.state.next_due(self.tick) == self.tick + 1
 
     @property
     def needs_decision(self) -> np.ndarray:
         """(N,) bool: agents that will ask their policy for an action at the next tick."""
         due = np.zeros(self.agents.count, dtype=bool)
         if not self.done:
-            due[due_agents(self.waiting, self.agents.alive, self.hold_until, self.tick + 1)] = True
+            due[self.state.due(self.tick + 1)] = True
         return due
 
     def _decide(self) -> None:
         """The due agents (ascending) ask the policy and the round takes each decision
         (`take_decision`) before the next agent is asked; a `QuietPlayer`'s in compiled code."""
-        agents = self.agents
-        due = due_agents(self.waiting, agents.alive, self.hold_until, self.tick)
+        agents, state = self.agents, self.state
+        due = state.due(self.tick)
         if self._player is not None and len(due):
-            made, falls = decide_tick(self.state, self.tick, self._player, agents.weapon)
+            made, falls = decide_tick(state, self.tick, self._player, agents.weapon)
             self.decision_count += made
             self._falling += falls
             return
         for agent in due.tolist():
-            self.hold_until[agent] = 0
-            self.waiting[agent] = False
+            state.hold_until[agent] = 0
+            state.waiting[agent] = False
             self._deciding = agent
             decision = self.policy.decide(self, agent)
             self._deciding = -1

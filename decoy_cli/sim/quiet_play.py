@@ -275,4 +275,4 @@ def play_quiet(r, c, tick, horizon, next_draw, decisions_left, watch, carrier, b
         )
         tick += ticks - 1
         take_motion(r)
-        carry(bomb_position, r.pos, carrier)
+        carry(bomb_position, r.position, carrier)

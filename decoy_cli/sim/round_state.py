@@ -1,9 +1,9 @@
-"""The round's state as compiled code takes it: one `RoundState`.
+"""The round's state, one owner for the engine and compiled code: one `RoundState`.
 
-`RoundState` is built once when a simulator opens its round. It holds the agents' arrays, the
-engine's decision arrays (which it allocates, and the engine uses as its own), the mover's
-packed slots and what decisions read of the waypoint graph: the very arrays, not copies, so
-what compiled code writes the engine, the agents and the mover see.
+`RoundState` is built once when a simulator opens its round (`Simulator.state`). It holds the
+agents' arrays (under `Agents`' names), the decision arrays (which it allocates and owns), the
+mover's packed slots and what decisions read of the waypoint graph: the very arrays, not copies,
+so what compiled code writes the engine, the agents and the mover see.
 
 It goes to compiled code as ONE argument, a numba struct (`structref`) built once (`kernel`):
 numba's dispatch checks and converts every argument of every call, a struct costs one, and a
@@ -24,6 +24,7 @@ from numba.experimental import structref
 from decoy_cli.compiled import jit_enabled, njit_cached
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.layout import F_HEADING, R_ARRIVED, R_MOVED
+from decoy_cli.sim.schedule import due_agents, next_due
 from decoy_cli.sim.state import Agents
 from decoy_cli.waypoints.graph import WaypointGraph
 
@@ -59,13 +60,13 @@ class RoundState:
     them, and its graph's; `kernel` is the same arrays as one struct for compiled code (module
     docstring)."""
 
-    # the agents' (`Agents`)
-    pos: np.ndarray  # (N, 3) float64, feet
+    # the agents' (`Agents`, under its names)
+    position: np.ndarray  # (N, 3) float64, feet
     yaw: np.ndarray  # float64, degrees
     hp: np.ndarray  # int16
     armor: np.ndarray  # int16
     helmet: np.ndarray  # bool
-    kit: np.ndarray  # bool: has a defuse kit
+    has_defuser: np.ndarray  # bool: has a defuse kit
     alive: np.ndarray  # bool
     node: np.ndarray  # int64: the waypoint last reached
     # the engine's decisions
@@ -98,6 +99,15 @@ class RoundState:
 
     def __post_init__(self) -> None:
         self.kernel = pack(_round_struct, ROUND_FIELDS, [getattr(self, n) for n in ROUND_FIELDS])
+
+    def due(self, tick: int) -> np.ndarray:
+        """Indices (ascending) of the agents due for a decision at `tick` (`schedule`)."""
+        return due_agents(self.waiting, self.alive, self.hold_until, tick)
+
+    def next_due(self, tick: int) -> int:
+        """The first tick after `tick` at which an agent is due for a decision, if no agent
+        arrives before (`schedule`)."""
+        return next_due(self.waiting, self.alive, self.hold_until, tick)
 
     @classmethod
     def open(cls, agents: Agents, mover: MoverBase, graph: WaypointGraph) -> RoundState:
@@ -135,7 +145,7 @@ def take_motion(r):
     where the mover has them, those that moved face their heading, and the alive ones that
     arrived stand on their goal node and wait for a decision. The one place both the engine
     (`Simulator._moved`) and the compiled stretches (`quiet_play.play_quiet`) take motion over."""
-    r.pos[:] = r.mpos
+    r.position[:] = r.mpos
     flags, yaw, fv, alive, node, goal_node = r.flags, r.yaw, r.fv, r.alive, r.node, r.goal_node
     for i in range(yaw.shape[0]):
         if flags[R_MOVED, i]:
