@@ -14,16 +14,19 @@ Every expected tick is derived from the rules, not from a previous run:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.sim.engine import Decision, Simulator
 from decoy_cli.sim.movement import KinematicMover
 from decoy_cli.sim.rules import BombRules, RulesConfig, SiteZones
 from decoy_cli.sim.setup import RoundSetup, open_round
 from decoy_cli.sim.state import Agents, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import STOP_ACTION, EdgeKind, WaypointGraph
-from decoy_cli.weapons import max_speed_m_s
+from decoy_cli.weapons import NO_WEAPON, max_speed_m_s
 
 E, W = 2, 6  # compass directions east and west
 NODES = 6
@@ -346,6 +349,21 @@ def test_a_relocation_inside_a_decision_moves_on_from_the_new_node() -> None:
     assert policy.ticks_of(0) == [1, WALK_3 + 1]
     assert sim.agents.node[0] == 4
     np.testing.assert_allclose(sim.agents.position[0], [4.0, 0.0, 0.0], atol=1e-9)
+
+
+def test_equipment_changed_from_outside_is_held_and_paces_the_next_moves() -> None:
+    # at full speed a 1 m edge takes ceil(60 / 3.81) = 16 ticks with an AWP (200 u/s), 13 with
+    # the empty hand (the knife's speed)
+    awp = math.ceil(TICK_RATE / max_speed_m_s("AWP"))
+    policy = Script({0: [walk(E, speed=None), walk(E, speed=None)]})
+    sim = make_sim(t_and_ct(), policy=policy)
+    sim.equip(0, weapon="AWP", has_defuser=True)
+    assert sim.agents.weapon[0] == "AWP" and sim.agents.has_defuser[0]
+    sim.run(to_tick=awp)
+    sim.disarm(0)
+    sim.run(to_tick=awp + WALK_KNIFE + 1)
+    assert policy.ticks_of(0) == [1, 1 + awp, 1 + awp + WALK_KNIFE]
+    assert sim.agents.weapon[0] == NO_WEAPON and sim.agents.has_defuser[0]
 
 
 # ---- kills -----------------------------------------------------------------------------------

@@ -57,7 +57,7 @@ from decoy_cli.sim.rules import RulesConfig
 from decoy_cli.sim.setup import OpenRound, RoundSetup, RunSpec, open_round
 from decoy_cli.sim.state import Agents, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import FIREARMS, NO_WEAPON, max_speed_m_s
+from decoy_cli.weapons import FIREARMS
 from decoy_cli.world.occlusion import OcclusionScene
 from decoy_cli.world.physics import PhysicsWorld
 
@@ -332,7 +332,7 @@ def replay_round(
                     scripted[i] = True
             for i, tick in disarm.items():
                 if tick <= sim.tick + 1:
-                    agents.weapon[i] = NO_WEAPON
+                    sim.disarm(i)
             stop = int(frame_ticks[np.searchsorted(frame_ticks, sim.tick, side="right")])
             for i, tick in [*deaths.items(), *disarm.items()]:
                 if agents.alive[i] and tick > sim.tick + 1:
@@ -345,10 +345,9 @@ def replay_round(
                 for alive in np.nonzero(agents.alive)[0]:
                     i = int(alive)
                     if present[i, f]:
-                        agents.has_defuser[i] = kit_frames[i, f]
+                        sim.equip(i, has_defuser=kit_frames[i, f])
                     if weapon_frames[i, f] and alive_frames[i, f]:  # the dead hold nothing
-                        agents.weapon[i] = weapon_frames[i, f]
-                        sim.mover.set_max_speed(i, max_speed_m_s(str(weapon_frames[i, f])))
+                        sim.equip(i, weapon=weapon_frames[i, f])
         played_from = sim.tick
         while sim.bomb.planter >= 0 and not sim.done:
             sim.step()  # a plant under way when the data ends completes (or aborts) first

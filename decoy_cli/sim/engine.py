@@ -36,7 +36,7 @@ from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER
 from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import max_speed_m_s
+from decoy_cli.weapons import NO_WEAPON, max_speed_m_s
 
 
 class Policy(Protocol):
@@ -322,6 +322,24 @@ class Simulator:
             self.events.append(SimEvent(self.tick, "death", agent, data={"reason": reason}))
             self._kill(agent)
         self._set_fall(agent, 0.0)
+
+    def equip(
+        self, agent: int, *, weapon: str | None = None, has_defuser: bool | None = None
+    ) -> None:
+        """Change what an agent holds from outside the round (a replay following the data): the
+        weapon in hand, whose full speed then caps its moves (`MoverBase.set_max_speed`), and
+        the defuse kit; None leaves either as it is."""
+        if weapon is not None:
+            self.agents.weapon[agent] = weapon
+            self.mover.set_max_speed(agent, max_speed_m_s(str(weapon)))
+        if has_defuser is not None:
+            self.agents.has_defuser[agent] = has_defuser
+
+    def disarm(self, agent: int) -> None:
+        """Take the weapon out of an agent's hands (a replayed player the data shows dead, a
+        target until removed): it shoots nobody. The mover's cap on it stays; a decision with no
+        cap of its own takes the empty hand's speed, as any takes its weapon's."""
+        self.agents.weapon[agent] = NO_WEAPON
 
     # ---- internals ----------------------------------------------------------------------------
 
