@@ -733,14 +733,18 @@ def test_ctrl_c_while_the_outputs_are_written_keeps_the_last_ones(
 
 
 def test_a_ctrl_c_while_outputs_are_written_waits_for_them() -> None:
-    """`ctrl_c_deferred`: a SIGINT inside the block lets the block finish, then is raised."""
+    """`ctrl_c_deferred`: a SIGINT inside the block lets the block finish, then is raised, and
+    the handler from before the block is back (whatever it was: a library loaded by an earlier
+    test in the same process may have left SIGINT ignored)."""
     import signal
 
     from decoy_cli.evaluate.outputs import ctrl_c_deferred
 
+    before = signal.getsignal(signal.SIGINT)
     finished = []
     with pytest.raises(KeyboardInterrupt), ctrl_c_deferred():
+        assert signal.getsignal(signal.SIGINT) is not before
         os.kill(os.getpid(), signal.SIGINT)
         finished.append(True)
     assert finished == [True]
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert signal.getsignal(signal.SIGINT) is before
