@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,11 @@ from typer.testing import CliRunner
 from decoy_cli.cli import app
 
 SAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sample"
+
+# One thread per torch (OpenMP) runtime: the suite runs in `-n 2` workers on two cores, where a
+# torch that spins a thread per core in each worker waits on the other worker's tests (a 3 s
+# test took a minute). Read when torch first loads, so set before any test imports it.
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 
 @pytest.fixture(scope="session")
