@@ -57,7 +57,7 @@ def test_the_pettingzoo_environment_plays_the_same_rounds_step_for_step() -> Non
     dicts = DecoyParallelEnv(damage_model=AlwaysHits())
     names = dicts.possible_agents
     deaths = ends = 0
-    for seed in range(4):
+    for seed in range(2):  # two rounds played to their end, with deaths on the way (below)
         rng = np.random.default_rng(seed)
         state = arrays.reset(seed)
         obs, infos = dicts.reset(seed=seed)
@@ -88,7 +88,7 @@ def test_the_pettingzoo_environment_plays_the_same_rounds_step_for_step() -> Non
         assert {info["winner"] for info in infos.values()} == {state.winner}
     arrays.close()
     dicts.close()
-    assert ends == 4 and deaths > 0  # rounds that end, with deaths along the way
+    assert ends == 2 and deaths > 0  # rounds that end, with deaths along the way
 
 
 def test_rewards_and_terminations_follow_deaths_and_the_round_end(env: DecoyArrayEnv) -> None:
