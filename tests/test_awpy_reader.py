@@ -422,7 +422,7 @@ def test_a_round_of_an_unknown_map_reads_and_fails_to_replay_by_name(
 @needs_data
 def test_replay_of_a_zip_round_matches_the_esta_shaped_file(tmp_path: Path) -> None:
     """The 8 Hz round is identical in every form (its positions are float32 in the source), on
-    CS2's world as on CS:GO's (the test of CS:GO's: replay_fingerprints.py --cs2)."""
+    CS2's world as on CS:GO's (the test of CS:GO's: replay_fingerprints.py --cs2-forms)."""
     outputs = []
     for path in (
         SHARED / "cs2_dust2_both" / f"{STEMS[1]}.json.xz",

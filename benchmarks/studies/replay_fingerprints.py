@@ -1,29 +1,31 @@
 """Fingerprints of replays, to show two code trees replay real rounds identically.
 
-    python benchmarks/studies/replay_fingerprints.py OUT.json [FILES] [EVERY]
+    python benchmarks/studies/replay_fingerprints.py OUT.json [--files N] [--every N]
     PYTHONPATH=/path/to/other/tree python benchmarks/studies/replay_fingerprints.py OTHER.json
     python benchmarks/studies/replay_fingerprints.py --compare OUT.json OTHER.json
-    python benchmarks/studies/replay_fingerprints.py --cs2 [--float32]
+    python benchmarks/studies/replay_fingerprints.py --cs2-forms [--float32]
 
 Replays every EVERY-th round (default 4) of the first FILES match files (default 15) of
 ../shared/data/esta_dust2_tside under four settings (movement only; the bomb; the bomb with the
-physics mover; shooting with the shipped models and the bomb) and writes, per replay, a SHA-256
-of its recording (ticks, positions, yaw, HP, alive), its events and its outcome, with the time
-taken. `--compare` counts the replays whose fingerprints differ.
+physics mover; shooting with the shipped models and the bomb), and every real CS2 round in each
+of its three forms (the ESTA-shaped file of ../shared/data/cs2_dust2_both, the awpy 2 zip and
+the awpy 3 folder of ../shared/data/cs2_dust2_awpy) under four more (the game's damage rules with
+`--deaths data`, with simulated deaths, the shipped models, the physics mover), and writes, per
+replay, a SHA-256 of its recording (ticks, positions, yaw, HP, alive), its events and its
+outcome, with the time taken. `--compare` counts the replays whose fingerprints differ.
 
-`--cs2` replays the real CS2 rounds read from each of their three forms (the ESTA-shaped file
-of ../shared/data/cs2_dust2_both, the awpy 2 zip and the awpy 3 folder of
-../shared/data/cs2_dust2_awpy) under `--deaths data` and simulated deaths (shipped models, seed
-0) and prints, per round and setting, whether the three fingerprints agree. `--float32` first
-rounds the ESTA-shaped file's positions to float32, as awpy stores them: the one difference
-between the forms of the 1 Hz rounds (the file holds decimals of 0.1 u that float32 cannot).
+`--cs2-forms` prints, per CS2 round, whether its three forms replay alike with the damage rules
+under both death protocols.
+`--float32` first rounds the ESTA-shaped file's positions to float32, as awpy stores them: the
+one difference between the forms of the 1 Hz rounds (the file holds decimals of 0.1 u that
+float32 cannot).
 """
 
 from __future__ import annotations
 
+import argparse
 import hashlib
 import json
-import sys
 import time
 from pathlib import Path
 
@@ -70,8 +72,12 @@ def replay_digest(result: object) -> str:
     return digest.hexdigest()
 
 
-def cs2_fingerprints(float32: bool) -> None:
-    """Print whether each CS2 round replays alike from its three forms (module docstring)."""
+CS2_STEMS = ("spirit-vs-falcons-m2-dust2-r01-12", "spirit-vs-falcons-m2-dust2-8hz-r02")
+
+
+def cs2_replays(float32: bool = False, only: tuple[str, ...] = ()) -> dict[str, str]:
+    """Fingerprints of the CS2 rounds, keyed setting:stem:round:form (module docstring), under
+    the settings named in `only` (all when empty)."""
     from dataclasses import replace
 
     from decoy_cli.csgo import HAMMER_TO_M
@@ -84,15 +90,17 @@ def cs2_fingerprints(float32: bool) -> None:
 
     shared = DATA.parent
     graph = builtin_graph()
-    model = load_damage_model("rules")
+    rules = load_damage_model("rules")
     settings = {
-        "data": ReplayOptions(combat=True, bomb=True, damage_model=model, deaths="data", seed=0),
-        "simulated": ReplayOptions(combat=True, bomb=True, damage_model=model, seed=0),
+        "data": ReplayOptions(combat=True, bomb=True, damage_model=rules, deaths="data", seed=0),
+        "simulated": ReplayOptions(combat=True, bomb=True, damage_model=rules, seed=0),
+        "shipped": ReplayOptions(damage_model=load_damage_model("shipped"), seed=0),
+        "physics": ReplayOptions(combat=False, bomb=True, mover="physics"),
     }
-    stems = ["spirit-vs-falcons-m2-dust2-r01-12", "spirit-vs-falcons-m2-dust2-8hz-r02"]
-    differ = total = 0
+    settings = {k: v for k, v in settings.items() if not only or k in only}
+    out = {}
     with PhysicsWorld(nav_world()) as physics:
-        for stem in stems:
+        for stem in CS2_STEMS:
             forms = {
                 "esta": read_match(shared / "cs2_dust2_both" / f"{stem}.json.xz"),
                 "awpy2": read_match(shared / "cs2_dust2_awpy" / "awpy2" / f"{stem}.zip"),
@@ -100,39 +108,53 @@ def cs2_fingerprints(float32: bool) -> None:
             }
             for num in forms["esta"].round_numbers:
                 for name, options in settings.items():
-                    digests = {}
                     for form, match in forms.items():
                         round_ = match.round(num)
                         if float32 and form == "esta":
                             exact = round_.position / HAMMER_TO_M
                             stored = exact.astype(np.float32).astype(np.float64) * HAMMER_TO_M
                             round_ = replace(round_, position=stored)
-                        digests[form] = replay_digest(
-                            replay_round(round_, graph, options, physics=physics)
-                        )
-                    same = len(set(digests.values())) == 1
-                    total += 1
-                    differ += not same
-                    print(f"{stem}:{num} {name}: {'same' if same else digests}")
-    print(f"{total} replays of three forms; {differ} differ")
+                        result = replay_round(round_, graph, options, physics=physics)
+                        out[f"{name}:{stem}:{num}:{form}"] = replay_digest(result)
+    return out
+
+
+def print_cs2_forms(float32: bool) -> None:
+    """Print whether each CS2 round replays alike from its three forms, with the game's damage
+    rules under both death protocols."""
+    by_replay: dict[str, set[str]] = {}
+    for key, digest in cs2_replays(float32, only=("data", "simulated")).items():
+        by_replay.setdefault(key.rsplit(":", 1)[0], set()).add(digest)
+    differ = [key for key, digests in by_replay.items() if len(digests) > 1]
+    for key, digests in by_replay.items():
+        print(f"{key}: {'same' if len(digests) == 1 else 'differ'}")
+    print(f"{len(by_replay)} replays of three forms; {len(differ)} differ")
 
 
 def main() -> None:
-    if sys.argv[1:2] == ["--cs2"]:
-        cs2_fingerprints("--float32" in sys.argv)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("out", nargs="?", type=Path, help="where to write the fingerprints")
+    parser.add_argument("--files", type=int, default=15, help="T-side match files")
+    parser.add_argument("--every", type=int, default=4, help="every N-th round of each")
+    parser.add_argument("--compare", nargs=2, type=Path, metavar=("A", "B"))
+    parser.add_argument("--cs2-forms", action="store_true", help="do the three forms agree")
+    parser.add_argument("--float32", action="store_true", help="with --cs2-forms (docstring)")
+    args = parser.parse_args()
+    if args.cs2_forms:
+        print_cs2_forms(args.float32)
         return
-    if sys.argv[1:2] == ["--compare"]:
-        a, b = (json.loads(Path(p).read_text())["replays"] for p in sys.argv[2:4])
+    if args.compare:
+        a, b = (json.loads(p.read_text())["replays"] for p in args.compare)
         differ = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
         print(f"{len(a)} and {len(b)} replays; {len(differ)} differ {differ[:10]}")
         return
-    files = int(sys.argv[2]) if len(sys.argv) > 2 else 15
-    every = int(sys.argv[3]) if len(sys.argv) > 3 else 4
+    if args.out is None:
+        parser.error("give OUT.json, --compare A B or --cs2-forms")
     began = time.perf_counter()
-    replays = fingerprints(files, every)
+    replays = {**fingerprints(args.files, args.every), **cs2_replays()}
     seconds = time.perf_counter() - began
-    Path(sys.argv[1]).write_text(json.dumps({"seconds": seconds, "replays": replays}, indent=1))
-    print(f"{len(replays)} replays in {seconds:.1f} s -> {sys.argv[1]}")
+    args.out.write_text(json.dumps({"seconds": seconds, "replays": replays}, indent=1))
+    print(f"{len(replays)} replays in {seconds:.1f} s -> {args.out}")
 
 
 if __name__ == "__main__":
