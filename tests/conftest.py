@@ -16,6 +16,10 @@ SAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sample"
 # torch that spins a thread per core in each worker waits on the other worker's tests (a 3 s
 # test took a minute). Read when torch first loads, so set before any test imports it.
 os.environ.setdefault("OMP_NUM_THREADS", "1")
+# `decoy evaluate` runs its rounds in the test's own process unless a test asks for worker
+# processes (`--workers N`, which the tests of the pool, its crashes and Ctrl-C give): starting
+# a pool and loading the package again in each worker cost seconds per run.
+os.environ.setdefault("DECOY_WORKERS", "0")
 
 
 @pytest.fixture(scope="session")

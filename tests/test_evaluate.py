@@ -27,7 +27,7 @@ from typer.testing import CliRunner
 from decoy_cli.cli import app
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.errors import DecoyError, OutputError
-from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
+from decoy_cli.evaluate.backends import DaskBackend, InProcessBackend, LocalBackend
 from decoy_cli.evaluate.cache import RunCache
 from decoy_cli.evaluate.heat import HeatGrid, grid_sums, read_grid_sums
 from decoy_cli.evaluate.job import RoundTask, evaluate_round, is_synthetic
@@ -171,6 +171,30 @@ def test_the_reference_run_evaluates_every_player_round(
     pooled = (players["mean_dist"] * both).sum() / both.sum()
     assert acc.error_count.sum() == both.sum() == acc.places_error_count.sum()
     assert acc.error_mm.sum() / 1000 / acc.error_count.sum() == pytest.approx(pooled, abs=5e-4)
+
+
+def test_in_this_process_the_results_are_the_worker_s(
+    clean: Path, settings: EvalSettings, reference: tuple[Evaluation, Tables], tmp_path: Path
+) -> None:
+    """`--workers 0` (`InProcessBackend`): the same numbers as a worker process, and the
+    command says where the rounds ran; `DECOY_WORKERS` is the default a `--workers` overrides."""
+    evaluation = run_evaluation([clean], settings, tmp_path / "lib", InProcessBackend())
+    assert_same_results(evaluation, reference)
+    out = tmp_path / "cli"
+    result = runner.invoke(
+        app,
+        ["evaluate", str(clean), "--no-combat", "--no-bomb", "--out", str(out)],
+        env={**WIDE, "DECOY_WORKERS": "0"},
+    )
+    assert result.exit_code == 0, result.output
+    assert "evaluating with this process" in result.output
+    assert (out / "players.csv").read_text() == reference[1].players.to_csv(index=False)
+    told = runner.invoke(
+        app,
+        ["evaluate", str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out)],
+        env={**WIDE, "DECOY_WORKERS": "0"},
+    )
+    assert told.exit_code == 0 and "evaluating with 1 local worker process" in told.output
 
 
 def test_cli_end_to_end_writes_every_table_and_figure_with_two_workers(

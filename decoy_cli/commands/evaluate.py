@@ -55,7 +55,7 @@ from decoy_cli.metrics import PAPER_PROTOCOL_NAMES, BombMetrics
 from decoy_cli.waypoints.build import GameWorld
 
 if TYPE_CHECKING:
-    from decoy_cli.evaluate.backends import DaskBackend, LocalBackend
+    from decoy_cli.evaluate.backends import DaskBackend, InProcessBackend, LocalBackend
 
 DEFAULT_OUT = Path("decoy-out") / "evaluate"
 
@@ -96,7 +96,7 @@ def evaluate(
         "--round-timeout",
         min=0,
         help="Wall-clock seconds one round may take before it is recorded as a timeout "
-        "failure (0: no limit; local workers only).",
+        "failure (0: no limit; not on a Dask cluster).",
     ),
     fastdtw: bool | None = typer.Option(
         None,
@@ -110,9 +110,12 @@ def evaluate(
     workers: int | None = typer.Option(
         None,
         "--workers",
-        min=1,
+        min=0,
+        envvar="DECOY_WORKERS",
         show_default=False,
-        help="Local worker processes (default: the number of cores).",
+        help="Local worker processes (default: the number of cores). 0: the rounds run in this "
+        "process, one after another: no process to start, the quickest for a few rounds, but a "
+        "round that crashes the interpreter ends the run (the finished rounds stay cached).",
     ),
     view: bool = typer.Option(
         True,
@@ -157,12 +160,17 @@ def evaluate(
         world=world,
     )
     command = command_line(inputs, settings, sample, out)
-    backend: DaskBackend | LocalBackend
+    backend: DaskBackend | LocalBackend | InProcessBackend
     if scheduler:
         from decoy_cli.evaluate.backends import DaskBackend
 
         backend = DaskBackend(scheduler)
         where = f"Dask scheduler {scheduler}"
+    elif workers == 0:
+        from decoy_cli.evaluate.backends import InProcessBackend
+
+        backend = InProcessBackend()
+        where = "this process"
     else:
         from decoy_cli.evaluate.backends import LocalBackend
 

@@ -1,4 +1,5 @@
-"""Where the jobs run: a local pool of worker processes, or an existing Dask cluster.
+"""Where the jobs run: a local pool of worker processes, this process, or an existing Dask
+cluster.
 
 Both backends take a job function and its tasks and yield `(task, outcome)` as tasks finish,
 where the outcome is the job's return value or a `RoundFailure` the backend made because the
@@ -14,6 +15,11 @@ worker is in flight, so when a worker dies (the pool then breaks and every in-fl
 with it) the suspects are those few tasks: each runs again alone in a fresh one-worker pool,
 where a second death is that task's failure and the others complete; the rest of the batch
 goes on in a new pool.
+
+In this process (`--workers 0`): the jobs run one after another in the caller, with no process
+to start (the quickest way to evaluate a few rounds); nothing isolates a crash, so a round that
+brings the interpreter down ends the run (the rounds finished before it stay cached). A job
+never raises, so the outcomes are the pool's.
 
 Dask: the same job functions are submitted to a `dask.distributed` scheduler. The input files
 must be readable by the workers at the same paths (a shared file system); results come back to
@@ -173,6 +179,21 @@ def _result(future: Future[Outcome]) -> Outcome | RoundFailure | _Broken:
         return _BROKEN
     except Exception as error:  # e.g. a result that could not be sent back
         return _internal(error)
+
+
+class InProcessBackend:
+    """Jobs run one after another in this process (see the module docstring)."""
+
+    def __enter__(self) -> InProcessBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        pass
+
+    def run(self, job: Callable[[Task], Outcome], tasks: Iterable[Task]) -> Outcomes[Task, Outcome]:
+        """Yield (task, outcome) for every task, in order."""
+        for task in tasks:
+            yield task, job(task)
 
 
 class DaskBackend:
