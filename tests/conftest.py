@@ -30,9 +30,3 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     result = CliRunner().invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "2"])
     assert result.exit_code == 0, result.output
     return out
-
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The tests marked slow first (in their order), then the rest: with `-n 2` the workers
-    take the long ones early instead of one of them finishing alone."""
-    items.sort(key=lambda item: item.get_closest_marker("slow") is None)

@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-import pytest
 from typer.testing import CliRunner
 
 from decoy_cli.cli import app
@@ -15,7 +14,6 @@ from decoy_cli.esta.awpy.writer import write_awpy2_zip, write_awpy3_folder
 from decoy_cli.synth.sample import SAMPLE_DIR
 
 
-@pytest.mark.slow
 def test_both_layouts_of_one_demo_evaluate_to_the_same_tables(tmp_path: Path) -> None:
     sample = read_match(sorted(SAMPLE_DIR.glob("*.json*"))[0])
     match = replace(sample, rounds=sample.rounds[:2])

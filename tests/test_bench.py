@@ -67,7 +67,6 @@ def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, dict[str, 
     return result, json.loads(out.read_text())
 
 
-@pytest.mark.slow
 def test_quick_bench_writes_every_section_and_the_machine(quick_run) -> None:
     result, report = quick_run
     assert set(report["sections"]) == set(SECTIONS)

@@ -88,7 +88,6 @@ def test_a_git_ref_side_by_side_with_a_relative_out(
     assert [p.name for p in (tmp_path / "side").iterdir()] == ["bench.json"]  # nothing left
 
 
-@pytest.mark.slow
 @needs_git
 def test_a_portable_section_runs_this_trees_file_on_the_baselines_package(tmp_path: Path) -> None:
     args = ["bench", "--quick", "--sections", "kinematic,combat_step", "--repeats", "1"]

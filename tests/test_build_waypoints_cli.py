@@ -77,7 +77,6 @@ def esta_match(tmp_path_factory: pytest.TempPathFactory) -> Path:
 # ---- the built-in map (one full build, ~12 s, with every check on its output) ---------------
 
 
-@pytest.mark.slow
 def test_builtin_build(tmp_path: Path, subtests: pytest.Subtests) -> None:
     """THE test that the shipped graph is current: rebuilding it gives the same bytes.
 

@@ -184,7 +184,6 @@ FUZZ_EXAMPLES = int(os.environ.get("DECOY_FUZZ_EXAMPLES", "40"))
 """Mutated files per run (CI's default; set DECOY_FUZZ_EXAMPLES for a longer search)."""
 
 
-@pytest.mark.slow
 @settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(changes=mutations, damage=byte_damage, xz_fraction=compression)
 def test_any_mutated_file_ends_in_results_or_one_error_line(

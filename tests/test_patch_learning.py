@@ -240,7 +240,6 @@ def test_the_command_fails_in_one_line_and_writes_nothing(tmp_path: Path) -> Non
 # ---- the real T-side data -------------------------------------------------------------------
 
 
-@pytest.mark.slow
 @pytest.mark.skipif(not TSIDE.is_dir(), reason=f"real data not present ({TSIDE})")
 def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_path: Path) -> None:
     files = sorted(TSIDE.glob("*.json.xz"))[:3]

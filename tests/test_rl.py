@@ -56,7 +56,6 @@ def test_rllib_sees_only_the_agents_that_decide_and_every_ending() -> None:
     env.close()
 
 
-@pytest.mark.slow
 def test_the_ppo_example_trains_two_tiny_iterations(tmp_path: Path) -> None:
     pytest.importorskip("ray.rllib", reason="needs Ray RLlib: pip install -e '.[rl]'")
     args = ["--iterations", "2", "--env-runners", "0", "--batch", "200", "--models", "none"]

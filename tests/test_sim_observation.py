@@ -6,7 +6,6 @@ under way."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from busy_rounds import Shots, Wanderers, site_agents
 
 from decoy_cli.env.observation import BOMB_SITES, NUM_ACTIONS, ObservationEncoder
@@ -76,7 +75,6 @@ def _steps_of(sim: Simulator, encoder: ObservationEncoder) -> RoundSteps:
     return RoundSteps(sim, encoder, choices, list(sim.agents.names), is_t)
 
 
-@pytest.mark.slow
 def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
     graph = builtin_graph()
     setup = RoundSetup(graph=graph, damage_model=Shots())
