@@ -46,6 +46,7 @@ from decoy_cli.world.nav_geometry import (
     subtract,
 )
 from decoy_cli.world.nav_json import PolygonNav
+from decoy_cli.world.polygon_index import Edges, Floors
 from decoy_cli.world.world import World
 
 PIECE_U = 16.0
@@ -59,8 +60,6 @@ de_dust2 nav's open edges to the walls of the brush mesh of ../shared/data/meshe
 SAME_LEVEL_REACH_U = 2 * POLYGON_WALL_PUSH_U
 """A floor of the same level (within a jump) farther beyond an open edge than this has a wall
 between: both stop that far short of it (CS:GO's world counts three of its pushes)."""
-GRID_U = 64.0
-"""Cell size of the index that finds the areas under a point."""
 OVERHEAD_U = 72.0
 """A floor more than this above a wall's foot is a floor overhead: the wall stops below it."""
 
@@ -80,8 +79,8 @@ def polygon_world(nav: PolygonNav, map_name: str) -> World:
 
 def polygon_triangles(nav: PolygonNav) -> np.ndarray:
     """Floors, step faces and open-edge faces of a polygon nav mesh, (T, 3, 3) Hammer units."""
-    floors = _Floors(nav)
-    edges = _Edges(nav)
+    floors = Floors(nav)
+    edges = Edges(nav)
     covered, tris = _shared_stretches(edges, floors)
     walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]] = defaultdict(list)
     for e, t0, t1, found in _open_pieces(edges, floors, covered):
@@ -92,100 +91,10 @@ def polygon_triangles(nav: PolygonNav) -> np.ndarray:
     return np.concatenate([floor_tris, faces])
 
 
-# ---- floors -------------------------------------------------------------------------------
+# ---- shared edges ---------------------------------------------------------------------------
 
 
-class _Floors:
-    """The floor triangles of every area, and the areas and heights under a point."""
-
-    def __init__(self, nav: PolygonNav) -> None:
-        tris, owner = [], []
-        for a in range(nav.num_areas):
-            for tri in _triangulate(nav.polygon(a)):
-                tris.append(tri)
-                owner.append(a)
-        self.triangles = np.asarray(tris, dtype=np.float64)
-        self.owner = np.asarray(owner, dtype=np.int64)
-        self.cells: dict[tuple[int, int], list[int]] = defaultdict(list)
-        low = np.floor(self.triangles[:, :, :2].min(axis=1) / GRID_U).astype(int)
-        high = np.floor(self.triangles[:, :, :2].max(axis=1) / GRID_U).astype(int)
-        for t in range(len(self.triangles)):
-            for i in range(low[t, 0], high[t, 0] + 1):
-                for j in range(low[t, 1], high[t, 1] + 1):
-                    self.cells[(i, j)].append(t)
-
-    def under(self, x: float, y: float) -> list[tuple[int, float]]:
-        """(area, floor height) of every area whose floor lies under the point (x, y)."""
-        found = []
-        for t in self.cells.get((int(np.floor(x / GRID_U)), int(np.floor(y / GRID_U))), []):
-            z = _height_in(self.triangles[t], x, y)
-            if z is not None:
-                found.append((int(self.owner[t]), z))
-        return found
-
-
-def _triangulate(polygon: np.ndarray) -> list[np.ndarray]:
-    """Triangles of a convex (or nearly convex) polygon, dropping degenerate ones; a
-    quadrilateral is cut along the diagonal that leaves both halves turning the same way."""
-    n = len(polygon)
-    if n == 4 and (_twice_area(polygon[[0, 1, 2]]) <= 0 or _twice_area(polygon[[0, 2, 3]]) <= 0):
-        polygon = polygon[[1, 2, 3, 0]]
-    tris = [polygon[[0, k, k + 1]] for k in range(1, n - 1)]
-    return [t for t in tris if _twice_area(t) > 1e-3]
-
-
-def _twice_area(tri: np.ndarray) -> float:
-    (x0, y0), (x1, y1), (x2, y2) = tri[:, :2]
-    return float((x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0))
-
-
-def _height_in(tri: np.ndarray, x: float, y: float, tol: float = 1e-6) -> float | None:
-    """Height of the triangle's plane at (x, y) when the point lies in it (seen from above)."""
-    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = tri
-    det = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)
-    if abs(det) < 1e-9:
-        return None
-    l0 = ((y1 - y2) * (x - x2) + (x2 - x1) * (y - y2)) / det
-    l1 = ((y2 - y0) * (x - x2) + (x0 - x2) * (y - y2)) / det
-    l2 = 1 - l0 - l1
-    if min(l0, l1, l2) < -tol:
-        return None
-    return float(l0 * z0 + l1 * z1 + l2 * z2)
-
-
-# ---- edges --------------------------------------------------------------------------------
-
-
-class _Edges:
-    """Every polygon edge: start, direction, length, outward normal (seen from above)."""
-
-    def __init__(self, nav: PolygonNav) -> None:
-        start, end, area = [], [], []
-        for a in range(nav.num_areas):
-            poly = nav.polygon(a)
-            for k in range(len(poly)):
-                p, q = poly[k], poly[(k + 1) % len(poly)]
-                if np.hypot(*(q - p)[:2]) > TOUCH_TOL_U:
-                    start.append(p)
-                    end.append(q)
-                    area.append(a)
-        self.start = np.asarray(start)
-        self.end = np.asarray(end)
-        self.area = np.asarray(area, dtype=np.int64)
-        delta = (self.end - self.start)[:, :2]
-        self.length = np.hypot(delta[:, 0], delta[:, 1])
-        self.direction = delta / self.length[:, None]
-        self.normal = np.stack([self.direction[:, 1], -self.direction[:, 0]], axis=1)
-        self.count = len(self.area)
-
-    def point(self, e: int, t: float, out: float = 0.0) -> np.ndarray:
-        """(x, y, z) at `t` along edge e (z on the edge), moved `out` along its normal."""
-        s = t / self.length[e]
-        p = self.start[e] + s * (self.end[e] - self.start[e])
-        return np.array([*(p[:2] + out * self.normal[e]), p[2]])
-
-
-def _shared_stretches(edges: _Edges, floors: _Floors) -> tuple[list[list], list]:
+def _shared_stretches(edges: Edges, floors: Floors) -> tuple[list[list], list]:
     """Per edge, the stretches [lo, hi] (along it) that another area's edge lies on, and the
     step faces of those where the two floors differ in height (made once per pair)."""
     covered: list[list[tuple[float, float]]] = [[] for _ in range(edges.count)]
@@ -220,7 +129,7 @@ def _shared_stretches(edges: _Edges, floors: _Floors) -> tuple[list[list], list]
     return covered, tris
 
 
-def _lower_goes_under(edges: _Edges, floors: _Floors, e: int, f: int, lo: float, hi: float) -> bool:
+def _lower_goes_under(edges: Edges, floors: Floors, e: int, f: int, lo: float, hi: float) -> bool:
     """True where edges e and f meet far apart in height and the lower floor goes on under the
     upper one across their line (a walkway over a passage): no face stands there."""
     mid = edges.point(e, (lo + hi) / 2)
@@ -231,13 +140,13 @@ def _lower_goes_under(edges: _Edges, floors: _Floors, e: int, f: int, lo: float,
     return _floor_near(floors, x, y, low, upper)
 
 
-def _floor_near(floors: _Floors, x: float, y: float, z: float, left_out: int) -> bool:
+def _floor_near(floors: Floors, x: float, y: float, z: float, left_out: int) -> bool:
     """Whether a floor within a jump of height `z` lies under (x, y), the area `left_out`'s
     aside: the test for a lower floor going on beneath an upper one."""
     return any(area != left_out and abs(h - z) <= JUMP_U for area, h in floors.under(x, y))
 
 
-def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
+def _z_on_edge(edges: Edges, e: int, point: np.ndarray) -> float:
     """Height of edge e at the point of it nearest to `point` (seen from above)."""
     along = np.dot(point[:2] - edges.start[e, :2], edges.direction[e])
     t = float(np.clip(along, 0, edges.length[e]))
@@ -247,9 +156,7 @@ def _z_on_edge(edges: _Edges, e: int, point: np.ndarray) -> float:
 # ---- open edges ---------------------------------------------------------------------------
 
 
-def _beyond(
-    edges: _Edges, floors: _Floors, e: int, t: float, z: float
-) -> tuple[float, float] | None:
+def _beyond(edges: Edges, floors: Floors, e: int, t: float, z: float) -> tuple[float, float] | None:
     """(gap, height) of the nearest other floor beyond edge e at `t` within reach, or None.
     A floor within a jump of `z` across a hole (at most `BRIDGE_MAX_GAP_U`) comes first, even
     where a floor far below shows sooner: the hole's far side, not the pit under it."""
@@ -258,7 +165,7 @@ def _beyond(
 
 
 def _first_floor(
-    edges: _Edges, floors: _Floors, e: int, t: float, z: float, within: float, reach: float
+    edges: Edges, floors: Floors, e: int, t: float, z: float, within: float, reach: float
 ) -> tuple[float, float] | None:
     """(gap, height) of the nearest other area's floor beyond edge e at `t`, up to `reach`
     out, among those at most `within` from height `z` (the closest in height where several)."""
@@ -285,7 +192,7 @@ def _first_floor(
 
 
 def _open_pieces(
-    edges: _Edges, floors: _Floors, covered: list[list[tuple[float, float]]]
+    edges: Edges, floors: Floors, covered: list[list[tuple[float, float]]]
 ) -> Iterator[tuple[int, float, float, tuple[float, float] | None]]:
     """Every open piece of every edge, at most `PIECE_U` long: (edge, t0, t1, beyond), where
     `beyond` is the (gap, height) of the nearest other floor beyond the piece's middle, None
@@ -300,8 +207,8 @@ def _open_pieces(
 
 
 def _piece_faces(
-    edges: _Edges,
-    floors: _Floors,
+    edges: Edges,
+    floors: Floors,
     e: int,
     t0: float,
     t1: float,
@@ -341,7 +248,7 @@ def _piece_faces(
     return tris + _face(edges, e, t0, t1, push, (z0, z1), (other, other))
 
 
-def _wall_top(edges: _Edges, floors: _Floors, e: int, t: float, z: float) -> float | None:
+def _wall_top(edges: Edges, floors: Floors, e: int, t: float, z: float) -> float | None:
     """A wall's height above its foot at `t` of edge e: `WALL_HEIGHT_U`, capped below a floor
     overhead; None where the wall would stand on another floor of about the same level."""
     x, y, _ = edges.point(e, t, POLYGON_WALL_PUSH_U)
@@ -357,7 +264,7 @@ def _wall_top(edges: _Edges, floors: _Floors, e: int, t: float, z: float) -> flo
 
 
 def _note_ends(
-    edges: _Edges,
+    edges: Edges,
     e: int,
     t0: float,
     t1: float,
@@ -393,7 +300,7 @@ def _corner_walls(
     return tris
 
 
-def _strip(edges: _Edges, e: int, t0: float, t1: float, width: float, z0: float, z1: float):
+def _strip(edges: Edges, e: int, t0: float, t1: float, width: float, z0: float, z1: float):
     """The area's floor carried `width` beyond edge e between t0 and t1."""
     if width <= 0.5:
         return []
@@ -402,7 +309,7 @@ def _strip(edges: _Edges, e: int, t0: float, t1: float, width: float, z0: float,
     return quad((*a[:2], z0), (*b[:2], z1), (*c[:2], z1), (*d[:2], z0))
 
 
-def _face(edges: _Edges, e: int, t0: float, t1: float, push: float, low, high):
+def _face(edges: Edges, e: int, t0: float, t1: float, push: float, low, high):
     """A vertical face on the line `push` beyond edge e, between two height profiles."""
     a, b = edges.point(e, t0, push), edges.point(e, t1, push)
     return quad((*a[:2], low[0]), (*b[:2], low[1]), (*b[:2], high[1]), (*a[:2], high[0]))
@@ -416,7 +323,7 @@ def open_edge_rays(
     the edge to `reach` beyond it: (starts, ends) in Hammer units and `back`, what a study of
     how far the real walls stand casts against a map's geometry
     (benchmarks/studies/cs2_world.py)."""
-    floors, edges = _Floors(nav), _Edges(nav)
+    floors, edges = Floors(nav), Edges(nav)
     covered, _ = _shared_stretches(edges, floors)
     starts, ends = [], []
     for e, t0, t1, found in _open_pieces(edges, floors, covered):
