@@ -29,12 +29,31 @@ PARTS = (  # (part, substrings of "file:function"), first match wins
     ("pybullet", ("pybullet.", "getClosestPoints", "resetBasePosition", "MultiBody")),
     ("Embree line of sight", ("EmbreeScene", "occlusion.py")),
     ("movement kernels (numba)", ("collision.py", "kernels.py")),
-    ("bomb rules", ("sim/rules.py", "sim/sites.py")),
+    (
+        "bomb rules",
+        (
+            "sim/rules.py",
+            "sim/rules_config.py",
+            "sim/plant_defuse.py",
+            "sim/round_end.py",
+            "sim/sites.py",
+        ),
+    ),
     ("line of sight and damage", ("sim/sight.py", "sim/combat.py", "damage/", "torch")),
     ("compiled stretches (decisions and glides)", ("quiet_play.py",)),
     ("random policy (the benchmark's)", ("random_play.py", "bench/simspeed.py:", "graph.py:")),
     ("recording", ("_record",)),
-    ("engine (sim/engine.py, sim/schedule.py)", ("sim/engine.py", "sim/schedule.py")),
+    (
+        "engine (sim/engine.py and its parts, sim/schedule.py)",
+        (
+            "sim/engine.py",
+            "sim/quiet_ticks.py",
+            "sim/falls.py",
+            "sim/judging.py",
+            "sim/outside_changes.py",
+            "sim/schedule.py",
+        ),
+    ),
     ("movers' Python (goals, calls)", ("sim/movement/",)),
     ("numpy calls", ("numpy", "{method '", "{built-in method numpy")),
 )

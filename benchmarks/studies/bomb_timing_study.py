@@ -4,7 +4,7 @@
 
 For every `plant_begin` followed by the same player's `plant`, and every `defuse_start` followed
 by the same player's `defuse`, prints the duration on the round's clock (ticks at `tickRate`):
-the measurements behind the rules' plant and defuse constants (decoy_cli/sim/rules.py).
+the measurements behind the rules' plant and defuse constants (decoy_cli/sim/rules_config.py).
 """
 
 from __future__ import annotations

@@ -15,6 +15,10 @@ Each tick:
 Every loop is bounded by the round's time limit (plus the bomb timer after a plant), so a run
 always ends. The policy, the mover, the damage model and the recording are pluggable; the engine
 itself knows nothing of ESTA data (the replay is one policy among others).
+
+This module is the tick driver; beside it are the quiet ticks it crosses in one go
+(`quiet_ticks`), the damaging drops and their landings (`falls`), when the outcome is judged
+(`judging`) and the changes made to a round from outside its rules (`outside_changes`).
 """
 
 from __future__ import annotations
@@ -24,19 +28,23 @@ from typing import Protocol
 
 import numpy as np
 
-from decoy_cli.csgo import TICK_RATE, fall_damage
+from decoy_cli.csgo import TICK_RATE
 from decoy_cli.sim.decisions import REFUSED, Decision, Taken, take_decision
+from decoy_cli.sim.falls import Falls
+from decoy_cli.sim.judging import OutcomeJudge
 from decoy_cli.sim.movement import KinematicMover, MoveStep
 from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
-from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick, play_stretch
+from decoy_cli.sim.outside_changes import OutsideChanges
+from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick
+from decoy_cli.sim.quiet_ticks import play_quiet, quiet_until, stretch_end
 from decoy_cli.sim.recording import Recorder, Recording
 from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
 from decoy_cli.sim.schedule import NEVER
-from decoy_cli.sim.state import Agents, Bomb, BombStatus, RoundOutcome, SimEvent
+from decoy_cli.sim.state import Agents, Bomb, RoundOutcome, SimEvent
 from decoy_cli.waypoints.graph import WaypointGraph
-from decoy_cli.weapons import NO_WEAPON, max_speed_m_s
+from decoy_cli.weapons import max_speed_m_s
 
 
 class Policy(Protocol):
@@ -55,7 +63,7 @@ class CombatRunner(Protocol):
     def run(self, agents: Agents, tick: int, rng: np.random.Generator) -> list[SimEvent]: ...
 
 
-class Simulator:
+class Simulator(OutsideChanges):
     """One round; build it, then `run()` (or `step()` yourself, as the environment does).
 
     Rounds are normally opened with `decoy_cli.sim.setup.open_round`, which builds the mover,
@@ -88,7 +96,6 @@ class Simulator:
         self.rules = rules
         self.combat = combat
         self.combat_every_ticks = int(combat_every_ticks)
-        self.kills = kills  # False: a fall stops at 1 HP (deaths come from elsewhere)
         self.rng = np.random.default_rng(seed)
         self.tick = start_tick
         self.events: list[SimEvent] = []
@@ -100,8 +107,7 @@ class Simulator:
         """The round's arrays, their one owner: the agents' (the very arrays of `agents`), the
         decisions' (who waits, STOPs, wants to plant or defuse, is on a drop), the mover's and
         the graph's; compiled code takes them as one struct."""
-        self._falling = 0  # how many agents are on a damaging drop (`state.fall_m` > 0)
-        self._fall_killed = False  # a landing killed since the outcome was last judged
+        self.falls = Falls(self.state, kills)  # kills False: a fall stops at 1 HP
         self.decision_count = 0  # state.decisions.sum(), kept as they are made
         self._deciding = -1  # the agent whose policy is deciding right now
         self._player = policy if isinstance(policy, QuietPlayer) else None  # decides compiled
@@ -110,8 +116,7 @@ class Simulator:
         self.bomb: Bomb = rules.start(agents, bomb_carrier)
         self.recorder = Recorder(record_ticks, agents.count, self.events)
         self.recording = self.recorder.recording
-        self._alive_judged = b""  # who was alive (as bytes) when the outcome was judged
-        self._judged_as: tuple[BombStatus, bool] | None = None  # and the bomb and the clock
+        self.judge = OutcomeJudge(rules)
         # every loop is bounded: the round's time limit plus the bomb timer after a plant
         self._max_tick = start_tick + rules.config.round_ticks + rules.config.bomb_ticks + 1
         self._record()
@@ -142,7 +147,7 @@ class Simulator:
     ) -> None:
         """Decide, then move: the one driver of the round's ticks (`step`, `run`), from this
         tick through at most `end`. With a `player` (`run`'s `QuietPlayer`) and the next ticks
-        quiet, a stretch of them is handed to compiled code (`_play_quiet`, up to `limit`
+        quiet, a stretch of them is handed to compiled code (`quiet_ticks.play_quiet`, up to `limit`
         decisions in all); otherwise, or when that stretch ends with a tick half played, the
         next tick's decisions are made here and then its motion:
 
@@ -151,12 +156,12 @@ class Simulator:
         * glided with the quiet ticks after it (`_glide`) when `stop` says go on;
         * else (no `stop`: `step`) played whole with the rest of the tick (`_finish_tick`)."""
         decided = False
-        if player is not None and self.outcome is None and not self._falling:
-            horizon = self._stretch_end(self.tick, end)
+        if player is not None and self.outcome is None and not self.falls.count:
+            horizon = stretch_end(self, self.tick, end)
             if horizon > self.tick:
                 before = (self.tick, self.decision_count)
                 watched = self.rules.watched(self.agents, self.bomb)
-                decided = self._play_quiet(player, horizon, limit, watched) == StretchEnd.DECIDED
+                decided = play_quiet(self, player, horizon, limit, watched) == StretchEnd.DECIDED
                 if not decided and (self.tick, self.decision_count) != before:
                     return  # the caller asks its stopping rules again
         if not decided:
@@ -170,7 +175,7 @@ class Simulator:
             self._record()
             return
         if stop is not None and not stop():
-            last = min(self._quiet_until(self.tick - 1), end)
+            last = min(quiet_until(self, self.tick - 1), end)
             if last >= self.tick:
                 self._glide(last)
                 return
@@ -192,11 +197,11 @@ class Simulator:
         self._record()
 
     def _judge_and_announce(self) -> None:
-        """Judge the outcome (`_judge`); a "round_end" event the moment there is one."""
-        self._fall_killed = False
+        """Judge the outcome (`OutcomeJudge`); a "round_end" event the moment there is one."""
+        self.falls.killed = False
         if self.outcome is not None:
             return
-        self._judge()
+        self.outcome = self.judge.judge(self.tick, self.agents, self.bomb)
         if self.outcome is not None:
             self.events.append(
                 SimEvent(
@@ -247,99 +252,23 @@ class Simulator:
             self._advance(end, stop, player, limit)
         return self.recording
 
-    def _play_quiet(
-        self, player: QuietPlayer, horizon: int, limit: int, watched: np.ndarray
-    ) -> StretchEnd:
-        """Play from this tick through at most `horizon` with `player`'s choices in compiled
-        code (`quiet_play.play_stretch`), up to `limit` decisions in all, refilling its draws
-        as it needs them; take over what it played and return how it ended."""
-        choices = player.choices_for(self.agents.count)
-        while True:
-            left = limit - self.decision_count
-            played = play_stretch(
-                self.state, self.tick, horizon, left, watched, choices, self.agents.weapon,
-                self.rules.carrier(self.bomb), self.bomb.position,
-            )  # fmt: skip
-            self.note_quiet_play(played.tick, played.made, played.falls)
-            if played.status != StretchEnd.NEED_DRAWS:
-                break
-            player.refill()
-        if played.status == StretchEnd.AIRBORNE:
-            raise ValueError("an agent due for a decision is in the air")
-        return played.status
-
     def note_quiet_play(self, tick: int, made: int, falls: int) -> None:
         """Take over a quiet stretch played in compiled code (`quiet_play.play_quiet`, from
         `run` or the environment's steps): the tick it reached, the decisions it made and the
         damaging drops they started (the agents, the mover and a carried bomb it moved itself)."""
         self.tick = tick
         self.decision_count += made
-        self._falling += falls
+        self.falls.count += falls
 
     def quiet_horizon(self) -> int:
         """The last tick through which nothing but decisions and motion can happen from here
-        (`_stretch_end`), for a caller that plays quiet stretches itself, as `run` hands them to
-        a `quiet_play.QuietPlayer` (the environment's steps, `env_step`); the tick itself when the
-        next is not quiet, the round is done, an agent is on a damaging drop or the mover is not
-        kinematic."""
-        if self.done or self._falling or not isinstance(self.mover, KinematicMover):
+        (`quiet_ticks.stretch_end`), for a caller that plays quiet stretches itself, as `run`
+        hands them to a `quiet_play.QuietPlayer` (the environment's steps, `env_step`); the tick
+        itself when the next is not quiet, the round is done, an agent is on a damaging drop or
+        the mover is not kinematic."""
+        if self.done or self.falls.count or not isinstance(self.mover, KinematicMover):
             return self.tick
-        return self._stretch_end(self.tick, self._max_tick)
-
-    def relocate(self, agent: int, node: int) -> None:
-        """Put an agent on a waypoint directly (a plan across a graph gap); counted as an event.
-
-        Inside the agent's own decision the decision that follows says what it does next;
-        from anywhere else its walk or STOP ends and it is asked again at the next tick."""
-        self.mover.place(agent, self.graph.positions[node])
-        self.agents.position[agent] = self.graph.positions[node]
-        self.agents.node[agent] = node
-        self.state.goal_node[agent] = -1
-        self._set_fall(agent, 0.0)
-        if agent != self._deciding:
-            self.mover.clear_goal(agent)
-            self.state.hold_until[agent] = 0
-            self.state.waiting[agent] = bool(self.agents.alive[agent])
-        self.events.append(SimEvent(self.tick, "relocate", agent, data={"node": int(node)}))
-
-    def hand_bomb(self, agent: int) -> None:
-        """Give the bomb to an alive T from outside the rules (a replay following the data's
-        carrier); see `BombRules.hand_over`. Nothing changes hands after the round's end."""
-        if self.outcome is None:
-            self.events += self.rules.hand_over(self.tick, self.agents, self.bomb, agent)
-
-    def drop_bomb(self, position: np.ndarray) -> None:
-        """The carrier lets the bomb go at `position` (a replay following the data's drop); see
-        `BombRules.drop`. Nothing happens after the round's end."""
-        if self.outcome is None:
-            self.events += self.rules.drop(self.tick, self.agents, self.bomb, position)
-
-    def kill(self, agent: int, reason: str) -> None:
-        """Kill an agent from outside the combat step (a scripted death in a replay)."""
-        if self.agents.alive[agent]:
-            self.agents.alive[agent] = False
-            self.agents.hp[agent] = 0
-            self.events.append(SimEvent(self.tick, "death", agent, data={"reason": reason}))
-            self._kill(agent)
-        self._set_fall(agent, 0.0)
-
-    def equip(
-        self, agent: int, *, weapon: str | None = None, has_defuser: bool | None = None
-    ) -> None:
-        """Change what an agent holds from outside the round (a replay following the data): the
-        weapon in hand, whose full speed then caps its moves (`MoverBase.set_max_speed`), and
-        the defuse kit; None leaves either as it is."""
-        if weapon is not None:
-            self.agents.weapon[agent] = weapon
-            self.mover.set_max_speed(agent, max_speed_m_s(str(weapon)))
-        if has_defuser is not None:
-            self.agents.has_defuser[agent] = has_defuser
-
-    def disarm(self, agent: int) -> None:
-        """Take the weapon out of an agent's hands (a replayed player the data shows dead, a
-        target until removed): it shoots nobody. The mover's cap on it stays; a decision with no
-        cap of its own takes the empty hand's speed, as any takes its weapon's."""
-        self.agents.weapon[agent] = NO_WEAPON
+        return stretch_end(self, self.tick, self._max_tick)
 
     # ---- internals ----------------------------------------------------------------------------
 
@@ -351,8 +280,15 @@ class Simulator:
         """Take over what the mover did (positions, yaw) and note the last tick's arrivals,
         stuck agents and teleports; returns the (N,) mask of the agents that moved then."""
         take_motion(self.state.kernel)
-        if moved.happened & ARRIVAL and self._falling:
-            self._land(moved.arrived)
+        if moved.happened & ARRIVAL and self.falls.count:
+            self.falls.land(
+                moved.arrived,
+                self.tick,
+                self.agents,
+                self.events,
+                self.outcome is not None,
+                self.kill,
+            )
         if moved.happened & STUCK:
             for agent in np.flatnonzero(moved.stuck).tolist():
                 self.events.append(SimEvent(self.tick, "stuck", agent))
@@ -361,41 +297,12 @@ class Simulator:
                 self.events.append(SimEvent(self.tick, "teleport", agent))
         return moved.moving
 
-    def _quiet_until(self, tick: int) -> int:
-        """The last tick through which nothing but motion can happen after `tick`, if no agent
-        arrives before: no decision falls due, and `_stretch_end`. Equal to `tick` when the
-        tick after it is not quiet. Asked once the decisions of the tick after `tick` are made
-        (they are the only part of that tick already played)."""
-        due = self.state.next_due(tick)
-        if due == tick + 1:
-            return tick
-        return max(tick, min(self._stretch_end(tick, self._max_tick), due - 1))
-
-    def _stretch_end(self, tick: int, end: int) -> int:
-        """The last tick, at most `end`, through which nothing but decisions and motion can
-        happen after `tick`: no combat step, no recorded tick, the bomb rules have nothing to
-        do and the outcome cannot change (the clock, the detonation), as long as no agent the
-        rules watch decides (`BombRules.watched`); `tick` when the tick after it is not quiet."""
-        alive = self.agents.alive
-        if self.outcome is not None or alive.tobytes() != self._alive_judged:
-            return tick  # judged yet? (not after a kill from outside)
-        state = self.state
-        rules = self.rules.quiet_until(
-            tick, self.agents, self.bomb, state.wants_plant, state.wants_defuse,
-            self.mover.is_standing,
-        )  # fmt: skip
-        last = min(end, self._max_tick - 1, rules)
-        if self.combat is not None:
-            last = min(last, (tick // self.combat_every_ticks + 1) * self.combat_every_ticks - 1)
-        last = min(last, self.recorder.next_tick - 1)
-        return max(tick, last)
-
     def _glide(self, last: int) -> None:
         """Play the motion of this tick (its decisions are made) and of the quiet ticks after it
-        up to `last` (`_quiet_until`) in one mover call; it stops after the first tick with an
-        arrival, a stuck agent or a teleport, which is then noted as `step` notes it. The bomb
-        rules have nothing to do on quiet ticks but follow the carrier, so stepping them once,
-        at the last tick, is the same as stepping them at every tick."""
+        up to `last` (`quiet_ticks.quiet_until`) in one mover call; it stops after the first tick
+        with an arrival, a stuck agent or a teleport, which is then noted as `step` notes it. The
+        bomb rules have nothing to do on quiet ticks but follow the carrier, so stepping them
+        once, at the last tick, is the same as stepping them at every tick."""
         ticks, moved = self.mover.glide(last - self.tick + 1)
         self.tick += ticks - 1
         moving = self._moved(moved)
@@ -403,56 +310,8 @@ class Simulator:
         self.events += self.rules.step(
             self.tick, self.agents, self.bomb, state.wants_plant, state.wants_defuse, moving
         )
-        if self._fall_killed:  # at the glide's last tick
+        if self.falls.killed:  # at the glide's last tick
             self._judge_and_announce()
-
-    def _set_fall(self, agent: int, depth: float) -> None:
-        """Note the depth of the damaging drop an agent is on (0: none), keeping the count."""
-        fall_m = self.state.fall_m
-        self._falling += int(depth > 0) - int(fall_m[agent] > 0)
-        fall_m[agent] = depth
-
-    def _land(self, arrived: np.ndarray) -> None:
-        """Fall damage for the agents that arrived at the end of a drop deeper than the safe
-        fall (`csgo.fall_damage`); a fall that takes the last health kills, unless nothing in
-        the simulation kills (`kills`: deaths follow the data), where it leaves 1 HP. Before the
-        round's end only: afterwards nothing changes health."""
-        for agent in np.flatnonzero(arrived).tolist():
-            height = float(self.state.fall_m[agent])
-            if not height:
-                continue
-            self._set_fall(agent, 0.0)
-            damage = fall_damage(height)
-            if self.outcome is not None or not damage or not self.agents.alive[agent]:
-                continue
-            left = max(0 if self.kills else 1, int(self.agents.hp[agent]) - damage)
-            self.agents.hp[agent] = left
-            data = {"damage": damage, "height_m": round(height, 3)}
-            self.events.append(SimEvent(self.tick, "fall_damage", agent, data=data))
-            if left == 0:
-                self.kill(agent, "fall")
-                self._fall_killed = True
-
-    def _judge(self) -> None:
-        """The outcome at this tick. It depends only on who is alive, the bomb's status and
-        whether the round clock has run out, so it is asked of the rules only when one of these
-        changed since the last judgement."""
-        clock_out = self.tick >= self.rules.config.round_ticks
-        alive = self.agents.alive.tobytes()
-        if alive == self._alive_judged and self._judged_as == (self.bomb.status, clock_out):
-            return
-        self.outcome = self.rules.outcome(self.tick, self.agents, self.bomb)
-        self._alive_judged = alive
-        self._judged_as = (self.bomb.status, clock_out)
-
-    def _kill(self, agent: int) -> None:
-        self.mover.remove(agent)
-        state = self.state
-        state.waiting[agent] = False
-        state.wants_plant[agent] = False
-        state.wants_defuse[agent] = False
-        if self.outcome is None:  # after the end the bomb stays as the round left it
-            self.events += self.rules.on_death(self.tick, agent, self.agents, self.bomb)
 
     @property
     def decision_due(self) -> bool:
@@ -475,7 +334,7 @@ class Simulator:
         if self._player is not None and len(due):
             made, falls = decide_tick(state, self.tick, self._player, agents.weapon)
             self.decision_count += made
-            self._falling += falls
+            self.falls.count += falls
             return
         for agent in due.tolist():
             state.hold_until[agent] = 0
@@ -491,7 +350,7 @@ class Simulator:
                 self.state.kernel, agent, decision.action, speed, top,
                 max(1, int(decision.hold_ticks)), decision.plant, decision.defuse, self.tick,
             )  # fmt: skip
-            self._falling += falls
+            self.falls.count += falls
             if taken == Taken.NO_EDGE:  # held as a STOP, and recorded
                 data = {"action": decision.action}
                 self.events.append(SimEvent(self.tick, "invalid_action", agent, data=data))

@@ -1,7 +1,7 @@
 """Quiet stretches played in compiled code: decisions and kinematic motion, event to event.
 
 A quiet stretch is a run of ticks on which nothing but decisions and motion can happen: up to
-the next combat step, recorded tick, bomb-rule tick or the end (`Simulator._stretch_end`). A
+the next combat step, recorded tick, bomb-rule tick or the end (`quiet_ticks.stretch_end`). A
 policy whose choices need no Python per decision (`QuietPlayer`) plays it in one compiled loop
 (`play_quiet`): at each tick the due agents decide, then the motion glides to the next arrival
 or decision and a carried bomb follows its carrier, exactly as `Simulator.run` plays it tick by
