@@ -64,7 +64,8 @@ MOVER_HELP = (
 
 WORLD_HELP = (
     "The world to replay on without --graph: CS:GO's (csgo), or CS2's (cs2, shipped for "
-    "de_dust2: movement closer to CS2 data, the fight calibrated on CS:GO's; docs/cs2.md)."
+    "de_dust2: movement closer to CS2 data, the real winner less often with the fight "
+    "deciding; docs/cs2.md)."
 )
 
 
