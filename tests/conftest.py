@@ -13,8 +13,8 @@ from decoy_cli.cli import app
 SAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sample"
 
 # One thread per torch (OpenMP) runtime: the suite runs in `-n 2` workers on two cores, where a
-# torch that spins a thread per core in each worker waits on the other worker's tests (a 3 s
-# test took a minute). Read when torch first loads, so set before any test imports it.
+# torch that spins a thread per core in each worker waits on the other worker's tests. Read
+# when torch first loads, so set before any test imports it.
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 # `decoy evaluate` runs its rounds in the test's own process unless a test asks for worker
 # processes (`--workers N`, which the tests of the pool, its crashes and Ctrl-C give): starting
