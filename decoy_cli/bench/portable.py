@@ -4,12 +4,12 @@ a baseline that predates them.
 
 `decoy bench --baseline REF` runs each section in a fresh process of either code tree. The
 sections here use only what every version of the benchmark offers (`speed_table` and `NeverHits`
-of `decoy_cli.bench.simspeed`, `step_costs` of `decoy_cli.bench.combat`, `metric_throughput`
-and `walk` of `decoy_cli.bench.metrics`, `dtw` and `frechet` of `decoy_cli.metrics`,
-`DecoyParallelEnv`, `load_damage_model`), so the baseline's process loads this file by path
-(`baseline.DRIVER`) and its imports resolve to the baseline's package: one measuring code, two
-simulators. Their sizes come from the settings (`PortableConfig`, made from the current code's
-`BenchConfig`), so both sides measure the same amount of work.
+of `decoy_cli.bench.simspeed`, `step_costs` and `summarize_ms` of `decoy_cli.bench.combat`,
+`metric_throughput` and `walk` of `decoy_cli.bench.metrics`, `dtw` and `frechet` of
+`decoy_cli.metrics`, `DecoyParallelEnv`, `load_damage_model`), so the baseline's process loads
+this file by path (`baseline.DRIVER`) and its imports resolve to the baseline's package: one
+measuring code, two simulators. Their sizes come from the settings (`PortableConfig`, made from
+the current code's `BenchConfig`), so both sides measure the same amount of work.
 
 * `kinematic`: the Table 1 protocol at 10 agents with the kinematic mover, whose engine plays
   event by event (`Simulator.run`);
@@ -279,6 +279,7 @@ def metrics_section(config: PortableConfig) -> MetricsResult:
 def kernel_times(repeats: int, seed: int = 0) -> list[KernelRow]:
     """Wall times of `dtw`, `frechet` and `frechet` on x-y alone, each on one pair of random
     walks of every `KERNEL_FRAMES` length, after a call that compiles or loads the kernel."""
+    from decoy_cli.bench.combat import summarize_ms
     from decoy_cli.bench.metrics import walk
     from decoy_cli.metrics import dtw, frechet
 
@@ -286,26 +287,23 @@ def kernel_times(repeats: int, seed: int = 0) -> list[KernelRow]:
     rows: list[KernelRow] = []
     for frames in KERNEL_FRAMES:
         a, b = walk(rng, frames), walk(rng, frames)
-        for kernel, first, second in (
-            ("dtw", a, b),
-            ("frechet", a, b),
-            ("frechet x-y", a[:, :2], b[:, :2]),
+        for kernel, call, first, second in (
+            ("dtw", dtw, a, b),
+            ("frechet", frechet, a, b),
+            ("frechet x-y", frechet, a[:, :2], b[:, :2]),
         ):
-            call = dtw if kernel == "dtw" else frechet
             call(first, second)
             times = []
             for _ in range(repeats):
                 started = time.perf_counter()
                 call(first, second)
-                times.append((time.perf_counter() - started) * 1e3)
+                times.append(time.perf_counter() - started)
             rows.append(
                 {
                     "kernel": kernel,
                     "size": f"{frames}x{frames}",
                     "calls": repeats,
-                    "median_ms": float(np.median(times)),
-                    "min_ms": min(times),
-                    "max_ms": max(times),
+                    **summarize_ms(times),
                 }
             )
     return rows

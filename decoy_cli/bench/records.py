@@ -193,15 +193,13 @@ class ReplayResult(_ReplayFigures, Measured):
     options: ReplaySettings
 
 
-class KernelRow(TypedDict):
-    """One distance kernel on one pair of curves (`portable.kernel_times`)."""
+class KernelRow(StepTimes):
+    """One distance kernel on one pair of curves (`portable.kernel_times`), its wall times as
+    the combat step's parts'."""
 
     kernel: str
     size: str
     calls: int
-    median_ms: float
-    min_ms: float
-    max_ms: float
 
 
 class _MetricsFigures(TypedDict, total=False):
