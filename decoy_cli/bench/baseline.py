@@ -258,9 +258,7 @@ def headlines(section: str, result: JsonObject) -> dict[str, float]:
     if section == "metrics":
         figures = {"pairs/s": result.get("pairs_per_s")}
         for row in objects_in(result.get("kernels")):
-            median = row.get("median_ms")
-            rate = 1e3 / median if isinstance(median, int | float) and median else None
-            figures[f"calls/s, {row.get('kernel')} {row.get('size')}"] = rate
+            figures[f"calls/s, {row.get('kernel')} {row.get('size')}"] = _per_s(row)
     elif section == "reader" and result.get("files"):
         figures = {"MB/s (JSON)": result.get("mb_per_s_decompressed")}
     elif section == "awpy":
@@ -279,10 +277,15 @@ def headlines(section: str, result: JsonObject) -> dict[str, float]:
         figures = {f"ticks/s, {row.get('agents')} agents": row.get("ticks_per_s") for row in rows}
     elif section == "combat_step":
         for row in objects_in(result.get("rows")):
-            median = object_at(object_at(row, "parts"), "step").get("median_ms")
-            rate = 1e3 / median if isinstance(median, int | float) and median else None
-            figures[f"steps/s, {row.get('agents')} agents, {row.get('layout')}"] = rate
+            step = object_at(object_at(row, "parts"), "step")
+            figures[f"steps/s, {row.get('agents')} agents, {row.get('layout')}"] = _per_s(step)
     return {k: float(v) for k, v in figures.items() if isinstance(v, int | float) and v > 0}
+
+
+def _per_s(times: JsonObject) -> float | None:
+    """The rate of a median time in milliseconds (None without one, or at zero)."""
+    median = times.get("median_ms")
+    return 1e3 / median if isinstance(median, int | float) and median else None
 
 
 @dataclass(frozen=True)
