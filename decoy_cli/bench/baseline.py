@@ -59,8 +59,6 @@ import decoy_cli
 from decoy_cli.bench import BenchConfig, check_damage_model, find_data, run_section
 from pathlib import Path
 run = args["run"]
-config = BenchConfig.create(**run["switches"])
-status = check_damage_model(run["switches"]["models"])
 data = find_data(Path(args["data"])) if args["data"] else None
 try:
     if args["portable"]:  # the current tree's file, run on this tree's package
@@ -70,7 +68,9 @@ try:
         spec.loader.exec_module(module)
         section = module.PORTABLE_SECTIONS[args["section"]]
         result = section(run["portable"])
-    else:
+    else:  # the tree's own section, its model checked as its `decoy bench` would
+        config = BenchConfig.create(**run["switches"])
+        status = check_damage_model(run["switches"]["models"])
         fields = {field.name for field in dataclasses.fields(config)}
         lacking = sorted(set(run["sizes"]) - fields)
         if lacking:
