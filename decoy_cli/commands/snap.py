@@ -33,7 +33,7 @@ from decoy_cli.replay.study import (
     study_round,
 )
 from decoy_cli.sim.setup import RoundSetup
-from decoy_cli.waypoints.build import GameWorld, builtin_graph, canonical_map
+from decoy_cli.waypoints.build import GameWorld, canonical_map, chosen_graph
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.world.navmesh import load_navmesh
 
@@ -94,9 +94,7 @@ def snap(
     console = make_console()
     map_id = canonical_map(map_name)
     path = Path(target)
-    if graph_file is not None and world != "csgo":
-        raise DecoyError("--graph brings its own world: leave out --world")
-    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id, world)
+    graph = chosen_graph(map_id, world, graph_file)
     if path.exists():
         for option, given in (
             ("--plot", plot is not None),

@@ -25,8 +25,7 @@ from decoy_cli.metrics.players import player_metrics
 from decoy_cli.replay.output import animate, plot_paths, write_replay
 from decoy_cli.replay.replayer import ReplayOptions, ReplayResult, replay_round
 from decoy_cli.sim.setup import SIGHT_WITHOUT_SHOOTING
-from decoy_cli.waypoints.build import GameWorld, builtin_graph, canonical_map
-from decoy_cli.waypoints.graph import WaypointGraph
+from decoy_cli.waypoints.build import GameWorld, canonical_map, chosen_graph
 from decoy_cli.world.navmesh import BUILTIN_MAP, load_navmesh
 from decoy_cli.world.occlusion import read_sight_scene
 
@@ -69,9 +68,7 @@ def replay_address(
         map_name = canonical_map(map_name)  # an unknown --map fails before reading the file
     round_ = load_round(address, implausible=options.implausible, rate=options.rate)
     map_id = round_map(address, round_.map_name, map_name)
-    if graph_file is not None and world != "csgo":
-        raise DecoyError("--graph brings its own world: leave out --world")
-    graph = WaypointGraph.load(graph_file) if graph_file else builtin_graph(map_id, world)
+    graph = chosen_graph(map_id, world, graph_file)
     graph_map = str(graph.meta.get("map", ""))
     if graph_map and graph_map != map_id:
         raise DecoyError(f"{address}: a {map_id} round, but the graph {graph_file} is {graph_map}")

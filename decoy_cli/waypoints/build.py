@@ -157,6 +157,17 @@ def builtin_graph(map_name: str = BUILTIN_MAP, world: GameWorld = "csgo") -> Way
     return WaypointGraph.load(folder / CS2_GRAPH_FILE)
 
 
+def chosen_graph(map_name: str, world: GameWorld, graph_file: Path | None) -> WaypointGraph:
+    """The graph a command replays on: the user's `--graph` file, which brings its own world,
+    else the map's shipped graph on `world`; a GraphError when both a file and CS2's world
+    are asked for."""
+    if graph_file is None:
+        return builtin_graph(map_name, world)
+    if world != "csgo":
+        raise GraphError("--graph brings its own world: leave out --world")
+    return WaypointGraph.load(graph_file)
+
+
 def graph_world(graph: WaypointGraph) -> World:
     """The world a graph was built on: the one it carries (a CS2 nav world), else the built-in
     nav world of its map with the map's shipped patches, or with the patches recorded in the
