@@ -37,7 +37,7 @@ from decoy_cli.sim.movement.base import MoverBase
 from decoy_cli.sim.movement.interface import ARRIVAL, STUCK, TELEPORT
 from decoy_cli.sim.outside_changes import OutsideChanges
 from decoy_cli.sim.quiet_play import QuietPlayer, StretchEnd, decide_tick
-from decoy_cli.sim.quiet_ticks import play_quiet, quiet_until, stretch_end
+from decoy_cli.sim.quiet_ticks import play_stretches, quiet_until, stretch_end
 from decoy_cli.sim.recording import Recorder, Recording
 from decoy_cli.sim.round_state import RoundState, take_motion
 from decoy_cli.sim.rules import BombRules
@@ -147,9 +147,9 @@ class Simulator(OutsideChanges):
     ) -> None:
         """Decide, then move: the one driver of the round's ticks (`step`, `run`), from this
         tick through at most `end`. With a `player` (`run`'s `QuietPlayer`) and the next ticks
-        quiet, a stretch of them is handed to compiled code (`quiet_ticks.play_quiet`, up to `limit`
-        decisions in all); otherwise, or when that stretch ends with a tick half played, the
-        next tick's decisions are made here and then its motion:
+        quiet, a stretch of them is handed to compiled code (`quiet_ticks.play_stretches`, up
+        to `limit` decisions in all); otherwise, or when that stretch ends with a tick half
+        played, the next tick's decisions are made here and then its motion:
 
         * after the outcome, with that of the ticks after it on which no decision falls due and
           nothing is recorded, in one mover call (the rules, combat and the outcome stay);
@@ -161,7 +161,9 @@ class Simulator(OutsideChanges):
             if horizon > self.tick:
                 before = (self.tick, self.decision_count)
                 watched = self.rules.watched(self.agents, self.bomb)
-                decided = play_quiet(self, player, horizon, limit, watched) == StretchEnd.DECIDED
+                decided = (
+                    play_stretches(self, player, horizon, limit, watched) == StretchEnd.DECIDED
+                )
                 if not decided and (self.tick, self.decision_count) != before:
                     return  # the caller asks its stopping rules again
         if not decided:

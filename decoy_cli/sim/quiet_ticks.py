@@ -1,6 +1,6 @@
 """Quiet ticks: the ticks of a round on which nothing but decisions and motion can happen, which
 the engine crosses in one go (`Simulator.run`, its glides) or hands to compiled code with a
-`quiet_play.QuietPlayer` (`play_quiet`). Asking how far they reach (`stretch_end`,
+`quiet_play.QuietPlayer` (`play_stretches`). Asking how far they reach (`stretch_end`,
 `quiet_until`) is what makes crossing them tick for tick what stepping every tick gives."""
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def quiet_until(sim: Simulator, tick: int) -> int:
     return max(tick, min(stretch_end(sim, tick, sim._max_tick), due - 1))
 
 
-def play_quiet(
+def play_stretches(
     sim: Simulator, player: QuietPlayer, horizon: int, limit: int, watched: np.ndarray
 ) -> StretchEnd:
     """Play from the round's tick through at most `horizon` with `player`'s choices in compiled
