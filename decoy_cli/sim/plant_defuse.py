@@ -76,10 +76,7 @@ def defuse_tick(
 ) -> list[SimEvent]:
     """One tick of the defuse of the planted bomb (mutates `bomb`): the defuser's goes on,
     completes or stops, and a candidate starts one when nobody defuses."""
-    offset = agents.position - bomb.position
-    in_range = (np.hypot(offset[:, 0], offset[:, 1]) <= cfg.defuse_range_m) & (
-        np.abs(offset[:, 2]) <= cfg.defuse_vertical_m
-    )
+    in_range = within(agents.position, bomb.position, cfg.defuse_range_m, cfg.defuse_vertical_m)
     events = []
     defuser = bomb.defuser
     if defuser >= 0:
@@ -139,6 +136,17 @@ def abort_defuse(tick: int, bomb: Bomb, reason: str) -> SimEvent:
     bomb.defuser = -1
     bomb.defuse_ticks = 0
     return SimEvent(tick, "defuse_aborted", defuser, data={"reason": reason})
+
+
+def within(
+    positions: np.ndarray, point: np.ndarray, horizontal_m: float, vertical_m: float
+) -> np.ndarray:
+    """(N,) bool: which of `positions` (N, 3) lie within `horizontal_m` of `point` horizontally
+    and `vertical_m` vertically: the reach of a defuse, and of a bomb pickup (`BombRules`)."""
+    offset = positions - point
+    return (np.hypot(offset[:, 0], offset[:, 1]) <= horizontal_m) & (
+        np.abs(offset[:, 2]) <= vertical_m
+    )
 
 
 def _first_true(*checks: tuple[str, bool]) -> str:

@@ -24,7 +24,14 @@ import numpy as np
 
 from decoy_cli.compiled import njit_cached
 from decoy_cli.csgo import seconds_to_ticks
-from decoy_cli.sim.plant_defuse import abort_defuse, abort_plant, defuse_tick, explode, plant_tick
+from decoy_cli.sim.plant_defuse import (
+    abort_defuse,
+    abort_plant,
+    defuse_tick,
+    explode,
+    plant_tick,
+    within,
+)
 from decoy_cli.sim.round_end import round_outcome
 from decoy_cli.sim.rules_config import RulesConfig
 from decoy_cli.sim.sites import (
@@ -248,10 +255,7 @@ class BombRules:
 
     def _pickup(self, tick: int, agents: Agents, bomb: Bomb) -> list[SimEvent]:
         cfg = self.config
-        offset = agents.position - bomb.position
-        near = (np.hypot(offset[:, 0], offset[:, 1]) <= cfg.pickup_range_m) & (
-            np.abs(offset[:, 2]) <= cfg.pickup_vertical_m
-        )
+        near = within(agents.position, bomb.position, cfg.pickup_range_m, cfg.pickup_vertical_m)
         takers = np.nonzero(agents.alive & (agents.side == "T") & near)[0]
         if not len(takers):
             return []
