@@ -186,10 +186,8 @@ class Simulator(OutsideChanges):
     def _finish_tick(self, moving: np.ndarray) -> None:
         """The rest of a tick after the decisions and the motion: the bomb rules, the combat
         step, the outcome and the recording."""
-        agents, state = self.agents, self.state
-        self.events += self.rules.step(
-            self.tick, agents, self.bomb, state.wants_plant, state.wants_defuse, moving
-        )
+        agents = self.agents
+        self._step_rules(moving)
         if self.combat is not None and self.tick % self.combat_every_ticks == 0:
             alive_before = agents.alive.copy()
             self.events += self.combat.run(agents, self.tick, self.rng)
@@ -307,13 +305,16 @@ class Simulator(OutsideChanges):
         once, at the last tick, is the same as stepping them at every tick."""
         ticks, moved = self.mover.glide(last - self.tick + 1)
         self.tick += ticks - 1
-        moving = self._moved(moved)
+        self._step_rules(self._moved(moved))
+        if self.falls.killed:  # at the glide's last tick
+            self._judge_and_announce()
+
+    def _step_rules(self, moving: np.ndarray) -> None:
+        """The bomb rules' tick (`BombRules.step`), with the agents that `moving` says moved."""
         state = self.state
         self.events += self.rules.step(
             self.tick, self.agents, self.bomb, state.wants_plant, state.wants_defuse, moving
         )
-        if self.falls.killed:  # at the glide's last tick
-            self._judge_and_announce()
 
     @property
     def decision_due(self) -> bool:
