@@ -320,7 +320,10 @@ def test_build_waypoints_nav_writes_a_graph_with_its_world(tmp_path: Path) -> No
     assert result.exit_code == 0, result.output
     assert "CS2 de_dust2 nav mesh" in result.output
     assert "1 ladder links but no ladder positions" in result.output
-    assert WaypointGraph.load(out).world_triangles is not None
+    graph = WaypointGraph.load(out)
+    assert graph.world_triangles is not None
+    climbs = len(np.asarray(cs2_world(path, "de_dust2").meta["climbs"]))
+    assert f"{graph.meta['climbs_joined']} of the nav's {climbs} joined" in result.output
 
 
 @pytest.mark.parametrize(

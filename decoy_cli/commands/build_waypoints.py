@@ -242,6 +242,9 @@ def build_waypoints(
         table.add_row(
             "manual", f"{stats.manual_added} added, {stats.manual_dropped} unlinkable", ""
         )
+    if result.climbs_joined is not None:
+        given = len(np.asarray(world.meta["climbs"]))
+        table.add_row("climbs", f"{result.climbs_joined:,} of the nav's {given:,} joined", "")
     table.add_row(
         "graph",
         f"{stats.nodes:,} nodes, {sum(stats.edges.values()):,} edges: "

@@ -97,7 +97,16 @@ def build_graph(
     nav = load_navmesh(map_name)
     seed_points = default_seeds(nav) if seeds is None else np.asarray(seeds, dtype=np.float64)
     with PhysicsWorld(world) as physics:
-        result = build_lattice(physics, seed_points, params, manual, progress, nav.ladders)
+        climbs = world.meta.get("climbs")
+        result = build_lattice(
+            physics,
+            seed_points,
+            params,
+            manual,
+            progress,
+            nav.ladders,
+            climbs if isinstance(climbs, np.ndarray) else None,
+        )
     places = nav.places
     place_index = {name: k for k, name in enumerate(places)}
     area = nav.area_of(result.positions)
@@ -134,6 +143,7 @@ def build_graph(
             "seeds_m": np.round(seed_points, 6).tolist(),
             "manual_waypoints": 0 if manual is None else len(manual),
             **({"patches": world.meta["patch_boxes"]} if "patch_boxes" in world.meta else {}),
+            **({"climbs_joined": result.climbs_joined} if result.climbs_joined is not None else {}),
             "stats": stats,
         },
         world_triangles=world.triangles if carried else None,

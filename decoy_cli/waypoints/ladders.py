@@ -107,7 +107,7 @@ def add_ladder_edges(
             continue
         ways = [(bottom, top), (top, bottom)]
         new = {
-            (s, t): _free_direction(used, s, positions[t] - positions[s])
+            (s, t): free_direction(used, s, positions[t] - positions[s])
             for s, t in ways
             if (s, t) not in joining
         }
@@ -142,7 +142,7 @@ def _end_node(
     return int(np.argmin(distance))
 
 
-def _free_direction(used: set[tuple[int, int]], node: int, delta: np.ndarray) -> int:
+def free_direction(used: set[tuple[int, int]], node: int, delta: np.ndarray) -> int:
     """The compass direction (0 = N = +y, clockwise) nearest `delta`'s that `node` has no edge
     in, -1 if it has all eight."""
     heading = math.degrees(math.atan2(delta[0], delta[1])) % 360.0

@@ -31,7 +31,8 @@
 
 **Ladders** (`ladders.py`): the map's ladders seed the flood beside their ends, and after the
 verification and the manual waypoints the nodes at a ladder's two ends are joined by a LADDER
-edge each way.
+edge each way. **Climbs** (`climbs.py`): a CS2 nav's steps of more than a step height that the
+graph goes far round get an edge of their own.
 
 Then the graph is pruned to its largest strongly connected component (so an agent can always get
 back), manual waypoints are merged in, each node gets its nav place, and nodes are numbered in a
@@ -48,6 +49,7 @@ import time
 import numpy as np
 
 from decoy_cli.errors import GraphError
+from decoy_cli.waypoints.climbs import add_climb_edges
 from decoy_cli.waypoints.flood import Lattice, flood
 from decoy_cli.waypoints.graph import DIRECTION_VECTORS, EdgeKind
 from decoy_cli.waypoints.ladders import add_ladder_edges, ladder_seeds
@@ -89,9 +91,11 @@ def build_lattice(
     manual: np.ndarray | None = None,
     progress: Progress = lambda stage, done, total: None,
     ladders_u: np.ndarray | None = None,
+    climbs_m: np.ndarray | None = None,
 ) -> LatticeResult:
     """Run the three stages, prune, merge manual waypoints; see the module docstring. `ladders_u`:
-    the map's ladders, (L, 6) top and bottom x y z in Hammer units (`NavMesh.ladders`)."""
+    the map's ladders, (L, 6) top and bottom x y z in Hammer units (`NavMesh.ladders`);
+    `climbs_m`: the world's climbs, (C, 6) start and end in metres (`climbs.py`)."""
     stats = BuildStats()
     seeds = np.asarray(seeds, dtype=np.float64).reshape(-1, 3)
     if len(seeds) == 0:
@@ -169,6 +173,9 @@ def build_lattice(
     if manual is not None and len(manual):
         positions, edge_arr = merge_manual(physics, positions, edge_arr, manual, params, stats)
     edge_arr, stats.ladders_joined = add_ladder_edges(positions, edge_arr, ladders, params)
+    climbs_joined = None
+    if climbs_m is not None:
+        edge_arr, climbs_joined = add_climb_edges(positions, edge_arr, climbs_m, params)
     positions, edge_arr, pruned = prune(positions, edge_arr, stats)
     positions, edge_arr = canonical_order(positions, edge_arr)
     stats.seconds["pruning"] = time.perf_counter() - clock
@@ -184,4 +191,5 @@ def build_lattice(
         removed_kinds=removed[:, 2].astype(np.uint8),
         pruned_positions=pruned,
         stats=stats,
+        climbs_joined=climbs_joined,
     )

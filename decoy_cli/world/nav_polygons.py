@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from decoy_cli.csgo import HAMMER_TO_M
+from decoy_cli.world.nav_climbs import nav_climbs
 from decoy_cli.world.nav_geometry import (
     BRIDGE_MAX_GAP_U,
     JUMP_U,
@@ -73,7 +74,12 @@ def polygon_world(nav: PolygonNav, map_name: str) -> World:
         triangles=polygon_triangles(nav) * HAMMER_TO_M,
         name=map_name,
         source=f"CS2 {map_name} nav mesh ({Path(nav.source).name}, nav version {nav.version})",
-        meta={"kind": POLYGON_NAV_KIND, "areas": nav.num_areas, "ladder_links": nav.ladder_links},
+        meta={
+            "kind": POLYGON_NAV_KIND,
+            "areas": nav.num_areas,
+            "ladder_links": nav.ladder_links,
+            "climbs": nav_climbs(nav),
+        },
     )
 
 
