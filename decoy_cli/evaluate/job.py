@@ -144,7 +144,7 @@ def run_graph(settings: EvalSettings) -> WaypointGraph:
     from decoy_cli.waypoints.build import builtin_graph
 
     if not settings.graph:
-        return builtin_graph(settings.map_name, "cs2" if settings.world == "cs2" else "csgo")
+        return builtin_graph(settings.map_name, settings.shipped_world)
     if content_sha256(Path(settings.graph)) != settings.graph_sha:
         raise DecoyError(f"{settings.graph}: the graph file changed while the evaluation ran")
     return WaypointGraph.load(settings.graph)

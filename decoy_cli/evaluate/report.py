@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from decoy_cli.esta.frame_rate import describe_rates
 from decoy_cli.evaluate.bomb_report import bomb_section
@@ -36,6 +37,9 @@ from decoy_cli.metrics import (
 )
 from decoy_cli.metrics.bootstrap import MIN_ROUNDS, RESAMPLES
 from decoy_cli.metrics.fastdtw_metric import FASTDTW_RTOL
+
+if TYPE_CHECKING:
+    from decoy_cli.waypoints.build import GameWorld
 
 
 @dataclass(frozen=True)
@@ -92,7 +96,7 @@ def model_lines(settings: EvalSettings) -> dict[str, str]:
 
 def world_line(settings: EvalSettings) -> str:
     """The world the rounds replay on, in words, and why that one."""
-    source = _world_source(settings.map_name, settings.world, settings.graph) or "unnamed"
+    source = _world_source(settings.map_name, settings.shipped_world, settings.graph) or "unnamed"
     if settings.graph:
         return f"{source}, from the graph {settings.graph}"
     if settings.world == "cs2":
@@ -101,7 +105,7 @@ def world_line(settings: EvalSettings) -> str:
 
 
 @cache
-def _world_source(map_name: str, world: str, graph: str) -> str:
+def _world_source(map_name: str, world: GameWorld, graph: str) -> str:
     """Where the world of a run's graph comes from (the console, report.md and summary.json
     each say it: the graph is read once)."""
     from decoy_cli.waypoints.build import builtin_graph
@@ -109,7 +113,7 @@ def _world_source(map_name: str, world: str, graph: str) -> str:
 
     if graph:
         return WaypointGraph.load(graph).world_source
-    return builtin_graph(map_name, "cs2" if world == "cs2" else "csgo").world_source
+    return builtin_graph(map_name, world).world_source
 
 
 def sight_line(settings: EvalSettings) -> str | None:

@@ -13,6 +13,7 @@ import json
 from dataclasses import asdict, dataclass
 from functools import cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from decoy_cli.damage.choice import ModelChoice
 from decoy_cli.esta import Round
@@ -20,6 +21,9 @@ from decoy_cli.esta.content import content_sha256
 from decoy_cli.evaluate.heat import HeatGrid
 from decoy_cli.replay.replayer import ReplaySpec
 from decoy_cli.world.navmesh import asset_dir
+
+if TYPE_CHECKING:
+    from decoy_cli.waypoints.build import GameWorld
 
 RECORD_VERSION = 9
 """Format of the cached per-round records and file indexes; bump when it changes."""
@@ -80,6 +84,11 @@ class EvalSettings(ReplaySpec):
     """A map's geometry for line of sight (`--sight-mesh`), absolute ("": the graph's world)."""
     sight_mesh_sha: str = ""
     """SHA-256 of that file."""
+
+    @property
+    def shipped_world(self) -> GameWorld:
+        """The world of the map's shipped graph a run without `graph` replays on."""
+        return "cs2" if self.world == "cs2" else "csgo"
 
     def to_json(self) -> str:
         return json.dumps({**asdict(self), "models": str(self.models)}, sort_keys=True)
