@@ -8,6 +8,7 @@ import io
 import json
 import os
 import re
+import sys
 import zipfile
 from dataclasses import replace
 from pathlib import Path
@@ -348,13 +349,10 @@ def test_a_header_that_is_not_a_json_object_is_named(folder: Path) -> None:
         read_match(folder)
 
 
-def test_a_demo_without_awpy3_installed_says_how_to_read_it(tmp_path: Path) -> None:
-    try:
-        import awpy  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        pytest.skip("awpy 3 is installed: the demo path is tested with DECOY_TEST_DEMO")
+def test_a_demo_without_awpy3_installed_says_how_to_read_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "awpy", None)  # as if awpy 3 were not installed
     (tmp_path / "match.dem").write_bytes(b"PBDEMS2\x00")
     with pytest.raises(EstaError, match=r"needs awpy 3 \(pip install 'decoy\[cs2\]'\)"):
         read_match(tmp_path / "match.dem")

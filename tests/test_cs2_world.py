@@ -7,10 +7,12 @@ import gzip
 import json
 import lzma
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from nav_binary import write_binary_nav
 from shipped_graphs import assert_rebuilt_when_inputs_changed
 from typer.testing import CliRunner
 
@@ -27,7 +29,7 @@ from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import SAME_MAP_SHARE, cs2_world, on_map_share
 from decoy_cli.world.nav_data import REGIONS, load_navmesh
-from decoy_cli.world.nav_json import read_nav
+from decoy_cli.world.nav_json import PolygonNav, read_nav
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -135,21 +137,65 @@ def test_a_compressed_bomb_is_refused_without_unpacking_it(tmp_path: Path) -> No
         read_nav(tmp_path / "bomb.json.xz")
 
 
-def test_a_binary_nav_without_awpy_3_says_how_to_read_it(tmp_path: Path) -> None:
-    try:
-        import awpy  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        pytest.skip("awpy 3 is installed: the binary path is tested with DECOY_TEST_NAV")
-    (tmp_path / "de_dust2.nav").write_bytes((0xFEEDFACE).to_bytes(4, "little") + b"\0" * 60)
+def test_a_binary_nav_without_awpy_3_says_how_to_read_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "awpy", None)  # as if awpy 3 were not installed
+    path = write_binary_nav(tmp_path / "de_dust2.nav", [square(0, 0, 64, 0)], [])
     with pytest.raises(WorldError, match=r"read through awpy 3 .*awpy nav FILE\.nav"):
-        read_nav(tmp_path / "de_dust2.nav")
+        read_nav(path)
+
+
+def same_nav(a: PolygonNav, b: PolygonNav) -> bool:
+    return (
+        np.array_equal(a.area_id, b.area_id)
+        and np.array_equal(a.sides, b.sides)
+        and np.array_equal(a.corners, b.corners)
+        and np.array_equal(a.connections, b.connections)
+        and a.version == b.version
+    )
+
+
+@pytest.mark.parametrize("version", [30, 35, 36])
+def test_a_binary_nav_reads_through_awpy3_as_its_json_form(tmp_path: Path, version: int) -> None:
+    """A binary nav written in the layout awpy 3 reads (tests/nav_binary.py; no file from the
+    game is here) gives the areas, corners and connections of the same nav in JSON form."""
+    pytest.importorskip("awpy", reason="awpy 3 (the test extra) reads binary navs")
+    polygons = [
+        square(0, 0, 64, 0),
+        [(64.0, 0.0, 0.0), (128.0, 0.0, 16.0), (64.0, 64.0, 0.0)],  # a sloped triangle
+        square(0, 64, 64, 40),
+    ]
+    links = [(0, 1), (1, 0), (0, 2)]
+    binary = read_nav(write_binary_nav(tmp_path / "x.nav", polygons, links, version))
+    document = nav_document(polygons)
+    for k, area in enumerate(document["areas"].values()):
+        area["connections"] = [b + 1 for a, b in links if a == k]
+    json_form = read_nav(write_nav(tmp_path / "x.json", {**document, "version": version}))
+    assert same_nav(binary, json_form)
+
+
+@pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
+def test_cs2_dust2_as_a_binary_nav_makes_the_same_world(tmp_path: Path) -> None:
+    pytest.importorskip("awpy", reason="awpy 3 (the test extra) reads binary navs")
+    nav = read_nav(CS2_NAV)
+    polygons = [nav.polygon(a).tolist() for a in range(nav.num_areas)]
+    path = write_binary_nav(
+        tmp_path / "de_dust2.nav", polygons, nav.connections.tolist(), area_ids=nav.area_id
+    )
+    assert same_nav(read_nav(path), nav)
+    world = cs2_world(path, "de_dust2")
+    assert world.source == "CS2 de_dust2 nav mesh (de_dust2.nav, nav version 35)"
+    assert np.array_equal(world.triangles, cs2_world(CS2_NAV, "de_dust2").triangles)
+    truncated = tmp_path / "cut.nav"
+    truncated.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    with pytest.raises(WorldError, match=r"cut\.nav: not a CS2 nav file awpy 3 reads"):
+        read_nav(truncated)
 
 
 @pytest.mark.skipif(
     not os.environ.get("DECOY_TEST_NAV"),
-    reason="DECOY_TEST_NAV names no CS2 de_dust2 .nav to read through awpy 3",
+    reason="DECOY_TEST_NAV names no CS2 de_dust2 .nav from the game to read through awpy 3",
 )
 def test_a_real_binary_nav_reads_through_awpy3() -> None:
     world = cs2_world(os.environ["DECOY_TEST_NAV"], "de_dust2")

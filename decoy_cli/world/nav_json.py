@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import lzma
 import zlib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -84,9 +86,9 @@ def _binary_document(path: Path) -> dict[str, object]:
         ) from None
     try:
         mesh = NavMesh(path)
-        areas = {}
+        areas: dict[str, object] = {}
         for area_id in mesh.areas["area_id"].to_list():
-            area = mesh.area(area_id) or {}
+            area: Mapping[str, Any] = mesh.area(area_id) or {}
             areas[str(area_id)] = {
                 "area_id": area_id,
                 "corners": [{"x": x, "y": y, "z": z} for x, y, z in area.get("corners", [])],
