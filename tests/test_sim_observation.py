@@ -75,11 +75,18 @@ def _steps_of(sim: Simulator, encoder: ObservationEncoder) -> RoundSteps:
     return RoundSteps(sim, encoder, choices, list(sim.agents.names), is_t)
 
 
+SEEDS = (0, 1, 4)
+"""Busy rounds whose every step is checked. The encoder must match the reference on any
+state; these three (of the first twelve, which the test once played) reach every kind of state
+the layout has entries for, on both sites: the bomb carried, dropped, planted and exploded, a
+plant and a defuse under way (seed 4 alone has a defuse), agents dead; 12,184 steps."""
+
+
 def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
     graph = builtin_graph()
     setup = RoundSetup(graph=graph, damage_model=Shots())
     checked, seen = 0, set()
-    for seed in range(12):
+    for seed in SEEDS:
         agents = site_agents(graph, seed)
         encoder = ObservationEncoder(graph, list(agents.side), setup.rules_config(), bomb=True)
         with open_round(setup, agents, Wanderers(seed), bomb_carrier=seed % 5, seed=seed) as sim:
