@@ -22,9 +22,12 @@ def test_both_layouts_of_one_demo_evaluate_to_the_same_tables(tmp_path: Path) ->
         write_awpy3_folder(match, tmp_path / "m"),
     ]
     tables = []
-    for k, source in enumerate(sources):
+    # the zip in a worker process, the folder in this one: two processes, so a fight seeded by
+    # anything a process draws for itself (str hashes) cannot give both the same tables, and
+    # one pool to start instead of two
+    for k, (source, workers) in enumerate(zip(sources, ("1", "0"), strict=True)):
         out = tmp_path / f"run{k}"
-        args = ["evaluate", str(source), "--seed", "5", "--workers", "1", "--no-view"]
+        args = ["evaluate", str(source), "--seed", "5", "--workers", workers, "--no-view"]
         result = CliRunner().invoke(app, [*args, "--out", str(out)])
         assert result.exit_code == 0, result.output
         tables.append({p.name: p.read_text() for p in sorted((out / "tables").glob("*.csv"))})
