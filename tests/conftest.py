@@ -25,8 +25,9 @@ os.environ.setdefault("DECOY_WORKERS", "0")
 @pytest.fixture(scope="session")
 def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """One `decoy evaluate` of the shipped sample, for the view's tests (once per test process;
-    a test that changes a run changes a copy of it)."""
+    a test that changes a run changes a copy of it). In this process: the suite's two test
+    processes already keep both cores busy, and a pool would load the package twice more."""
     out = tmp_path_factory.mktemp("run") / "evaluate"
-    result = CliRunner().invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "2"])
+    result = CliRunner().invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "0"])
     assert result.exit_code == 0, result.output
     return out
