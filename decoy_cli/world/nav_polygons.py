@@ -64,6 +64,10 @@ between: both stop that far short of it (CS:GO's world counts three of its pushe
 OVERHEAD_U = 72.0
 """A floor more than this above a wall's foot is a floor overhead: the wall stops below it."""
 
+CornerNotes = dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]]
+"""Per corner of the open boundary (x, y rounded), the wall pieces that start or end there:
+("starts" or "ends", the piece's end beyond the edge, the corner's height, the wall's top)."""
+
 POLYGON_NAV_KIND = "polygon-nav"
 """`World.meta["kind"]` of a world made from a polygon nav mesh."""
 
@@ -88,7 +92,7 @@ def polygon_triangles(nav: PolygonNav) -> np.ndarray:
     floors = Floors(nav)
     edges = Edges(nav)
     covered, tris = _shared_stretches(edges, floors)
-    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]] = defaultdict(list)
+    walls: CornerNotes = defaultdict(list)
     for e, t0, t1, found in _open_pieces(edges, floors, covered):
         tris += _piece_faces(edges, floors, e, t0, t1, found, walls)
     tris += _corner_walls(walls)
@@ -219,7 +223,7 @@ def _piece_faces(
     t0: float,
     t1: float,
     found: tuple[float, float] | None,
-    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+    walls: CornerNotes,
 ) -> list:
     """Faces of the open piece [t0, t1] of edge e by what lies beyond it (module docstring);
     its wall's ends at the edge's corners are noted in `walls` for `_corner_walls`."""
@@ -275,7 +279,7 @@ def _note_ends(
     t0: float,
     t1: float,
     top: float,
-    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+    walls: CornerNotes,
 ) -> None:
     """Note a wall piece's ends that sit at a corner of its edge, keyed by the corner."""
     for t, kind in ((t0, "starts"), (t1, "ends")):
@@ -287,7 +291,7 @@ def _note_ends(
 
 
 def _corner_walls(
-    walls: dict[tuple[float, float], list[tuple[str, np.ndarray, float, float]]],
+    walls: CornerNotes,
 ) -> list:
     """A wall from each wall that ends at a corner to each that starts there (same level)."""
     tris: list = []
