@@ -249,11 +249,10 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
         (folder / file.name).symlink_to(file)
     out = tmp_path / "g.npz"
     # A 1.0 m lattice, not the default 0.7 m: the graph is built twice (without and with the
-    # candidates) and a coarser lattice builds in about half the time. On these three matches it
-    # weighs the same 17 candidate patches (66 boxes) on 16,736 real paths, finds 5 lengthened
-    # and keeps every patch, as 0.7 m does (28,400 paths, 35 lengthened): the graph written is
-    # the one the check built. Coarser still (1.2 m, 1.4 m) the lattice's own zig-zag lengthens
-    # paths enough to leave patches out: a third build, and a verdict about the lattice.
+    # candidates) and a coarser lattice builds in about half the time. On these three matches
+    # it learns the same candidates and keeps every one, as 0.7 m does, so the graph written
+    # is the one the check built; coarser still, the lattice's own zig-zag lengthens paths
+    # enough to leave patches out (a third build, and a verdict about the lattice).
     result = runner.invoke(
         app,
         [

@@ -79,7 +79,7 @@ SEEDS = (0, 1, 4)
 """Busy rounds whose every step is checked. The encoder must match the reference on any
 state; these three (of the first twelve, which the test once played) reach every kind of state
 the layout has entries for, on both sites: the bomb carried, dropped, planted and exploded, a
-plant and a defuse under way (seed 4 alone has a defuse), agents dead; 12,184 steps."""
+plant and a defuse under way (seed 4 alone has a defuse), agents dead."""
 
 
 def test_the_compiled_encoder_writes_every_entry_as_the_layout_says() -> None:
