@@ -176,7 +176,7 @@ def test_a_binary_nav_reads_through_awpy3_as_its_json_form(tmp_path: Path, versi
 
 
 @pytest.mark.skipif(not CS2_NAV.is_file(), reason=f"{CS2_NAV} is absent (../shared/data)")
-def test_cs2_dust2_as_a_binary_nav_makes_the_same_world(tmp_path: Path) -> None:
+def test_cs2_dust2_as_a_binary_nav_reads_as_its_json_form(tmp_path: Path) -> None:
     pytest.importorskip("awpy", reason="awpy 3 (the test extra) reads binary navs")
     nav = read_nav(CS2_NAV)
     polygons = [nav.polygon(a).tolist() for a in range(nav.num_areas)]
@@ -184,13 +184,22 @@ def test_cs2_dust2_as_a_binary_nav_makes_the_same_world(tmp_path: Path) -> None:
         tmp_path / "de_dust2.nav", polygons, nav.connections.tolist(), area_ids=nav.area_id
     )
     assert same_nav(read_nav(path), nav)
-    world = cs2_world(path, "de_dust2")
-    assert world.source == "CS2 de_dust2 nav mesh (de_dust2.nav, nav version 35)"
-    assert np.array_equal(world.triangles, cs2_world(CS2_NAV, "de_dust2").triangles)
     truncated = tmp_path / "cut.nav"
     truncated.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     with pytest.raises(WorldError, match=r"cut\.nav: not a CS2 nav file awpy 3 reads"):
         read_nav(truncated)
+
+
+def test_a_binary_nav_makes_the_world_its_json_form_makes(tmp_path: Path) -> None:
+    pytest.importorskip("awpy", reason="awpy 3 (the test extra) reads binary navs")
+    piece = read_nav(dust2_piece(tmp_path))
+    # the corners as a binary nav holds them (float32), written in both forms
+    polygons = [piece.polygon(a).astype(np.float32).tolist() for a in range(piece.num_areas)]
+    json_form = write_nav(tmp_path / "f32.json", nav_document(polygons))  # each to the next
+    path = write_binary_nav(tmp_path / "piece.nav", polygons, piece.connections.tolist(), 36)
+    world = cs2_world(path, "de_dust2")
+    assert world.source == "CS2 de_dust2 nav mesh (piece.nav, nav version 36)"
+    assert np.array_equal(world.triangles, cs2_world(json_form, "de_dust2").triangles)
 
 
 @pytest.mark.skipif(
