@@ -28,6 +28,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     a test that changes a run changes a copy of it). In this process: the suite's two test
     processes already keep both cores busy, and a pool would load the package twice more."""
     out = tmp_path_factory.mktemp("run") / "evaluate"
-    result = CliRunner().invoke(app, ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "0"])
+    args = ["evaluate", str(SAMPLE), "--out", str(out), "--workers", "0", "--no-figures"]
+    result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     return out

@@ -27,7 +27,16 @@ def test_both_layouts_of_one_demo_evaluate_to_the_same_tables(tmp_path: Path) ->
     # one pool to start instead of two
     for k, (source, workers) in enumerate(zip(sources, ("1", "0"), strict=True)):
         out = tmp_path / f"run{k}"
-        args = ["evaluate", str(source), "--seed", "5", "--workers", workers, "--no-view"]
+        args = [
+            "evaluate",
+            str(source),
+            "--seed",
+            "5",
+            "--workers",
+            workers,
+            "--no-view",
+            "--no-figures",
+        ]
         result = CliRunner().invoke(app, [*args, "--out", str(out)])
         assert result.exit_code == 0, result.output
         tables.append({p.name: p.read_text() for p in sorted((out / "tables").glob("*.csv"))})

@@ -85,7 +85,9 @@ def test_a_failure_message_with_markup_is_printed_as_it_is(tmp_path: Path) -> No
     file = _markup_match(tmp_path)
     broken = file.parent / "broken.json"
     broken.write_text("{")
-    result = _invoke("evaluate", str(file.parent), "--no-combat", "--out", str(tmp_path / "out"))
+    result = _invoke(
+        "evaluate", str(file.parent), "--no-combat", "--no-figures", "--out", str(tmp_path / "out")
+    )
     _clean_end(result)
     assert result.exit_code == 1
     assert f"in{MARKUP}" in result.stdout.replace("\n", "")
@@ -125,12 +127,13 @@ def test_a_cache_record_under_another_key_counts_as_missing(tmp_path: Path) -> N
     computed again, and the tables are those of a clean run."""
     file = _write(tmp_path / "in" / "m.json", make_match())
     out = tmp_path / "out"
-    assert _invoke("evaluate", str(file.parent), "--no-combat", "--out", str(out)).exit_code == 1
+    args = ("evaluate", str(file.parent), "--no-combat", "--no-figures", "--out", str(out))
+    assert _invoke(*args).exit_code == 1
     expected = _rows(out / "players.csv")
     records = sorted((out / "cache" / "rounds").glob("*.msgpack"))
     assert len(records) == 2  # rounds 1 and 2; round 3 has no frames
     shutil.copyfile(records[0], records[1])
-    result = _invoke("evaluate", str(file.parent), "--no-combat", "--out", str(out))
+    result = _invoke(*args)
     _clean_end(result)
     assert "1 computed" in result.stdout and "1 from the cache" in result.stdout
     assert _rows(out / "players.csv") == expected
@@ -147,7 +150,9 @@ def test_evaluate_replays_implausible_rounds_with_warnings_when_asked(tmp_path: 
     warning = "frame 0 (tick 1000): ct1 has HP 250 (at most 100)"
 
     failing = tmp_path / "fail"
-    result = _invoke("evaluate", str(file.parent), "--no-combat", "--out", str(failing))
+    result = _invoke(
+        "evaluate", str(file.parent), "--no-combat", "--no-figures", "--out", str(failing)
+    )
     assert result.exit_code == 1
     failures = _rows(failing / "failures.csv")
     assert [(row["round"], row["kind"]) for row in failures] == [
@@ -158,7 +163,14 @@ def test_evaluate_replays_implausible_rounds_with_warnings_when_asked(tmp_path: 
 
     warned = tmp_path / "warn"
     result = _invoke(
-        "evaluate", str(file.parent), "--no-combat", "--implausible", "warn", "--out", str(warned)
+        "evaluate",
+        str(file.parent),
+        "--no-combat",
+        "--no-figures",
+        "--implausible",
+        "warn",
+        "--out",
+        str(warned),
     )
     assert result.exit_code == 1  # round 3 (no frames) still fails
     assert "1 rounds replayed with implausible data" in result.stdout

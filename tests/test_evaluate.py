@@ -173,6 +173,10 @@ def test_the_reference_run_evaluates_every_player_round(
     assert acc.error_mm.sum() / 1000 / acc.error_count.sum() == pytest.approx(pooled, abs=5e-4)
 
 
+NO_FIGURES_RUN = ["evaluate", "--no-combat", "--no-bomb", "--no-figures"]
+"""An evaluation whose test reads the tables only."""
+
+
 def test_in_this_process_the_results_are_the_worker_s(
     clean: Path, settings: EvalSettings, reference: tuple[Evaluation, Tables], tmp_path: Path
 ) -> None:
@@ -183,7 +187,7 @@ def test_in_this_process_the_results_are_the_worker_s(
     out = tmp_path / "cli"
     result = runner.invoke(
         app,
-        ["evaluate", str(clean), "--no-combat", "--no-bomb", "--out", str(out)],
+        [*NO_FIGURES_RUN, str(clean), "--out", str(out)],
         env={**WIDE, "DECOY_WORKERS": "0"},
     )
     assert result.exit_code == 0, result.output
@@ -191,7 +195,7 @@ def test_in_this_process_the_results_are_the_worker_s(
     assert (out / "players.csv").read_text() == reference[1].players.to_csv(index=False)
     told = runner.invoke(
         app,
-        ["evaluate", str(clean), "--no-combat", "--no-bomb", "--workers", "1", "--out", str(out)],
+        [*NO_FIGURES_RUN, str(clean), "--workers", "1", "--out", str(out)],
         env={**WIDE, "DECOY_WORKERS": "0"},
     )
     assert told.exit_code == 0 and "evaluating with 1 local worker process" in told.output

@@ -130,7 +130,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (folder / "in").mkdir()
     write_match(folder / "in" / "m.json", make_match())
     out = folder / "evaluate"
-    args = ["evaluate", str(folder / "in"), "--no-combat", "--no-view", "--out", str(out)]
+    args = ["evaluate", str(folder / "in"), "--no-combat", "--no-view", "--no-figures"]
+    args += ["--out", str(out)]
     CliRunner().invoke(app, args)
     assert (out / "rounds.csv").is_file()
     return out

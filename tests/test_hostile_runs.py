@@ -40,7 +40,16 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     write_match(folder / "in" / "m.json", make_match())
     out = folder / "evaluate"
     result = runner.invoke(
-        app, ["evaluate", str(folder / "in"), "--no-combat", "--no-view", "--out", str(out)]
+        app,
+        [
+            "evaluate",
+            str(folder / "in"),
+            "--no-combat",
+            "--no-view",
+            "--no-figures",
+            "--out",
+            str(out),
+        ],
     )
     # exit 1: the fixture's round without frames is a recorded failure
     assert result.exit_code == 1 and (out / "rounds.csv").is_file(), result.output

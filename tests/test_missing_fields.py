@@ -377,7 +377,7 @@ def test_evaluate_names_what_it_inferred_and_the_protocol(tmp_path: Path) -> Non
     file = gunfight().write(tmp_path / "both.json")
     runner = CliRunner()
     out = tmp_path / "data"
-    args = ["evaluate", str(file), "--no-bomb", "--workers", "0", "--out", str(out)]
+    args = ["evaluate", str(file), "--no-bomb", "--workers", "0", "--no-figures", "--out", str(out)]
     result = runner.invoke(app, [*args, "--deaths", "data"], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
     assert "1 rounds lack fields the game needs" in result.stdout

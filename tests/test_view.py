@@ -170,7 +170,17 @@ def test_no_view_leaves_the_page_out(run: Path, tmp_path: Path) -> None:
     copy = tmp_path / "copy"
     shutil.copytree(run, copy)
     result = runner.invoke(
-        app, ["evaluate", str(SAMPLE), "--out", str(copy), "--workers", "1", "--no-view"]
+        app,
+        [
+            "evaluate",
+            str(SAMPLE),
+            "--out",
+            str(copy),
+            "--workers",
+            "1",
+            "--no-view",
+            "--no-figures",
+        ],
     )
     assert result.exit_code == 0, result.output
     assert not (copy / "view.html").exists()  # the earlier run's page goes with its tables
@@ -267,7 +277,7 @@ def empty_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (folder / "in").mkdir()
     (folder / "in" / "broken.json").write_text("{")
     out = folder / "evaluate"
-    result = runner.invoke(app, ["evaluate", str(folder / "in"), "--out", str(out)])
+    result = runner.invoke(app, ["evaluate", str(folder / "in"), "--no-figures", "--out", str(out)])
     assert result.exit_code == 1, result.output  # the failure is recorded
     return out
 
@@ -312,7 +322,8 @@ def hostile(tmp_path_factory: pytest.TempPathFactory) -> Path:
                     player["name"] = HOSTILE
     write_match(folder / "m.json", document)
     out = folder / "evaluate"
-    result = runner.invoke(app, ["evaluate", str(folder), "--no-combat", "--out", str(out)])
+    args = ["evaluate", str(folder), "--no-combat", "--no-figures", "--out", str(out)]
+    result = runner.invoke(app, args)
     assert (out / "view.html").is_file(), result.output
     return out / "view.html"
 
@@ -592,3 +603,19 @@ def test_an_injected_handler_or_script_does_not_run(browser: Browser, hostile: P
     )
     browser.wait_for("document.images.length > 0 && document.images[0].complete")
     assert browser.evaluate("window.ran.length") == 0
+
+
+def test_no_figures_leaves_them_out_and_the_tables_as_they_were(run: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "copy"
+    shutil.copytree(run, copy)
+    again = ["evaluate", str(SAMPLE), "--out", str(copy), "--workers", "0"]
+    assert runner.invoke(app, again).exit_code == 0  # every round from the cache; figures drawn
+    assert len(list((copy / "figures").glob("*.png"))) == 5
+    result = runner.invoke(app, [*again, "--no-figures"])
+    assert result.exit_code == 0, result.output
+    assert not (copy / "figures").exists()  # the earlier run's figures go with its tables
+    report = (copy / "report.md").read_text()
+    assert "Not drawn (`--no-figures`)" in report and "![" not in report
+    assert "| place | original | replay |" in report  # the table by place stays
+    for table in ("players.csv", "rounds.csv", "tables/places.csv"):
+        assert (copy / table).read_bytes() == (run / table).read_bytes()

@@ -123,6 +123,12 @@ def evaluate(
         help="Write view.html beside report.md: one page to look at any round, real against "
         "replay (`decoy view`).",
     ),
+    figures: bool = typer.Option(
+        True,
+        "--figures/--no-figures",
+        help="Draw the figures (figures/*.png, shown in report.md); --no-figures leaves them "
+        "out, which saves seconds a run when many runs only need the tables.",
+    ),
     scheduler: str | None = typer.Option(
         None,
         "--scheduler",
@@ -197,7 +203,7 @@ def evaluate(
                 )
             started = time.perf_counter()
             tables = build_tables(evaluation.accumulator)
-            write_outputs(evaluation, tables, out, info, view=view)
+            write_outputs(evaluation, tables, out, info, view=view, figures=figures)
         except KeyboardInterrupt:
             console.print(
                 f"interrupted: the finished rounds are cached in {out / 'cache'}; run the "

@@ -32,6 +32,9 @@ if TYPE_CHECKING:
 
     from decoy_cli.world.navmesh import NavMesh
 
+FIGURES_DIR = "figures"
+"""The figures' folder in an evaluation's output folder."""
+
 FIGURES = {
     "heatmaps": "heatmaps.png",
     "error_map": "error_map.png",

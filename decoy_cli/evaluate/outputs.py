@@ -13,8 +13,9 @@ Layout of the output folder:
   tables have only their header when the bomb was off);
 * `summary.json`: what was run and every aggregate table;
 * `figures/`: see decoy_cli/evaluate/figures.py; `report.md` (decoy_cli/evaluate/report.py)
-  shows them all;
-* `view.html`: the page to look at any round, real against replay (decoy_cli/view/page.py);
+  shows them all (no figures with `--no-figures`; an earlier run's are removed then);
+* `view.html`: the page to look at any round, real against replay (decoy_cli/view/page.py;
+  none with `--no-view`);
 * `cache/`: the per-round results (decoy_cli/evaluate/cache.py).
 """
 
@@ -27,14 +28,14 @@ import signal
 import threading
 from collections import Counter
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 import pandas as pd
 
 from decoy_cli.errors import OutputError
 from decoy_cli.evaluate.cache import CACHE_DIR
-from decoy_cli.evaluate.figures import draw_figures
+from decoy_cli.evaluate.figures import FIGURES, FIGURES_DIR, draw_figures
 from decoy_cli.evaluate.record import WARNING_SEPARATOR
 from decoy_cli.evaluate.report import (
     RunInfo,
@@ -121,17 +122,24 @@ def clear_leftovers(out: Path) -> None:
 
 
 def write_outputs(
-    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, *, view: bool = True
+    evaluation: Evaluation,
+    tables: Tables,
+    out: Path,
+    info: RunInfo,
+    *,
+    view: bool = True,
+    figures: bool = True,
 ) -> list[Path]:
-    """Write every output (see the module docstring; `view.html` unless `view` is off, and an
-    earlier run's is removed then) as one set: into a staging folder first,
+    """Write every output (see the module docstring; `view.html` unless `view` is off, the
+    figures unless `figures` is off, and an earlier run's are removed then) as one set: into a
+    staging folder first,
     then moved into `out` together, so a failure never leaves new tables beside an old report.
     A Ctrl-C takes effect once the set is in place (`ctrl_c_deferred`: stopped in the middle,
     matplotlib can fail with an error of its own). Only a SIGKILL or a power cut during the
     moves can leave a mix; the next run (every round cached) writes the set again. Returns the
     paths written."""
     with ctrl_c_deferred():
-        return _write_and_publish(evaluation, tables, out, info, view)
+        return _write_and_publish(evaluation, tables, out, info, view, figures)
 
 
 @contextmanager
@@ -152,18 +160,25 @@ def ctrl_c_deferred() -> Iterator[None]:
 
 
 def _write_and_publish(
-    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, view: bool
+    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, view: bool, figures: bool
 ) -> list[Path]:
     with staged(out) as stage:
-        written = _write_outputs(evaluation, tables, stage, info)
+        written = _write_outputs(evaluation, tables, stage, info, figures)
         if view:
             written.append(write_page(stage / VIEW_PAGE, run_page(stage, cache_root=out)))
     if not view:
         (out / VIEW_PAGE).unlink(missing_ok=True)
+    if not figures:  # an earlier run's figures would not be this run's
+        for name in FIGURES.values():
+            (out / FIGURES_DIR / name).unlink(missing_ok=True)
+        with suppress(OSError):  # absent, or holding files that are not ours
+            (out / FIGURES_DIR).rmdir()
     return [out / path.relative_to(stage) for path in written]
 
 
-def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo) -> list[Path]:
+def _write_outputs(
+    evaluation: Evaluation, tables: Tables, out: Path, info: RunInfo, figures: bool
+) -> list[Path]:
     from decoy_cli.world.navmesh import load_navmesh
 
     written = [
@@ -189,11 +204,13 @@ def _write_outputs(evaluation: Evaluation, tables: Tables, out: Path, info: RunI
     written.append(
         write_json(out / "summary.json", summary(evaluation, tables, info), sort_keys=False)
     )
-    nav = load_navmesh(evaluation.settings.map_name)
-    figures = draw_figures(out / "figures", evaluation.accumulator, tables, nav)
-    written += list(figures.values())
+    drawn: dict[str, Path] = {}
+    if figures:
+        nav = load_navmesh(evaluation.settings.map_name)
+        drawn = draw_figures(out / FIGURES_DIR, evaluation.accumulator, tables, nav)
+    written += list(drawn.values())
     text = report_markdown(
-        evaluation, tables, info, {k: p.relative_to(out) for k, p in figures.items()}
+        evaluation, tables, info, {k: p.relative_to(out) for k, p in drawn.items()}
     )
     written.append(write_atomic(out / "report.md", visible(text, keep="\n").encode()))
     return written

@@ -437,7 +437,19 @@ def _combat_section(tables: Tables, settings: EvalSettings) -> str:
     return "\n\n".join(text)
 
 
+PLACE_COLUMNS = [
+    "place",
+    "original",
+    "replay",
+    "difference (pp)",
+    "mean distance (m)",
+    "off the graph",
+]
+
+
 def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
+    """The figures with their captions and the table by nav place; the table alone when no
+    figure was drawn."""
     rows = [
         [
             str(r.place),
@@ -449,6 +461,16 @@ def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
         ]
         for r in tables.places.itertuples()
     ]
+    if not figures:
+        return "\n\n".join(
+            [
+                "## Figures",
+                "Not drawn (`--no-figures`). By nav place (the place of the nearest waypoint), "
+                "largest replay error first, with the share of the player's samples that have "
+                "no waypoint on their floor (where the replay cannot follow):",
+                md_table(PLACE_COLUMNS, rows),
+            ]
+        )
     return "\n\n".join(
         [
             "## Figures",
@@ -463,17 +485,7 @@ def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
             "(the place of the nearest waypoint), largest error first, with the share of the "
             "player's samples that have no waypoint on their floor (where the replay cannot "
             "follow):",
-            md_table(
-                [
-                    "place",
-                    "original",
-                    "replay",
-                    "difference (pp)",
-                    "mean distance (m)",
-                    "off the graph",
-                ],
-                rows,
-            ),
+            md_table(PLACE_COLUMNS, rows),
             "### HP over time",
             f"![HP over time]({figures['hp_over_time'].as_posix()})",
             "### Death times",
