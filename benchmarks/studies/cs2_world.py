@@ -80,8 +80,9 @@ def kill_eyes() -> np.ndarray:
 def movement(graph_file: Path | None, out: Path) -> dict[str, object]:
     """Movement figures of the 12 rounds replayed on a graph (None: the built-in one)."""
     extra = ["--graph", str(graph_file)] if graph_file else []
+    command = ["decoy", "evaluate", str(ROUNDS), "--no-combat", "--no-bomb", "--no-figures"]
     subprocess.run(
-        ["decoy", "evaluate", str(ROUNDS), "--no-combat", "--no-bomb", "--out", str(out), *extra],
+        [*command, "--out", str(out), *extra],
         check=True,
         capture_output=True,
     )
@@ -126,7 +127,7 @@ def whole_rounds(graph_file: Path | None, seeds: int, out: Path) -> dict[str, ob
             folder = out / f"{deaths}-{seed}"
             subprocess.run(
                 ["decoy", "evaluate", str(ROUNDS), "--seed", str(seed), "--deaths", deaths,
-                 "--out", str(folder), *extra],
+                 "--no-figures", "--out", str(folder), *extra],
                 check=True,
                 capture_output=True,
             )  # fmt: skip
