@@ -271,7 +271,8 @@ def test_the_bomb_table_of_evaluate_by_hand(tmp_path: Path) -> None:
         (data / f"m{k}.json").write_text(json.dumps(document))
     out = tmp_path / "out"
     result = CliRunner().invoke(
-        app, ["evaluate", str(data), "--out", str(out), "--no-combat", "--workers", "1"]
+        app,
+        ["evaluate", str(data), "--out", str(out), "--no-combat", "--workers", "1", "--no-figures"],
     )
     assert result.exit_code == 0, result.output
     table = pd.read_csv(out / "tables" / "bomb.csv").set_index("metric")

@@ -442,7 +442,9 @@ def test_evaluate_names_the_world_it_replays_on(tmp_path: Path) -> None:
     zipped = write_awpy2_zip(sample, tmp_path / "m.zip")
     out = tmp_path / "run"
     args = ["evaluate", str(zipped), "--sample", "1", "--no-combat", "--no-bomb", "--world", "cs2"]
-    result = runner.invoke(app, [*args, "--workers", "1", "--no-view", "--out", str(out)])
+    result = runner.invoke(
+        app, [*args, "--workers", "1", "--no-view", "--no-figures", "--out", str(out)]
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "summary.json").read_text())
     assert summary["world"].startswith("CS2 de_dust2 nav mesh")

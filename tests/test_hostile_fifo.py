@@ -61,7 +61,16 @@ def data(tmp_path: Path) -> Path:
 
 def test_evaluate_names_each_fifo_and_writes_the_good_rounds(data: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    done = decoy("evaluate", str(data), "--no-combat", "--no-view", "--out", str(out), cwd=tmp_path)
+    done = decoy(
+        "evaluate",
+        str(data),
+        "--no-combat",
+        "--no-view",
+        "--no-figures",
+        "--out",
+        str(out),
+        cwd=tmp_path,
+    )
     assert done.returncode == 1, done.stderr  # failures recorded, not a bug (2)
     assert "internal error" not in done.stderr and "Traceback" not in done.stderr
     with (out / "failures.csv").open(newline="") as handle:
@@ -156,7 +165,16 @@ def test_evaluate_over_one_bad_file_of_each_kind_keeps_the_good(tmp_path: Path) 
     (data / "folder.json").mkdir()
     (data / "loop.json").symlink_to(data / "loop.json")
     out = tmp_path / "out"
-    done = decoy("evaluate", str(data), "--no-combat", "--no-view", "--out", str(out), cwd=tmp_path)
+    done = decoy(
+        "evaluate",
+        str(data),
+        "--no-combat",
+        "--no-view",
+        "--no-figures",
+        "--out",
+        str(out),
+        cwd=tmp_path,
+    )
     assert done.returncode == 1, done.stderr
     assert "internal error" not in done.stderr and "Traceback" not in done.stderr
     with (out / "failures.csv").open(newline="") as handle:

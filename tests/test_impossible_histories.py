@@ -149,7 +149,8 @@ def test_evaluate_replays_a_player_on_both_sides_as_one_agent_per_side(tmp_path:
         frame["t"]["players"].append(ct2)
     file = write_match(tmp_path / "m.json", document)
     out = tmp_path / "out"
-    args = ["evaluate", str(file), "--no-combat", "--implausible", "warn", "--out", str(out)]
+    args = ["evaluate", str(file), "--no-combat", "--implausible", "warn", "--no-figures"]
+    args += ["--out", str(out)]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 1, result.output  # round 3 has no frames: its failure
     assert "Traceback" not in result.output

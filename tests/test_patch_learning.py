@@ -297,6 +297,7 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
             str(out),
             "--no-combat",
             "--no-bomb",
+            "--no-figures",
             "--sample",
             "2",
             "--workers",
