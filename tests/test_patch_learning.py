@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -271,6 +272,7 @@ def test_learning_on_real_matches_builds_a_graph_that_carries_its_patches(tmp_pa
     patches = out.with_suffix(".patches.csv")
     assert "learned" in result.output and str(patches) in result.output.replace("\n", "")
     assert "real consecutive-frame paths" in result.output
+    assert re.search(r"nav coverage: [\d.]+% of", result.output)  # a built-in map's build says it
     with open(patches, newline="") as f:
         rows = list(csv.DictReader(f))
     assert rows and all(int(r["matches"]) >= 2 for r in rows)
