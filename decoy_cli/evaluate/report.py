@@ -446,6 +446,11 @@ PLACE_COLUMNS = [
     "off the graph",
 ]
 
+PLACE_CAPTION = (
+    "By nav place (the place of the nearest waypoint), largest error first, with the share of "
+    "the player's samples that have no waypoint on their floor (where the replay cannot follow):"
+)
+
 
 def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
     """The figures with their captions and the table by nav place; the table alone when no
@@ -465,9 +470,7 @@ def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
         return "\n\n".join(
             [
                 "## Figures",
-                "Not drawn (`--no-figures`). By nav place (the place of the nearest waypoint), "
-                "largest replay error first, with the share of the player's samples that have "
-                "no waypoint on their floor (where the replay cannot follow):",
+                f"Not drawn (`--no-figures`). {PLACE_CAPTION}",
                 md_table(PLACE_COLUMNS, rows),
             ]
         )
@@ -481,10 +484,7 @@ def _figures_section(tables: Tables, figures: dict[str, Path]) -> str:
             "### Where the replay is off",
             f"![error map]({figures['error_map'].as_posix()})",
             "The distance between the replayed agent and the player at each data frame (the "
-            "clock protocol's per-frame distance), by where the player was. By nav place "
-            "(the place of the nearest waypoint), largest error first, with the share of the "
-            "player's samples that have no waypoint on their floor (where the replay cannot "
-            "follow):",
+            f"clock protocol's per-frame distance), by where the player was. {PLACE_CAPTION}",
             md_table(PLACE_COLUMNS, rows),
             "### HP over time",
             f"![HP over time]({figures['hp_over_time'].as_posix()})",
