@@ -19,7 +19,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from decoy_cli.waypoints.graph import EdgeKind
-from decoy_cli.waypoints.ladders import free_direction
+from decoy_cli.waypoints.ladders import end_node, free_direction
 from decoy_cli.waypoints.lattice_params import LatticeParams
 
 DETOUR = 5.0
@@ -34,8 +34,12 @@ def add_climb_edges(
     `climbs_m` ((C, 6) start and end, metres) the graph goes far round (module docstring);
     returns (edges, climbs joined)."""
     rows = np.asarray(edges, dtype=np.int64).reshape(-1, 4)
+    band = (-params.step_height, params.step_height)
     ends = [
-        (_near_node(positions, c[:3], params), _near_node(positions, c[3:], params))
+        (
+            end_node(positions, c[:3], band, params.spacing),
+            end_node(positions, c[3:], band, params.spacing),
+        )
         for c in climbs_m
     ]
     pairs = sorted({(s, t) for s, t in ends if s >= 0 and t >= 0 and s != t})
@@ -59,13 +63,3 @@ def add_climb_edges(
         kind = EdgeKind.JUMP if positions[t, 2] > positions[s, 2] else EdgeKind.DROP
         added.append([s, t, int(kind), direction])
     return np.concatenate([rows, np.asarray(added, dtype=np.int64).reshape(-1, 4)]), len(added)
-
-
-def _near_node(positions: np.ndarray, end: np.ndarray, params: LatticeParams) -> int:
-    """The node nearest `end` horizontally within a lattice spacing and a step in height, -1
-    if none."""
-    horizontal = np.hypot(positions[:, 0] - end[0], positions[:, 1] - end[1])
-    ok = (horizontal <= params.spacing) & (np.abs(positions[:, 2] - end[2]) <= params.step_height)
-    if not ok.any():
-        return -1
-    return int(np.argmin(np.where(ok, horizontal, np.inf)))

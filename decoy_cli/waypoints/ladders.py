@@ -101,8 +101,8 @@ def add_ladder_edges(
     ends = ladder_ends(ladders_u)
     joined = 0
     for top_end, bottom_end in zip(ends[0::2], ends[1::2], strict=True):
-        top = _end_node(positions, *top_end, reach)
-        bottom = _end_node(positions, *bottom_end, reach)
+        top = end_node(positions, *top_end, reach)
+        bottom = end_node(positions, *bottom_end, reach)
         if top < 0 or bottom < 0 or top == bottom:
             continue
         ways = [(bottom, top), (top, bottom)]
@@ -129,10 +129,11 @@ def _hurts(positions: np.ndarray, source: int, target: int) -> bool:
     return bool(positions[source, 2] - positions[target, 2] > SAFE_DROP_M)
 
 
-def _end_node(
+def end_node(
     positions: np.ndarray, end: np.ndarray, band: tuple[float, float], reach: float
 ) -> int:
-    """The node nearest a ladder's end within `reach` and its height band, -1 if none."""
+    """The node nearest `end` within `reach` horizontally and its height band (relative to
+    `end`), -1 if none: a ladder's end, or a climb's (`climbs.py`)."""
     horizontal = np.hypot(positions[:, 0] - end[0], positions[:, 1] - end[1])
     dz = positions[:, 2] - end[2]
     ok = (horizontal <= reach) & (dz >= band[0]) & (dz <= band[1])

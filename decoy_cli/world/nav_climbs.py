@@ -2,13 +2,12 @@
 more than a step and at most a jump, across at most a small hole.
 
 CS2's nav draws steep stairs as a column of flat areas, each a few units deep, with rises of
-a step to a jump between them (de_dust2's stairs between Under A and A: areas 10 to 25 u deep,
-rising 28 to 60 u from one to the next). The world built from it (`nav_polygons.py`) keeps those
-rises as step faces; players walk the stairs. The lattice, 0.7 m apart, seldom lands a node on
-so narrow an area with room for the capsule, so it can miss the way the nav names. Each climb
-here is the pair of nearest points of two connected areas' outlines (metres: lower or higher
-end first as the connection runs), for the waypoint builder to join where its graph goes far
-round (`decoy_cli/waypoints/climbs.py`).
+a step to a jump between them (de_dust2's stairs between Under A and A). The world built from
+it (`nav_polygons.py`) keeps those rises as step faces; players walk the stairs. The lattice,
+0.7 m apart, seldom lands a node on so narrow an area with room for the capsule, so it can miss
+the way the nav names. Each climb here is the pair of nearest points of two connected areas'
+outlines (metres: lower or higher end first as the connection runs), for the waypoint builder
+to join where its graph goes far round (`decoy_cli/waypoints/climbs.py`).
 """
 
 from __future__ import annotations
