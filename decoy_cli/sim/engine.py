@@ -104,9 +104,9 @@ class Simulator(OutsideChanges):
             agents.position, max_speed=np.array([max_speed_m_s(str(w)) for w in agents.weapon])
         )
         self.state = RoundState.open(agents, mover, graph)
-        """The round's arrays, their one owner: the agents' (the very arrays of `agents`), the
-        decisions' (who waits, STOPs, wants to plant or defuse, is on a drop), the mover's and
-        the graph's; compiled code takes them as one struct."""
+        """The round's decision arrays (who waits, STOPs, wants to plant or defuse, is on a
+        drop) beside the agents, the mover and the graph; compiled code takes all their arrays
+        as one struct."""
         self.falls = Falls(self.state, kills)  # kills False: a fall stops at 1 HP
         self.decision_count = 0  # state.decisions.sum(), kept as they are made
         self._deciding = -1  # the agent whose policy is deciding right now

@@ -1,20 +1,23 @@
-"""The round's state, one owner for the engine and compiled code: one `RoundState`.
+"""The round's state as the engine and compiled code share it: one `RoundState`.
 
-`RoundState` is built once when a simulator opens its round (`Simulator.state`). It holds the
-agents' arrays (under `Agents`' names), the decision arrays (which it allocates and owns), the
-mover's packed slots and what decisions read of the waypoint graph: the very arrays, not copies,
-so what compiled code writes the engine, the agents and the mover see.
+`RoundState` is built once when a simulator opens its round (`Simulator.state`). It owns the
+engine's decision arrays (who waits, STOPs, wants to plant or defuse, walks to which node, is on
+a damaging drop) and holds the round's other owners: the agents (`Agents`, whose arrays are the
+agents' state), the mover (its packed slots) and the waypoint graph. No array has a second
+Python handle: the agents' position is `agents.position`, nowhere else.
 
 It goes to compiled code as ONE argument, a numba struct (`structref`) built once (`kernel`):
-numba's dispatch checks and converts every argument of every call, a struct costs one, and a
-kernel reads its fields by name instead of taking dozens of positional arrays. With numba's JIT
-disabled (kernels run as Python) the struct is a plain namespace of the same fields.
+the very arrays of those owners, not copies, under their owners' names (`ROUND_FIELDS`), so what
+compiled code writes the engine, the agents and the mover see. Numba's dispatch checks and
+converts every argument of every call, a struct costs one, and a kernel reads its fields by name
+instead of taking dozens of positional arrays. With numba's JIT disabled (kernels run as Python)
+the struct is a plain namespace of the same fields.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
@@ -43,7 +46,7 @@ class _RoundType(StructBase):
 
 
 class RoundStruct(structref.StructRefProxy):
-    """`RoundState`'s arrays as one numba struct (fields: `RoundState`'s, in its order)."""
+    """The round's arrays as one numba struct (fields: `ROUND_FIELDS`, in that order)."""
 
 
 def pack(make: Callable[..., object], names: Sequence[str], values: Sequence[object]) -> object:
@@ -54,22 +57,35 @@ def pack(make: Callable[..., object], names: Sequence[str], values: Sequence[obj
     return SimpleNamespace(**dict(zip(names, values, strict=True)))
 
 
+AGENT_FIELDS = ("position", "yaw", "hp", "armor", "helmet", "has_defuser", "alive", "node")
+"""The agents' arrays compiled code reads and writes (`Agents`' fields of those names)."""
+DECISION_FIELDS = (
+    "waiting", "hold_until", "decisions", "wants_plant", "wants_defuse", "goal_node", "fall_m",
+)  # fmt: skip
+"""`RoundState`'s own arrays."""
+MOVER_FIELDS = ("mpos", "start", "target", "fv", "iv", "flags", "prm", "jump_speed", "gravity")
+"""The mover's packed slots (`MoverBase.kernel_arrays`; `movement.layout` names them), then its
+jump speed and gravity."""
+GRAPH_FIELDS = (
+    "first", "actions", "out_edges", "edge_target", "edge_kind", "edge_fall", "node_pos",
+)  # fmt: skip
+"""The graph's arrays, read only: each node's possible actions (`first`, `actions`:
+`WaypointGraph.allowed_actions`), its edges, `WaypointGraph.fall_m` and `.positions`."""
+ROUND_FIELDS = AGENT_FIELDS + DECISION_FIELDS + MOVER_FIELDS + GRAPH_FIELDS
+"""`RoundStruct`'s fields, in order."""
+
+structref.define_proxy(RoundStruct, _RoundType, list(ROUND_FIELDS))
+
+
 @dataclass(slots=True)
 class RoundState:
-    """One round's per-agent arrays (N rows each), as the engine, the agents and the mover share
-    them, and its graph's; `kernel` is the same arrays as one struct for compiled code (module
+    """One round's decision arrays (N rows each) beside the agents, the mover and the graph
+    they decide on; `kernel` is all their arrays as one struct for compiled code (module
     docstring)."""
 
-    # the agents' (`Agents`, under its names)
-    position: np.ndarray  # (N, 3) float64, feet
-    yaw: np.ndarray  # float64, degrees
-    hp: np.ndarray  # int16
-    armor: np.ndarray  # int16
-    helmet: np.ndarray  # bool
-    has_defuser: np.ndarray  # bool: has a defuse kit
-    alive: np.ndarray  # bool
-    node: np.ndarray  # int64: the waypoint last reached
-    # the engine's decisions
+    agents: Agents
+    mover: MoverBase
+    graph: WaypointGraph
     waiting: np.ndarray  # bool: asks for a decision at the next tick
     hold_until: np.ndarray  # int64: end tick of a STOP (0: none)
     decisions: np.ndarray  # int64: decisions made
@@ -77,60 +93,35 @@ class RoundState:
     wants_defuse: np.ndarray  # bool
     goal_node: np.ndarray  # int64: the node the agent walks to (-1: none)
     fall_m: np.ndarray  # float64: depth of the damaging drop it is on (0: none)
-    # the mover's packed slots (`MoverBase.kernel_arrays`; `movement.layout` names them)
-    mpos: np.ndarray  # (N, 3) the mover's positions
-    start: np.ndarray
-    target: np.ndarray
-    fv: np.ndarray
-    iv: np.ndarray
-    flags: np.ndarray
-    prm: np.ndarray
-    jump_speed: float
-    gravity: float
-    # the graph's (`WaypointGraph`), read only
-    first: np.ndarray  # (nodes + 1,) and ...
-    actions: np.ndarray  # ... each node's possible actions (`WaypointGraph.allowed_actions`)
-    out_edges: np.ndarray  # (nodes, 8) int64
-    edge_target: np.ndarray
-    edge_kind: np.ndarray
-    edge_fall: np.ndarray  # `WaypointGraph.fall_m`
-    node_pos: np.ndarray  # (nodes, 3) `WaypointGraph.positions`
     kernel: object = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.kernel = pack(_round_struct, ROUND_FIELDS, [getattr(self, n) for n in ROUND_FIELDS])
+        agents, mover, graph = self.agents, self.mover, self.graph
+        values = [getattr(agents, name) for name in AGENT_FIELDS]
+        values += [getattr(self, name) for name in DECISION_FIELDS]
+        values += [*mover.kernel_arrays(), mover.jump_speed, mover.gravity]
+        values += [*graph.allowed_actions, graph.out_edges, graph.edge_target, graph.edge_kind]
+        values += [graph.fall_m, graph.positions]
+        self.kernel = pack(_round_struct, ROUND_FIELDS, values)
 
     def due(self, tick: int) -> np.ndarray:
         """Indices (ascending) of the agents due for a decision at `tick` (`schedule`)."""
-        return due_agents(self.waiting, self.alive, self.hold_until, tick)
+        return due_agents(self.waiting, self.agents.alive, self.hold_until, tick)
 
     def next_due(self, tick: int) -> int:
         """The first tick after `tick` at which an agent is due for a decision, if no agent
         arrives before (`schedule`)."""
-        return next_due(self.waiting, self.alive, self.hold_until, tick)
+        return next_due(self.waiting, self.agents.alive, self.hold_until, tick)
 
     @classmethod
     def open(cls, agents: Agents, mover: MoverBase, graph: WaypointGraph) -> RoundState:
         """The state of a round of `agents` moved by `mover` (already reset to them) on `graph`:
-        the engine's decision arrays new, everyone waiting for a first decision."""
+        the decision arrays new, everyone waiting for a first decision."""
         n = agents.count
-        mpos, start, target, fv, iv, flags, prm = mover.kernel_arrays()
-        first, actions = graph.allowed_actions
         return cls(
-            agents.position, agents.yaw, agents.hp, agents.armor, agents.helmet,
-            agents.has_defuser, agents.alive, agents.node,
-            np.ones(n, bool), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, bool),
-            np.zeros(n, bool), np.full(n, -1, np.int64), np.zeros(n),
-            mpos, start, target, fv, iv, flags, prm, mover.jump_speed, mover.gravity,
-            first, actions, graph.out_edges, graph.edge_target, graph.edge_kind, graph.fall_m,
-            graph.positions,
+            agents, mover, graph, np.ones(n, bool), np.zeros(n, np.int64), np.zeros(n, np.int64),
+            np.zeros(n, bool), np.zeros(n, bool), np.full(n, -1, np.int64), np.zeros(n),
         )  # fmt: skip
-
-
-ROUND_FIELDS = tuple(f.name for f in fields(RoundState) if f.name != "kernel")
-"""`RoundStruct`'s fields, in order."""
-
-structref.define_proxy(RoundStruct, _RoundType, list(ROUND_FIELDS))
 
 
 @njit_cached
