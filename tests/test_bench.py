@@ -43,7 +43,9 @@ WIDE = {"COLUMNS": "220"}
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, dict[str, Any]]:
-    """One `decoy bench --quick` on a fixture match with an unloadable model folder."""
+    """One `decoy bench --quick` on a fixture match with an unloadable model folder, at sizes
+    given in place of the quick ones (Table 1's agent counts, each once, and decisions; the
+    combat step's agent counts): what the options give must reach every section."""
     folder = tmp_path_factory.mktemp("bench")
     data = folder / "data"
     data.mkdir()
@@ -54,6 +56,7 @@ def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, dict[str, 
         [
             "bench",
             "--quick",
+            *("--agents", "2,4,2", "--decisions", "150", "--combat-agents", "2,12"),
             "--data",
             str(data),
             "--models",
@@ -96,16 +99,16 @@ def test_the_model_fallback_is_said_and_labelled(quick_run) -> None:
 
 def test_table1_rows_are_consistent(quick_run) -> None:
     _, report = quick_run
+    assert report["config"]["agent_counts"] == [2, 4] and report["config"]["decisions"] == 150
     table = report["sections"]["table1"]
-    assert [row["agents"] for row in table["rows"]] == [2, 10]
+    assert [row["agents"] for row in table["rows"]] == [2, 4]
     for row in table["rows"]:
-        assert row["decisions"] >= table["decisions_per_row"] == 1000
+        assert 1000 > row["decisions"] >= table["decisions_per_row"] == 150
         assert row["ticks"] > 0 and row["rounds"] >= 1
         assert math.isclose(row["game_s"], row["ticks"] / 60)
         assert math.isclose(row["ticks_per_s"], row["ticks"] / row["wall_s"])
         assert math.isclose(row["time_scale"], row["game_s"] / row["wall_s"])
-        paper = PAPER_TICKS_PER_S[row["agents"]]
-        assert row["paper_ticks_per_s"] == paper
+        assert row["paper_ticks_per_s"] == PAPER_TICKS_PER_S.get(row["agents"])
         assert "ratio_to_paper" not in row  # the paper's machine is not this one
 
 
@@ -113,7 +116,7 @@ def test_throughput_sections_count_what_they_measured(quick_run) -> None:
     _, report = quick_run
     sections = report["sections"]
     kinematic = sections["kinematic"]
-    assert kinematic["agents"] == 10 and kinematic["decisions"] >= 1000
+    assert kinematic["agents"] == 10 and 150 <= kinematic["decisions"] < 1000
     assert kinematic["ticks_per_s"] == pytest.approx(kinematic["ticks"] / kinematic["wall_s"])
     env = sections["env"]
     assert env["rounds"] == 1 and len(env["outcomes"]) == 1 and env["outcomes"][0]
@@ -138,27 +141,6 @@ def test_throughput_sections_count_what_they_measured(quick_run) -> None:
     for row in metrics["kernels"]:
         assert row["calls"] == 50 and row["max_ms"] >= row["median_ms"] >= row["min_ms"] > 0
     rows = sections["combat_step"]["rows"]
-    assert [(row["agents"], row["layout"]) for row in rows] == [(10, "spread"), (10, "clustered")]
-    for row in rows:
-        parts = row["parts"]
-        assert row["steps"] == 20
-        assert parts["step"]["median_ms"] >= parts["visible_pairs"]["median_ms"] > 0
-
-
-def test_the_sizes_reach_table_1_the_kinematic_core_and_the_combat_step(tmp_path: Path) -> None:
-    out = tmp_path / "bench.json"
-    args = ["bench", "--quick", "--sections", "table1,kinematic,combat_step", "--models", "none"]
-    sizes = ["--agents", "3,4,3", "--decisions", "150", "--combat-agents", "2,12"]
-    result = runner.invoke(app, [*args, *sizes, "--out", str(out)], env=WIDE)
-    assert result.exit_code == 0, result.output
-    report = json.loads(out.read_text())
-    assert report["config"]["agent_counts"] == [3, 4] and report["config"]["decisions"] == 150
-    table = report["sections"]["table1"]
-    assert [row["agents"] for row in table["rows"]] == [3, 4]
-    assert table["decisions_per_row"] == 150
-    assert all(150 <= row["decisions"] < 1000 for row in table["rows"])
-    assert 150 <= report["sections"]["kinematic"]["decisions"] < 1000
-    rows = report["sections"]["combat_step"]["rows"]
     shapes = [(row["agents"], row["layout"], row["steps"]) for row in rows]
     # 20 quick steps at 10 agents or fewer; proportionally fewer above: 20 * 10 // 12
     assert shapes == [
@@ -167,7 +149,9 @@ def test_the_sizes_reach_table_1_the_kinematic_core_and_the_combat_step(tmp_path
         (12, "spread", 16),
         (12, "clustered", 16),
     ]
-    assert "one combat step" in result.stdout and "12" in result.stdout
+    for row in rows:
+        parts = row["parts"]
+        assert parts["step"]["median_ms"] >= parts["visible_pairs"]["median_ms"] > 0
 
 
 @pytest.mark.parametrize(

@@ -69,45 +69,34 @@ def test_headlines_are_rates_higher_is_better() -> None:
 
 
 @needs_git
-def test_a_git_ref_side_by_side_with_a_relative_out(
+def test_a_git_ref_runs_this_trees_portable_sections_on_its_package(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.chdir(tmp_path)
-    args = ["bench", "--quick", "--sections", "metrics", "--repeats", "1", "--baseline", "HEAD"]
-    result = runner.invoke(app, [*args, "--out", "side/bench.json"], env=WIDE)
+    monkeypatch.chdir(tmp_path)  # and a relative --out
+    args = ["bench", "--quick", "--sections", "kinematic,combat_step", "--repeats", "1"]
+    sizes = ["--decisions", "150", "--combat-agents", "2"]
+    out = ["--baseline", "HEAD", "--models", "none", "--out", "side/bench.json"]
+    result = runner.invoke(app, [*args, *sizes, *out], env=WIDE)
     assert result.exit_code == 0, result.output
     assert "speed-up of the current code over HEAD" in result.output
     report = json.loads((tmp_path / "side" / "bench.json").read_text())["side_by_side"]
-    row, *kernels = report["ratios"]
-    assert row["section"] == "metrics" and len(row["current"]) == len(row["baseline"]) == 1
-    assert row["figure"] == "pairs/s" and len(kernels) == 6  # dtw and frechet, two sizes
-    assert row["current"][0] > 0 and row["baseline"][0] > 0
-    runs = report["runs"]["metrics"]
-    assert "/baseline-" in runs["baseline"][0]["code"]
-    assert runs["current"][0]["code"].startswith(str(CHECKOUT))
-    assert [p.name for p in (tmp_path / "side").iterdir()] == ["bench.json"]  # nothing left
-
-
-@needs_git
-def test_a_portable_section_runs_this_trees_file_on_the_baselines_package(tmp_path: Path) -> None:
-    args = ["bench", "--quick", "--sections", "kinematic,combat_step", "--repeats", "1"]
-    sizes = ["--decisions", "150", "--combat-agents", "2"]
-    out = ["--baseline", "HEAD", "--models", "none", "--out", str(tmp_path / "b.json")]
-    result = runner.invoke(app, [*args, *sizes, *out])
-    assert result.exit_code == 0, result.output
-    report = json.loads((tmp_path / "b.json").read_text())["side_by_side"]
     figures = [(row["section"], row["figure"]) for row in report["ratios"]]
     assert figures == [
         ("kinematic", "ticks/s, 10 agents"),
         ("combat_step", "steps/s, 2 agents, spread"),
         ("combat_step", "steps/s, 2 agents, clustered"),
     ]
-    assert all(row["baseline"][0] > 0 for row in report["ratios"])
-    kinematic = report["runs"]["kinematic"]["baseline"][0]
-    assert "/baseline-" in kinematic["code"]
+    for row in report["ratios"]:
+        assert len(row["current"]) == len(row["baseline"]) == 1
+        assert row["current"][0] > 0 and row["baseline"][0] > 0
+    kinematic = report["runs"]["kinematic"]
+    assert "/baseline-" in kinematic["baseline"][0]["code"]
+    assert kinematic["current"][0]["code"].startswith(str(CHECKOUT))
+    assert [p.name for p in (tmp_path / "side").iterdir()] == ["bench.json"]  # nothing left
     assert not list(tmp_path.glob("**/.numba-cache"))  # removed with the baseline's tree
-    assert kinematic["damage_model"] == "none"
-    assert 150 <= kinematic["decisions"] < 1000  # the current code's sizes, on either side
+    assert kinematic["baseline"][0]["damage_model"] == "none"
+    # the current code's sizes, on either side
+    assert 150 <= kinematic["baseline"][0]["decisions"] < 1000
     (combat,) = report["runs"]["combat_step"]["baseline"]
     assert [row["agents"] for row in combat["rows"]] == [2, 2]
 
