@@ -1,4 +1,4 @@
-"""Crash consistency of `decoy evaluate` under fault injection (issue 35): what a SIGKILL, a
+"""Crash consistency of `decoy evaluate` under fault injection: what a SIGKILL, a
 Ctrl-C, a full disk, a read-only folder or a second run leaves behind, and whether a rerun gives
 the outputs of a run never interrupted.
 

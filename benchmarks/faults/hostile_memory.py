@@ -1,4 +1,4 @@
-"""Peak memory of the commands on hostile match files built to exhaust memory (issue 17's
+"""Peak memory of the commands on hostile match files built to exhaust memory (the
 target: every case under 2 GB, with a clean error or a result).
 
     python benchmarks/faults/hostile_memory.py [--only NAME] [--keep FOLDER]

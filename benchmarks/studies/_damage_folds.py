@@ -39,7 +39,7 @@ from decoy_cli.modeling.split import FOLDS, deal_folds
 from decoy_cli.modeling.train_options import DogLossWeights, TrainOptions
 
 MIN_CELL = 5
-"""Fewest real samples of a cell in the Wasserstein mean (issue 13's protocol)."""
+"""Fewest real samples of a cell in the Wasserstein mean of the fold comparison."""
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@
 
 Reads the run's `players.csv` and `summary.json`; for the clock `mean_dist` mean of every side
 prints the 95% interval with two seeds and how far apart their bounds are, as a share of the
-interval's width (issue 15 asks for at most 10%), then the time to compute every trajectory
+interval's width (the target is at most 10%), then the time to compute every trajectory
 interval (`decoy_cli.evaluate.tables`) against the run's wall time.
 """
 

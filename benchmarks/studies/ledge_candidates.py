@@ -1,4 +1,4 @@
-"""Walled sides over a lower floor: would a player step off there? (issue 34)
+"""Walled sides over a lower floor: would a player step off there?
 python benchmarks/studies/ledge_candidates.py [--mesh MESH.tri] [--rounds PATH ...]
 (defaults: ../shared/data/meshes/de_dust2_moh-maps.tri; the real rounds of
 ../shared/data/esta_dust2_tside (T side, CS:GO) and of

@@ -1,4 +1,4 @@
-"""How faithfully a replay's bomb follows real rounds: plants, defuses, sites, times (issue 12).
+"""How faithfully a replay's bomb follows real rounds: plants, defuses, sites, times.
 
     python benchmarks/studies/plant_study.py ../shared/data/esta_dust2_tside [--workers 2] [--csv X]
 

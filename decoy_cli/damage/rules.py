@@ -1,7 +1,7 @@
 """CS:GO's damage rules: what one bullet does, given the weapon, where it hit, how far it flew
 and the victim's armour.
 
-The game decides the amount; only whether a shot lands and where are chance (issue 13). A
+The game decides the amount; only whether a shot lands and where are chance. A
 bullet's damage is
 
     base × range_modifier ^ (distance / 500 u) × hit-group multiplier

@@ -1,4 +1,4 @@
-"""`RulesDamage`: the simulator's damage model grounded in the game's rules (issue 13).
+"""`RulesDamage`: the simulator's damage model grounded in the game's rules.
 
 Per combat step, over every visible ordered pair at once:
 

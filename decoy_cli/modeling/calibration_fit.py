@@ -35,7 +35,7 @@ from decoy_cli.damage.calibration import (
 
 MIN_RECALL = 0.8
 """Least share of each map's real damaging steps DIP must call hits at the operating point
-`decoy models fight-threshold` chooses for the fight (issue 33's floor; used by
+`decoy models fight-threshold` chooses for the fight (the recall floor; used by
 decoy_cli/modeling/fight_threshold.py, kept here so the CLI reads it without loading a world)."""
 
 BINS = 10

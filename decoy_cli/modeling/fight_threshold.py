@@ -14,7 +14,7 @@ on what the fight meets:
   0.5 s, so a pair at or above it is hit about twice in such a second: the label asks whether
   the second saw damage at all, as the fight's first hit does);
 * **constraint**: DIP still says "hit" on at least `MIN_RECALL` of the real damaging steps of
-  every map of the events data, so that it stays a classifier of real hits (issue 33): of the
+  every map of the events data, so that it stays a classifier of real hits: of the
   steps it did not train on (outside the training part its metadata names: its validation and
   test matches or rounds), where a map has any, since recall on its own training steps flatters
   it; a map it trained on whole is held on those, and says so.
