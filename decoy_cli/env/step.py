@@ -334,7 +334,12 @@ def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
             return StepEnd.LEFT_TO_RUN.value, -1, tick, 0
     r = e.round
     c = (e.given, e.draws, e.plant, e.defuse, e.top, e.hold_ticks)
-    reached, _, made, _, status = play_quiet(r, c, tick, horizon, 0, NEVER, watch, bomb[1], bomb[2])
+    # constants typed as a call from Python types them (np.int64, np.bool_; a bare 0 or False
+    # is a literal type): `play_quiet` and `_finish` compile once for both callers
+    first_draw, no_limit = np.int64(0), np.int64(NEVER)
+    reached, _, made, _, status = play_quiet(
+        r, c, tick, horizon, first_draw, no_limit, watch, bomb[1], bomb[2]
+    )
     if status == StretchEnd.AIRBORNE:
         return StepEnd.IN_THE_AIR.value, -1, reached, made
     if status == StretchEnd.DECIDED:  # `_hands_back` missed a way back: the tick is half played
@@ -342,7 +347,7 @@ def _quiet_step(e, chosen, hand_in, tick, horizon, watch, bomb, out):
     # (an agent due with no action: Python says whom)
     if status != StretchEnd.DUE or reached == tick:
         return StepEnd.LEFT_TO_RUN.value, -1, reached, made
-    unused = _finish(e, -1, bomb, False, reached, out)
+    unused = _finish(e, np.int64(-1), bomb, np.bool_(False), reached, out)
     if unused >= 0:
         return StepEnd.NOT_TAKEN.value, unused, reached, made
     return StepEnd.PLAYED.value, -1, reached, made

@@ -102,9 +102,9 @@ def _upper_bounds(a_t: np.ndarray, b_rev_t: np.ndarray, frechet_dims: int) -> tu
             stair_worst = max(stair_worst, sq_f)
             j += 1
         j_prev = j_end
-    i = 0
+    i = np.int64(0)  # not a literal 0: `_squared` compiles once for every call
     j = 0
-    greedy_worst, sq = _squared(a_t, 0, b_rev_t, m - 1, frechet_dims)
+    greedy_worst, sq = _squared(a_t, i, b_rev_t, m - 1, frechet_dims)
     greedy_total = math.sqrt(sq)
     while i < n - 1 or j < m - 1:
         best = math.inf

@@ -183,7 +183,7 @@ class MoverBase:
             names = ", ".join(k.name for k in EdgeKind)
             raise ValueError(f"{kind!r} is not an edge kind ({names})")
         started = begin_edge(
-            i, x, y, z, int(kind), float(speed), cap, self.jump_speed, self.gravity,
+            i, x, y, z, np.uint8(kind), float(speed), cap, self.jump_speed, self.gravity,
             self._pos, self._target, self._fv, self._iv,
         )  # fmt: skip
         if not started:
