@@ -216,8 +216,8 @@ class DecoyArrayEnv:
             raise ValueError(
                 f"actions are ({len(self.sides)},) integers, got {chosen.dtype} {chosen.shape}"
             )
-        if np.can_cast(chosen.dtype, np.int64):  # one type for the compiled step (uint64 not)
-            chosen = chosen.astype(np.int64, copy=False)
+        if chosen.dtype != np.int64 and np.can_cast(chosen.dtype, np.int64):
+            chosen = chosen.astype(np.int64)  # one type for the compiled step (uint64 not)
         return steps.play(chosen)
 
     def render(self) -> np.ndarray:
