@@ -93,11 +93,11 @@ def _upper_bounds(a_t: np.ndarray, b_rev_t: np.ndarray, frechet_dims: int) -> tu
     stair_total = 0.0
     stair_worst = 0.0
     j_prev = -1
-    for i in range(n):
-        j_end = m - 1 if n == 1 else (i * (m - 1) + (n - 1) // 2) // (n - 1)
+    for row in range(n):
+        j_end = m - 1 if n == 1 else (row * (m - 1) + (n - 1) // 2) // (n - 1)
         j = max(j_prev + 1 if j_end > j_prev else j_prev, 0)
         while j <= j_end:
-            sq_f, sq = _squared(a_t, i, b_rev_t, m - 1 - j, frechet_dims)
+            sq_f, sq = _squared(a_t, row, b_rev_t, m - 1 - j, frechet_dims)
             stair_total += math.sqrt(sq)
             stair_worst = max(stair_worst, sq_f)
             j += 1
