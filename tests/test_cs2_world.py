@@ -28,6 +28,7 @@ from decoy_cli.waypoints.build import (
 from decoy_cli.waypoints.graph import WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams
 from decoy_cli.world.cs2_world import SAME_MAP_SHARE, cs2_world, on_map_share
+from decoy_cli.world.nav_climbs import world_climbs
 from decoy_cli.world.nav_data import REGIONS, load_navmesh
 from decoy_cli.world.nav_json import PolygonNav, read_nav
 from decoy_cli.world.nav_polygons import POLYGON_WALL_PUSH_U, polygon_triangles
@@ -377,7 +378,7 @@ def test_build_waypoints_nav_writes_a_graph_with_its_world(tmp_path: Path) -> No
     assert "1 ladder links but no ladder positions" in result.output
     graph = WaypointGraph.load(out)
     assert graph.world_triangles is not None
-    climbs = len(np.asarray(cs2_world(path, "de_dust2").meta["climbs"]))
+    climbs = len(world_climbs(cs2_world(path, "de_dust2")))
     assert f"{graph.meta['climbs_joined']} of the nav's {climbs} joined" in result.output
 
 

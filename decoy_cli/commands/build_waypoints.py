@@ -29,6 +29,7 @@ from decoy_cli.waypoints.quality import SnapQuality, alignment_quality, check_al
 from decoy_cli.world import patch_learning
 from decoy_cli.world.cs2_world import cs2_world
 from decoy_cli.world.meshfile import check_extent, read_mesh
+from decoy_cli.world.nav_climbs import world_climbs
 from decoy_cli.world.navmesh import load_navmesh, nav_world
 from decoy_cli.world.world import World
 
@@ -242,9 +243,10 @@ def build_waypoints(
         table.add_row(
             "manual", f"{stats.manual_added} added, {stats.manual_dropped} unlinkable", ""
         )
-    if result.climbs_joined is not None:
-        given = len(np.asarray(world.meta["climbs"]))
-        table.add_row("climbs", f"{result.climbs_joined:,} of the nav's {given:,} joined", "")
+    climbs = world_climbs(world)
+    if climbs is not None:
+        joined = f"{result.climbs_joined:,} of the nav's {len(climbs):,} joined"
+        table.add_row("climbs", joined, "")
     table.add_row(
         "graph",
         f"{stats.nodes:,} nodes, {sum(stats.edges.values()):,} edges: "

@@ -21,6 +21,7 @@ from decoy_cli.errors import GraphError
 from decoy_cli.reading import open_regular
 from decoy_cli.waypoints.graph import FORMAT_VERSION, WaypointGraph
 from decoy_cli.waypoints.lattice import LatticeParams, LatticeResult, Progress, build_lattice
+from decoy_cli.world.nav_climbs import world_climbs
 from decoy_cli.world.nav_polygons import POLYGON_NAV_KIND
 from decoy_cli.world.navmesh import BUILTIN_MAP, NavMesh, asset_dir, load_navmesh, nav_world
 from decoy_cli.world.physics import PhysicsWorld
@@ -97,16 +98,8 @@ def build_graph(
     nav = load_navmesh(map_name)
     seed_points = default_seeds(nav) if seeds is None else np.asarray(seeds, dtype=np.float64)
     with PhysicsWorld(world) as physics:
-        climbs = world.meta.get("climbs")
-        result = build_lattice(
-            physics,
-            seed_points,
-            params,
-            manual,
-            progress,
-            nav.ladders,
-            climbs if isinstance(climbs, np.ndarray) else None,
-        )
+        climbs = world_climbs(world)
+        result = build_lattice(physics, seed_points, params, manual, progress, nav.ladders, climbs)
     places = nav.places
     place_index = {name: k for k, name in enumerate(places)}
     area = nav.area_of(result.positions)
@@ -143,7 +136,7 @@ def build_graph(
             "seeds_m": np.round(seed_points, 6).tolist(),
             "manual_waypoints": 0 if manual is None else len(manual),
             **({"patches": world.meta["patch_boxes"]} if "patch_boxes" in world.meta else {}),
-            **({"climbs_joined": result.climbs_joined} if result.climbs_joined is not None else {}),
+            **({"climbs_joined": result.climbs_joined} if climbs is not None else {}),
             "stats": stats,
         },
         world_triangles=world.triangles if carried else None,

@@ -173,7 +173,7 @@ def build_lattice(
     if manual is not None and len(manual):
         positions, edge_arr = merge_manual(physics, positions, edge_arr, manual, params, stats)
     edge_arr, stats.ladders_joined = add_ladder_edges(positions, edge_arr, ladders, params)
-    climbs_joined = None
+    climbs_joined = 0
     if climbs_m is not None:
         edge_arr, climbs_joined = add_climb_edges(positions, edge_arr, climbs_m, params)
     positions, edge_arr, pruned = prune(positions, edge_arr, stats)

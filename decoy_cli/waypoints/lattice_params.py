@@ -84,5 +84,5 @@ class LatticeResult:
     removed_kinds: np.ndarray  # (R,) EdgeKind of each removed edge
     pruned_positions: np.ndarray  # (Q, 3) nodes dropped by the component pruning
     stats: BuildStats
-    climbs_joined: int | None = None
-    """Climbs of the world given their own edge (`climbs.py`); None: the world names none."""
+    climbs_joined: int = 0
+    """Climbs of the world given their own edge (`climbs.py`)."""

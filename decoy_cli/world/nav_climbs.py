@@ -17,9 +17,17 @@ import numpy as np
 from decoy_cli.csgo import HAMMER_TO_M
 from decoy_cli.world.nav_geometry import BRIDGE_MAX_GAP_U, JUMP_U, STEP_U
 from decoy_cli.world.nav_json import PolygonNav
+from decoy_cli.world.world import World
 
 OUTLINE_STEP_U = 4.0
 """Outlines are compared at points this far apart (and at every corner)."""
+
+
+def world_climbs(world: World) -> np.ndarray | None:
+    """The climbs a world carries (`World.meta["climbs"]`, set by `nav_climbs` for a world made
+    from a polygon nav), None for a world that names none (CS:GO's, a user's mesh)."""
+    climbs = world.meta.get("climbs")
+    return climbs if isinstance(climbs, np.ndarray) else None
 
 
 def nav_climbs(nav: PolygonNav) -> np.ndarray:
